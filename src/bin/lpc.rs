@@ -1,0 +1,225 @@
+//! `lpc`: the command-line tool. A thin layer over the library: parse arguments, load a scene,
+//! run models, print or write outputs.
+//!
+//! Exit status: 0 success; 1 a run failed (a model stalled or refused the scene, an output
+//! could not be written); 2 bad input (a scene or a flag that cannot exist, a missing file).
+
+use std::path::{Path, PathBuf};
+use std::process::ExitCode;
+
+use anyhow::{Context, Result};
+use clap::{Parser, Subcommand, ValueEnum};
+use indicatif::{ProgressBar, ProgressStyle};
+
+use lpc_damper::chain::{run_chain, KerRow};
+use lpc_damper::output::{text_summary, write_atomic, write_run_dir, RunSummary};
+use lpc_damper::scene::{self, Scene, SceneError};
+use lpc_damper::sweep::{run_sweep, sweep_scenes};
+use lpc_damper::Model;
+
+#[derive(Parser)]
+#[command(name = "lpc", version, about = "Simulate the Linear Particle Chain impact damper (Gharib & Ghani 2013)")]
+struct Cli {
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Subcommand)]
+enum Command {
+    /// Run one model on a scene and print a summary (or write series, impacts and summary).
+    Run(RunArgs),
+    /// Run every value of a scene's [sweep] table, in parallel.
+    Sweep(SweepArgs),
+    /// The chain experiment (Fig. 5): kinetic energy ratio against the number of large balls.
+    Chain(ChainArgs),
+}
+
+#[derive(Clone, Copy, ValueEnum, PartialEq, Eq)]
+enum Format {
+    Text,
+    Json,
+}
+
+#[derive(clap::Args)]
+struct RunArgs {
+    /// Scene file (TOML), e.g. scenes/lpc-lsl.toml.
+    scene: PathBuf,
+    /// Model to run.
+    #[arg(long, default_value = "reference")]
+    model: Model,
+    /// Simulated time, s (overrides the scene's).
+    #[arg(long)]
+    horizon: Option<f64>,
+    /// Output sampling step, s (default 1 ms).
+    #[arg(long)]
+    sample_dt: Option<f64>,
+    /// Write series.csv, impacts.csv and summary.json into this directory.
+    #[arg(long)]
+    out: Option<PathBuf>,
+    /// Output format on standard output.
+    #[arg(long, value_enum, default_value_t = Format::Text)]
+    format: Format,
+}
+
+#[derive(clap::Args)]
+struct SweepArgs {
+    /// Scene file with a [sweep] table.
+    scene: PathBuf,
+    /// Model to run.
+    #[arg(long, default_value = "reference")]
+    model: Model,
+    /// Simulated time, s (overrides the scene's).
+    #[arg(long)]
+    horizon: Option<f64>,
+    /// Output format on standard output.
+    #[arg(long, value_enum, default_value_t = Format::Text)]
+    format: Format,
+    /// Also write sweep.json into this directory.
+    #[arg(long)]
+    out: Option<PathBuf>,
+}
+
+#[derive(clap::Args)]
+struct ChainArgs {
+    /// Chain scene file (default: scenes/chain-ker.toml).
+    scene: Option<PathBuf>,
+    /// Model to run.
+    #[arg(long, default_value = "reference")]
+    model: Model,
+    /// Output format on standard output.
+    #[arg(long, value_enum, default_value_t = Format::Text)]
+    format: Format,
+}
+
+fn main() -> ExitCode {
+    let cli = Cli::parse();
+    let result = match cli.command {
+        Command::Run(a) => cmd_run(a),
+        Command::Sweep(a) => cmd_sweep(a),
+        Command::Chain(a) => cmd_chain(a),
+    };
+    match result {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(e) => {
+            eprintln!("error: {e:#}");
+            if e.chain().any(|c| c.is::<SceneError>()) {
+                ExitCode::from(2)
+            } else {
+                ExitCode::from(1)
+            }
+        }
+    }
+}
+
+/// Applies `--horizon` and `--sample-dt`, with the scene's own rules.
+fn override_run(scene: &mut Scene, path: &Path, horizon: Option<f64>, sample_dt: Option<f64>) -> Result<(), SceneError> {
+    let invalid = |field: &str, rule: String| SceneError::Invalid { file: path.display().to_string(), field: field.into(), rule };
+    if let Some(h) = horizon {
+        if !(h.is_finite() && h > 0.0) {
+            return Err(invalid("--horizon", format!("must be a positive number of seconds (got {h})")));
+        }
+        scene.horizon = h;
+    }
+    if let Some(dt) = sample_dt {
+        scene.sample_dt = dt;
+    }
+    let field = if sample_dt.is_some() { "--sample-dt" } else { "run.sample_dt" };
+    scene::check_sample_dt(scene.horizon, scene.sample_dt).map_err(|rule| invalid(field, rule))
+}
+
+fn print_json<T: serde::Serialize>(value: &T) -> Result<()> {
+    println!("{}", serde_json::to_string_pretty(value)?);
+    Ok(())
+}
+
+fn cmd_run(a: RunArgs) -> Result<()> {
+    let mut scene = scene::load_scene(&a.scene)?;
+    override_run(&mut scene, &a.scene, a.horizon, a.sample_dt)?;
+    let run = a.model.simulate(&scene)?;
+    let summary = RunSummary::of(&run);
+    if let Some(dir) = &a.out {
+        write_run_dir(&run, dir).with_context(|| format!("writing outputs to {}", dir.display()))?;
+    }
+    match a.format {
+        Format::Json => print_json(&summary)?,
+        Format::Text => {
+            print!("{}", text_summary(&summary));
+            if let Some(dir) = &a.out {
+                println!("wrote series.csv, impacts.csv, summary.json to {}", dir.display());
+            }
+        }
+    }
+    Ok(())
+}
+
+/// A progress bar on a terminal when there is enough work to wait for; hidden otherwise.
+fn progress_bar(len: usize, label: &str) -> ProgressBar {
+    let bar = if len > 4 { ProgressBar::new(len as u64) } else { ProgressBar::hidden() };
+    bar.set_style(ProgressStyle::with_template("{msg} [{bar:30}] {pos}/{len} ({elapsed})").expect("valid template"));
+    bar.set_message(label.to_string());
+    bar
+}
+
+fn cmd_sweep(a: SweepArgs) -> Result<()> {
+    let loaded = scene::load(&a.scene)?;
+    let mut scenes = sweep_scenes(&loaded)?;
+    for (_, s) in &mut scenes {
+        override_run(s, &a.scene, a.horizon, None)?;
+    }
+    let parameter = loaded.file.sweep.as_ref().map(|s| s.parameter.clone()).unwrap_or_default();
+    let bar = progress_bar(scenes.len(), "sweep");
+    let start = std::time::Instant::now();
+    let points = run_sweep(&parameter, &scenes, a.model, &|| bar.inc(1))?;
+    bar.finish_and_clear();
+    let elapsed = start.elapsed().as_secs_f64();
+    if let Some(dir) = &a.out {
+        write_atomic(&dir.join("sweep.json"), &serde_json::to_vec_pretty(&points)?)
+            .with_context(|| format!("writing {}", dir.display()))?;
+    }
+    match a.format {
+        Format::Json => print_json(&points)?,
+        Format::Text => {
+            println!("sweep of `{parameter}` ({}, {} runs in {:.3} s)", a.model.name(), points.len(), elapsed);
+            println!(
+                "{:>10} {:>8} {:>12} {:>12} {:>10} {:>10} {:>9}",
+                parameter, "impacts", "peak xs mm", "peak a m/s2", "rms xs mm", "settle s", "E left %"
+            );
+            for p in &points {
+                let m = &p.summary.metrics;
+                println!(
+                    "{:>10} {:>8} {:>12.4} {:>12.4} {:>10.4} {:>10} {:>9.3}",
+                    p.value,
+                    p.summary.impact_count,
+                    m.peak_displacement * 1e3,
+                    m.peak_acceleration,
+                    m.rms_displacement * 1e3,
+                    m.settling_time.map_or("-".into(), |t| format!("{t:.3}")),
+                    m.energy_remaining.unwrap_or(f64::NAN) * 100.0
+                );
+            }
+        }
+    }
+    Ok(())
+}
+
+fn cmd_chain(a: ChainArgs) -> Result<()> {
+    let path = a.scene.unwrap_or_else(|| PathBuf::from("scenes/chain-ker.toml"));
+    let loaded = scene::load(&path)?;
+    let cases = loaded.chain.ok_or_else(|| SceneError::Invalid {
+        file: path.display().to_string(),
+        field: "chain".into(),
+        rule: "is missing: `lpc chain` needs a scene file with a [chain] table".into(),
+    })?;
+    let rows: Vec<KerRow> = run_chain(&cases, a.model)?;
+    match a.format {
+        Format::Json => print_json(&rows)?,
+        Format::Text => {
+            println!("kinetic energy ratio ({}): KE of all balls after / KE of the incident ball", a.model.name());
+            println!("{:>7} {:>7} {:>10}", "large", "small", "KER");
+            for r in &rows {
+                println!("{:>7} {:>7} {:>10.4}", r.large, r.small, r.ker);
+            }
+        }
+    }
+    Ok(())
+}

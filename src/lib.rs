@@ -1,0 +1,29 @@
+//! # lpc-damper
+//!
+//! Simulates the Linear Particle Chain (LPC) impact damper of Gharib & Ghani (J. Sound Vib.
+//! 2013): a spring-damped frame carrying a container of large and small steel balls that
+//! collide with each other and with the walls. Several models of the same system read one
+//! scene format and write one output type, so they can be checked against each other.
+//!
+//! Data flows one way: `scenes/*.toml` → [`scene`] (parse + validate) → a model
+//! ([`reference`]) → [`run::Run`] → [`metrics`], [`output`], [`chain`], [`sweep`].
+//!
+//! ```
+//! let scene = lpc_damper::scene::load_scene(lpc_damper::scene::scenes_dir().join("lpc-lsl.toml")).unwrap();
+//! let run = lpc_damper::reference::simulate(&scene).unwrap();
+//! assert!(run.energy.balance_error.abs() < 1e-12);
+//! let m = lpc_damper::metrics::metrics(&run);
+//! assert!(m.peak_displacement < scene.initial_displacement);
+//! ```
+#![warn(missing_docs)]
+
+pub mod chain;
+pub mod metrics;
+pub mod model;
+pub mod output;
+pub mod reference;
+pub mod run;
+pub mod scene;
+pub mod sweep;
+
+pub use model::Model;

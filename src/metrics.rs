@@ -1,0 +1,61 @@
+//! Headline metrics of MODEL.md §4, computed from a [`Run`]'s samples once, the same way for
+//! every model: peaks after one bare period, RMS, settling time, energy remaining.
+
+use crate::run::Run;
+
+/// Fraction of `|xs0|` that counts as settled.
+pub const SETTLING_FRACTION: f64 = 0.05;
+
+/// The headline metrics of one run.
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct Metrics {
+    /// max |xs| for t >= T, m.
+    pub peak_displacement: f64,
+    /// max |a| for t >= T, m/s^2.
+    pub peak_acceleration: f64,
+    /// RMS of xs over the horizon, m.
+    pub rms_displacement: f64,
+    /// Last time |xs| >= 5 % of |xs0|; `None` when that still holds at the horizon.
+    pub settling_time: Option<f64>,
+    /// Mechanical energy at the horizon / initial energy (`None` when the initial energy is 0).
+    pub energy_remaining: Option<f64>,
+}
+
+/// Computes the metrics of `run`.
+pub fn metrics(run: &Run) -> Metrics {
+    let s = &run.series;
+    let after_period = s.t.partition_point(|&t| t < run.damped_period);
+    let peak = |v: &[f64]| v[after_period.min(v.len())..].iter().fold(0.0f64, |m, x| m.max(x.abs()));
+    let rms = if s.is_empty() { 0.0 } else { (s.xs.iter().map(|x| x * x).sum::<f64>() / s.len() as f64).sqrt() };
+    Metrics {
+        peak_displacement: peak(&s.xs),
+        peak_acceleration: peak(&s.a),
+        rms_displacement: rms,
+        settling_time: settling_time(&s.t, &s.xs, run.initial_displacement),
+        energy_remaining: (run.energy.initial != 0.0).then(|| run.energy.final_ / run.energy.initial),
+    }
+}
+
+/// The last sampled time at which `|xs| >= 5 % |xs0|`, or `None` if the last sample still is
+/// (not settled within the horizon). A series that never reaches the band settles at 0.
+pub fn settling_time(t: &[f64], xs: &[f64], xs0: f64) -> Option<f64> {
+    let band = SETTLING_FRACTION * xs0.abs();
+    match xs.iter().rposition(|x| x.abs() >= band) {
+        None => Some(0.0),
+        Some(i) if i + 1 == xs.len() => None,
+        Some(i) => Some(t[i]),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn settling_is_last_time_outside_the_band() {
+        let t = [0.0, 1.0, 2.0, 3.0];
+        assert_eq!(settling_time(&t, &[1.0, -0.5, 0.01, 0.0], 1.0), Some(1.0));
+        assert_eq!(settling_time(&t, &[1.0, 0.0, 0.0, 0.06], 1.0), None);
+        assert_eq!(settling_time(&t, &[0.01, 0.0, 0.0, 0.0], 1.0), Some(0.0));
+    }
+}

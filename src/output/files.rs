@@ -1,0 +1,72 @@
+//! Files of `--out DIR`. Every file is written to a temporary name in the same directory and
+//! renamed into place, so an interrupted run never leaves a half file that looks complete.
+
+use std::io::Write;
+use std::path::Path;
+
+use super::RunSummary;
+use crate::run::Run;
+use crate::scene::Scene;
+
+/// Writes `bytes` to `path` atomically (temporary file + rename).
+pub fn write_atomic(path: &Path, bytes: &[u8]) -> std::io::Result<()> {
+    let dir = path.parent().filter(|p| !p.as_os_str().is_empty()).unwrap_or(Path::new("."));
+    std::fs::create_dir_all(dir)?;
+    let name = path.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default();
+    let tmp = dir.join(format!(".{name}.tmp-{}", std::process::id()));
+    {
+        let mut f = std::fs::File::create(&tmp)?;
+        f.write_all(bytes)?;
+        f.sync_all()?;
+    }
+    std::fs::rename(&tmp, path)
+}
+
+/// `series.csv`: `t, xs, vs, a`, then `x` and `v` of each ball.
+pub fn series_csv(run: &Run) -> Vec<u8> {
+    let s = &run.series;
+    let mut w = csv::Writer::from_writer(Vec::with_capacity(s.len() * (40 + 40 * s.x.len())));
+    let mut header = vec!["t".to_string(), "xs".into(), "vs".into(), "a".into()];
+    for i in 0..s.x.len() {
+        header.push(format!("x{}", i + 1));
+        header.push(format!("v{}", i + 1));
+    }
+    w.write_record(&header).expect("writing to memory");
+    let mut row = Vec::with_capacity(header.len());
+    for k in 0..s.len() {
+        row.clear();
+        row.extend([s.t[k], s.xs[k], s.vs[k], s.a[k]].iter().map(|x| x.to_string()));
+        for i in 0..s.x.len() {
+            row.push(s.x[i][k].to_string());
+            row.push(s.v[i][k].to_string());
+        }
+        w.write_record(&row).expect("writing to memory");
+    }
+    w.into_inner().expect("writing to memory")
+}
+
+/// `impacts.csv`: `t, body_a, body_b, approach_speed, energy_lost`.
+pub fn impacts_csv(run: &Run) -> Vec<u8> {
+    let mut w = csv::Writer::from_writer(Vec::new());
+    w.write_record(["t", "body_a", "body_b", "approach_speed", "energy_lost"]).expect("writing to memory");
+    for i in &run.impacts {
+        w.write_record([
+            i.t.to_string(),
+            Scene::body_name(i.a),
+            Scene::body_name(i.b),
+            i.approach_speed.to_string(),
+            i.energy_lost.to_string(),
+        ])
+        .expect("writing to memory");
+    }
+    w.into_inner().expect("writing to memory")
+}
+
+/// Writes `series.csv`, `impacts.csv` and `summary.json` of `run` into `dir`.
+pub fn write_run_dir(run: &Run, dir: &Path) -> std::io::Result<()> {
+    std::fs::create_dir_all(dir)?;
+    write_atomic(&dir.join("series.csv"), &series_csv(run))?;
+    write_atomic(&dir.join("impacts.csv"), &impacts_csv(run))?;
+    let json = serde_json::to_vec_pretty(&RunSummary::of(run)).expect("summary serialises");
+    write_atomic(&dir.join("summary.json"), &json)
+}

@@ -1,0 +1,125 @@
+//! Output of runs: the JSON contract ([`RunSummary`]), a readable text summary, and the files
+//! of `--out DIR` (`series.csv`, `impacts.csv`, `summary.json`), each written atomically.
+
+pub mod files;
+
+use serde::{Deserialize, Serialize};
+
+use crate::metrics::{metrics, Metrics};
+use crate::run::Run;
+use crate::scene::Scene;
+
+pub use files::{write_atomic, write_run_dir};
+
+/// One impact as in the JSON contract.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct ImpactSummary {
+    /// s.
+    pub t: f64,
+    /// `[A, B]`, e.g. `["left-wall", "ball1"]`.
+    pub bodies: [String; 2],
+    /// m/s.
+    pub approach_speed: f64,
+    /// J.
+    pub energy_lost: f64,
+}
+
+/// The energy account as in the JSON contract.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct EnergySummary {
+    /// J.
+    pub initial: f64,
+    /// J.
+    #[serde(rename = "final")]
+    pub final_: f64,
+    /// J.
+    pub damping_loss: f64,
+    /// J.
+    pub impact_loss: f64,
+    /// Relative.
+    pub balance_error: f64,
+}
+
+/// A run as in the JSON contract (`summary.json`, `lpc run --format json`).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct RunSummary {
+    /// Scene name.
+    pub scene: String,
+    /// Model name.
+    pub model: String,
+    /// s.
+    pub horizon: f64,
+    /// Number of impacts.
+    pub impact_count: usize,
+    /// Every impact.
+    pub impacts: Vec<ImpactSummary>,
+    /// Headline metrics.
+    pub metrics: Metrics,
+    /// Energy account.
+    pub energy: EnergySummary,
+    /// Computing time, s.
+    pub wall_time_s: f64,
+}
+
+impl RunSummary {
+    /// The summary of `run`.
+    pub fn of(run: &Run) -> Self {
+        RunSummary {
+            scene: run.scene.clone(),
+            model: run.model.clone(),
+            horizon: run.horizon,
+            impact_count: run.impacts.len(),
+            impacts: run
+                .impacts
+                .iter()
+                .map(|i| ImpactSummary {
+                    t: i.t,
+                    bodies: [Scene::body_name(i.a), Scene::body_name(i.b)],
+                    approach_speed: i.approach_speed,
+                    energy_lost: i.energy_lost,
+                })
+                .collect(),
+            metrics: metrics(run),
+            energy: EnergySummary {
+                initial: run.energy.initial,
+                final_: run.energy.final_,
+                damping_loss: run.energy.damping_loss,
+                impact_loss: run.energy.impact_loss,
+                balance_error: run.energy.balance_error,
+            },
+            wall_time_s: run.wall_time_s,
+        }
+    }
+}
+
+/// A readable multi-line summary of a run.
+pub fn text_summary(s: &RunSummary) -> String {
+    let m = &s.metrics;
+    let opt = |x: Option<f64>, unit: &str, scale: f64| x.map_or("not reached".to_string(), |v| format!("{:.4} {unit}", v * scale));
+    let e = &s.energy;
+    format!(
+        "scene {} | model {} | horizon {} s | computed in {:.3} ms\n\
+         impacts            {}\n\
+         peak displacement  {:.4} mm (t >= T)\n\
+         peak acceleration  {:.4} m/s^2 (t >= T)\n\
+         rms displacement   {:.4} mm\n\
+         settling time      {}\n\
+         energy remaining   {}\n\
+         energy (J)         initial {:.6e} = final {:.6e} + damping {:.6e} + impacts {:.6e} (balance error {:.1e})\n",
+        s.scene,
+        s.model,
+        s.horizon,
+        s.wall_time_s * 1e3,
+        s.impact_count,
+        m.peak_displacement * 1e3,
+        m.peak_acceleration,
+        m.rms_displacement * 1e3,
+        opt(m.settling_time, "s", 1.0),
+        opt(m.energy_remaining.map(|x| x * 100.0), "%", 1.0),
+        e.initial,
+        e.final_,
+        e.damping_loss,
+        e.impact_loss,
+        e.balance_error,
+    )
+}

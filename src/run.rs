@@ -1,0 +1,116 @@
+//! The common output of every model: sampled series, impact list, energy account and wall
+//! time. Metrics, comparison and output read only this type, so models stay interchangeable.
+
+use crate::scene::Body;
+
+/// Series sampled every `sample_dt` from `t = 0` to the horizon (inclusive where it falls on a sample).
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct Series {
+    /// s.
+    pub t: Vec<f64>,
+    /// Frame displacement, m.
+    pub xs: Vec<f64>,
+    /// Frame velocity, m/s.
+    pub vs: Vec<f64>,
+    /// Frame acceleration without impulses and contact forces, `(Fe - cs vs - ks xs)/ms`, m/s^2.
+    pub a: Vec<f64>,
+    /// Ball centres, `[ball][sample]`, m.
+    pub x: Vec<Vec<f64>>,
+    /// Ball velocities, `[ball][sample]`, m/s.
+    pub v: Vec<Vec<f64>>,
+}
+
+impl Series {
+    /// An empty series with room for `samples` samples of `balls` balls.
+    pub fn with_capacity(balls: usize, samples: usize) -> Self {
+        Series {
+            t: Vec::with_capacity(samples),
+            xs: Vec::with_capacity(samples),
+            vs: Vec::with_capacity(samples),
+            a: Vec::with_capacity(samples),
+            x: (0..balls).map(|_| Vec::with_capacity(samples)).collect(),
+            v: (0..balls).map(|_| Vec::with_capacity(samples)).collect(),
+        }
+    }
+    /// Number of samples.
+    pub fn len(&self) -> usize {
+        self.t.len()
+    }
+    /// True when no sample was taken.
+    pub fn is_empty(&self) -> bool {
+        self.t.is_empty()
+    }
+}
+
+/// One impact between two neighbouring bodies.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Impact {
+    /// s.
+    pub t: f64,
+    /// The left body of the pair.
+    pub a: Body,
+    /// The right body of the pair.
+    pub b: Body,
+    /// Relative speed of approach just before, m/s.
+    pub approach_speed: f64,
+    /// Kinetic energy lost, J.
+    pub energy_lost: f64,
+}
+
+/// Where the energy went. `balance_error = (initial - final - damping_loss - impact_loss) / initial`.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct EnergyAccount {
+    /// Mechanical energy at t = 0, J.
+    pub initial: f64,
+    /// Mechanical energy at the horizon, J.
+    pub final_: f64,
+    /// Dissipated by the frame damper `cs`, J.
+    pub damping_loss: f64,
+    /// Lost in impacts, J.
+    pub impact_loss: f64,
+    /// Relative balance error.
+    pub balance_error: f64,
+}
+
+impl EnergyAccount {
+    /// An account with its balance error computed.
+    pub fn new(initial: f64, final_: f64, damping_loss: f64, impact_loss: f64) -> Self {
+        let scale = if initial != 0.0 { initial.abs() } else { 1.0 };
+        EnergyAccount {
+            initial,
+            final_,
+            damping_loss,
+            impact_loss,
+            balance_error: (initial - final_ - damping_loss - impact_loss) / scale,
+        }
+    }
+}
+
+/// A model's result for one scene.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Run {
+    /// Scene name.
+    pub scene: String,
+    /// Model name (`reference`, `rapier`, ...).
+    pub model: String,
+    /// Simulated time actually covered, s.
+    pub horizon: f64,
+    /// Output step, s.
+    pub sample_dt: f64,
+    /// Initial frame displacement (for the settling threshold).
+    pub initial_displacement: f64,
+    /// Bare frame's damped period, s (0 when it does not oscillate).
+    pub damped_period: f64,
+    /// Sampled motion.
+    pub series: Series,
+    /// Every impact, in time order.
+    pub impacts: Vec<Impact>,
+    /// Energy account.
+    pub energy: EnergyAccount,
+    /// Events processed (impacts, sticks, releases); for stall detection.
+    pub events: u64,
+    /// Final ball velocities (exact, not sampled), m/s.
+    pub final_velocities: Vec<f64>,
+    /// Computing time, s.
+    pub wall_time_s: f64,
+}

@@ -1,0 +1,209 @@
+//! The TOML scene file as written by people: every table and key, with lengths that may be
+//! given in metres or as multiples of the reference radius (`"0.25 Rr"`). Nothing here is
+//! checked beyond syntax and types; `validate` turns a [`SceneFile`] into a [`super::Scene`].
+
+use serde::{Deserialize, Serialize};
+
+/// A whole scene file. `[frame]` + `[balls]` describe a damper; `[chain]` describes the
+/// chain experiment of MODEL.md §6 instead.
+#[derive(Debug, Clone, Deserialize, Serialize, Default)]
+#[serde(deny_unknown_fields)]
+pub struct SceneFile {
+    /// Scene name used in outputs; defaults to the file stem.
+    pub name: Option<String>,
+    /// The primary structure.
+    pub frame: Option<FrameFile>,
+    /// The damper's balls and container.
+    pub balls: Option<BallsFile>,
+    /// Run settings.
+    #[serde(default)]
+    pub run: RunFile,
+    /// Settings of the Rapier model.
+    #[serde(default)]
+    pub rapier: RapierFile,
+    /// A parameter sweep over this scene.
+    pub sweep: Option<SweepFile>,
+    /// The chain experiment (KER), instead of a damper.
+    pub chain: Option<ChainFile>,
+}
+
+/// `[frame]`: the spring-damped primary structure.
+#[derive(Debug, Clone, Deserialize, Serialize)]
+#[serde(deny_unknown_fields)]
+pub struct FrameFile {
+    /// `ms`, kg.
+    pub mass: f64,
+    /// `ks`, N/m.
+    pub stiffness: f64,
+    /// `cs`, N s/m.
+    pub damping: f64,
+    /// `xs0`, the initial displacement (m or Rr).
+    pub initial_displacement: Length,
+}
+
+/// `[balls]`: the balls in the container and the container geometry.
+#[derive(Debug, Clone, Deserialize, Serialize)]
+#[serde(deny_unknown_fields)]
+pub struct BallsFile {
+    /// `"LSL"` (L = large, S = small) or an explicit list of balls.
+    pub arrangement: Arrangement,
+    /// `m_L`, kg.
+    pub large_mass: f64,
+    /// `m_L / m_S`.
+    #[serde(default = "one")]
+    pub mass_ratio: f64,
+    /// Steel density, kg/m^3.
+    pub density: f64,
+    /// Coefficient of restitution `e` of every impact.
+    pub restitution: f64,
+    /// `Delta`: left gap and gap between neighbouring balls.
+    pub gap: Length,
+    /// `Lc`: clearance between the last ball and the right wall. Give either this or
+    /// `container_length`.
+    pub clearance: Option<Length>,
+    /// `Le`: inner container length; the clearance then follows from Eq. 11.
+    pub container_length: Option<Length>,
+}
+
+/// The order of balls, left to right.
+#[derive(Debug, Clone, Deserialize, Serialize)]
+#[serde(untagged)]
+pub enum Arrangement {
+    /// One letter per ball: `L` large, `S` small.
+    Letters(String),
+    /// One table per ball.
+    List(Vec<BallFile>),
+}
+
+/// One ball of an explicit arrangement.
+#[derive(Debug, Clone, Deserialize, Serialize)]
+#[serde(deny_unknown_fields)]
+pub struct BallFile {
+    /// kg.
+    pub mass: f64,
+    /// kg/m^3; defaults to the scene's density.
+    pub density: Option<f64>,
+}
+
+/// `[run]`: horizon and output sampling.
+#[derive(Debug, Clone, Deserialize, Serialize, Default)]
+#[serde(deny_unknown_fields)]
+pub struct RunFile {
+    /// Simulated time, s (default 5).
+    pub horizon: Option<f64>,
+    /// Output sampling step, s (default 1 ms).
+    pub sample_dt: Option<f64>,
+}
+
+/// `[rapier]`: settings of the contact model.
+#[derive(Debug, Clone, Deserialize, Serialize, Default)]
+#[serde(deny_unknown_fields)]
+pub struct RapierFile {
+    /// Fixed physics step, s.
+    pub dt: Option<f64>,
+    /// Solver iterations per step.
+    pub solver_iterations: Option<u32>,
+}
+
+/// `[sweep]`: one parameter and its values.
+#[derive(Debug, Clone, Deserialize, Serialize)]
+#[serde(deny_unknown_fields)]
+pub struct SweepFile {
+    /// One of `clearance`, `gap`, `mass_ratio`, `restitution`, `large_mass`, `stiffness`,
+    /// `damping`, `frame_mass`, `initial_displacement`.
+    pub parameter: String,
+    /// The values, in the parameter's unit (lengths may be `"1 Rr"`).
+    pub values: Vec<Length>,
+}
+
+/// `[chain]`: the KER experiment of MODEL.md §6.
+#[derive(Debug, Clone, Deserialize, Serialize)]
+#[serde(deny_unknown_fields)]
+pub struct ChainFile {
+    /// Numbers of large balls, e.g. `[3, 4, 5, 6, 7]`.
+    pub large_counts: Vec<u32>,
+    /// Run each count without and/or with small balls between the large ones.
+    #[serde(default = "both")]
+    pub small_balls: Vec<bool>,
+    /// kg.
+    pub large_mass: f64,
+    /// `m_L / m_S`.
+    pub mass_ratio: f64,
+    /// kg/m^3.
+    pub density: f64,
+    /// `e`.
+    pub restitution: f64,
+    /// Gap between neighbouring balls (m or Rr).
+    pub gap: Length,
+    /// Speed of the incident ball, m/s.
+    pub incident_speed: f64,
+}
+
+fn one() -> f64 {
+    1.0
+}
+fn both() -> Vec<bool> {
+    vec![false, true]
+}
+
+/// A length in metres, or a multiple of the reference radius written `"<k> Rr"`.
+#[derive(Debug, Clone, Copy, PartialEq, Deserialize, Serialize)]
+#[serde(try_from = "LengthRepr", into = "LengthRepr")]
+pub enum Length {
+    /// Metres.
+    Metres(f64),
+    /// Multiples of the reference radius.
+    Rr(f64),
+}
+
+#[derive(Deserialize, Serialize)]
+#[serde(untagged)]
+enum LengthRepr {
+    Number(f64),
+    Int(i64),
+    Text(String),
+}
+
+impl TryFrom<LengthRepr> for Length {
+    type Error = String;
+    fn try_from(r: LengthRepr) -> Result<Self, String> {
+        match r {
+            LengthRepr::Number(x) => Ok(Length::Metres(x)),
+            LengthRepr::Int(i) => Ok(Length::Metres(i as f64)),
+            LengthRepr::Text(s) => parse_rr(&s)
+                .ok_or_else(|| format!("`{s}` is not a length: write metres as a number or `<k> Rr`")),
+        }
+    }
+}
+
+impl From<Length> for LengthRepr {
+    fn from(l: Length) -> Self {
+        match l {
+            Length::Metres(x) => LengthRepr::Number(x),
+            Length::Rr(k) => LengthRepr::Text(format!("{k} Rr")),
+        }
+    }
+}
+
+fn parse_rr(s: &str) -> Option<Length> {
+    let t = s.trim();
+    let k = t.strip_suffix("Rr")?.trim();
+    let k = if k.is_empty() { 1.0 } else { k.parse::<f64>().ok()? };
+    Some(Length::Rr(k))
+}
+
+impl Length {
+    /// The length in metres for reference radius `rr`.
+    pub fn metres(self, rr: f64) -> f64 {
+        match self {
+            Length::Metres(x) => x,
+            Length::Rr(k) => k * rr,
+        }
+    }
+    /// The number as written (metres or Rr multiple), for reports.
+    pub fn raw(self) -> f64 {
+        match self {
+            Length::Metres(x) | Length::Rr(x) => x,
+        }
+    }
+}

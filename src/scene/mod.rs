@@ -1,0 +1,592 @@
+//! Scene description and validation: the only place where a scene file is parsed and checked.
+//! Every model receives a [`Scene`] that is already known to be valid (MODEL.md §1-2, §6).
+
+pub mod format;
+
+use std::f64::consts::PI;
+use std::path::{Path, PathBuf};
+
+pub use format::{Arrangement, Length, SceneFile};
+
+/// Default simulated time, s (MODEL.md §5).
+pub const DEFAULT_HORIZON: f64 = 5.0;
+/// Default output sampling step, s.
+pub const DEFAULT_SAMPLE_DT: f64 = 1e-3;
+/// Most output samples one run may hold (about 1 GB of series for ten balls).
+pub const MAX_SAMPLES: f64 = 2e7;
+/// Horizon used for chain experiments; the reference stops earlier, once no pair approaches.
+pub const CHAIN_HORIZON: f64 = 0.05;
+
+/// A scene that cannot exist, or a file that cannot be read: names the file, the field and the rule.
+#[derive(Debug, thiserror::Error)]
+pub enum SceneError {
+    /// The file could not be read.
+    #[error("{file}: cannot read scene file: {message}")]
+    Io {
+        /// The path given.
+        file: String,
+        /// Why.
+        message: String,
+    },
+    /// The file is not valid TOML, or has unknown keys or wrong types.
+    #[error("{file}: {message}")]
+    Parse {
+        /// The path given.
+        file: String,
+        /// The TOML parser's message (it names the key and line).
+        message: String,
+    },
+    /// A value breaks a rule of the model.
+    #[error("{file}: `{field}` {rule}")]
+    Invalid {
+        /// The path given.
+        file: String,
+        /// Dotted field name, e.g. `balls.restitution`.
+        field: String,
+        /// The rule broken, with the value.
+        rule: String,
+    },
+}
+
+/// The spring-damped primary structure (MODEL.md Eq. 5).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Frame {
+    /// `ms`, kg.
+    pub mass: f64,
+    /// `ks`, N/m.
+    pub stiffness: f64,
+    /// `cs`, N s/m.
+    pub damping: f64,
+}
+
+impl Frame {
+    /// The bare frame's damped angular frequency, or `None` when it does not oscillate.
+    pub fn damped_omega(&self) -> Option<f64> {
+        let sigma = self.damping / (2.0 * self.mass);
+        let w0sq = self.stiffness / self.mass;
+        let wd2 = w0sq - sigma * sigma;
+        (wd2 > 0.0).then(|| wd2.sqrt())
+    }
+    /// `T = 2 pi / omega_d`, or 0 when the bare frame does not oscillate.
+    pub fn damped_period(&self) -> f64 {
+        self.damped_omega().map_or(0.0, |w| 2.0 * PI / w)
+    }
+}
+
+/// Size class of a ball, for reports and colours.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum BallKind {
+    /// `L`.
+    Large,
+    /// `S`.
+    Small,
+    /// From an explicit list.
+    Custom,
+}
+
+/// One ball.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Ball {
+    /// kg.
+    pub mass: f64,
+    /// m, from mass and density.
+    pub radius: f64,
+    /// Size class.
+    pub kind: BallKind,
+}
+
+/// The container fixed on the frame: inner walls at `xs` and `xs + length`.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Container {
+    /// `Le`, m.
+    pub length: f64,
+    /// `Delta`, m.
+    pub gap: f64,
+    /// `Lc`, m.
+    pub clearance: f64,
+}
+
+/// Settings of the Rapier model that a scene may fix.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct RapierSettings {
+    /// Fixed step, s.
+    pub dt: Option<f64>,
+    /// Solver iterations.
+    pub solver_iterations: Option<u32>,
+}
+
+/// A validated system: what every model simulates.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Scene {
+    /// Name used in outputs.
+    pub name: String,
+    /// `None` for free balls on a line (the chain experiment).
+    pub frame: Option<Frame>,
+    /// Present exactly when `frame` is.
+    pub container: Option<Container>,
+    /// Left to right.
+    pub balls: Vec<Ball>,
+    /// `e`.
+    pub restitution: f64,
+    /// `xs0`, m (0 without a frame).
+    pub initial_displacement: f64,
+    /// Initial ball centres, m.
+    pub initial_positions: Vec<f64>,
+    /// Initial ball velocities, m/s.
+    pub initial_velocities: Vec<f64>,
+    /// Simulated time, s.
+    pub horizon: f64,
+    /// Output sampling step, s.
+    pub sample_dt: f64,
+    /// Rapier model settings from the file.
+    pub rapier: RapierSettings,
+    /// Reference radius `Rr`, m (radius of a large ball).
+    pub reference_radius: f64,
+}
+
+/// Radius of a solid sphere of mass `m` and density `rho`: `(3 m / (4 pi rho))^(1/3)`.
+pub fn ball_radius(mass: f64, density: f64) -> f64 {
+    (3.0 * mass / (4.0 * PI * density)).cbrt()
+}
+
+impl Scene {
+    /// Initial mechanical energy: spring energy plus balls' kinetic energy.
+    pub fn initial_energy(&self) -> f64 {
+        let spring = self.frame.map_or(0.0, |f| 0.5 * f.stiffness * self.initial_displacement.powi(2));
+        spring
+            + self
+                .balls
+                .iter()
+                .zip(&self.initial_velocities)
+                .map(|(b, v)| 0.5 * b.mass * v * v)
+                .sum::<f64>()
+    }
+
+    /// Names of bodies in outputs: `left-wall`, `right-wall`, `ball1`..`ballN`.
+    pub fn body_name(body: Body) -> String {
+        match body {
+            Body::LeftWall => "left-wall".into(),
+            Body::RightWall => "right-wall".into(),
+            Body::Ball(i) => format!("ball{}", i + 1),
+        }
+    }
+}
+
+/// A body that takes part in an impact.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
+pub enum Body {
+    /// The container's left wall (the frame).
+    LeftWall,
+    /// Ball `i` (0-based, left to right).
+    Ball(usize),
+    /// The container's right wall (the frame).
+    RightWall,
+}
+
+/// A loaded scene file: the scene, and the sweep or chain experiment it may describe.
+#[derive(Debug, Clone)]
+pub struct Loaded {
+    /// The file as parsed (kept so sweeps can vary one parameter and re-validate).
+    pub file: SceneFile,
+    /// The path it came from.
+    pub path: String,
+    /// The damper scene, when the file has `[frame]`.
+    pub scene: Option<Scene>,
+    /// The chain experiment, when the file has `[chain]`.
+    pub chain: Option<Vec<ChainCase>>,
+}
+
+/// One chain of the KER experiment.
+#[derive(Debug, Clone)]
+pub struct ChainCase {
+    /// Number of large balls `N_L` (the incident ball is extra).
+    pub large: u32,
+    /// Whether a small ball sits between each two large balls.
+    pub small: bool,
+    /// The system: incident ball first, then the chain.
+    pub scene: Scene,
+}
+
+/// Reads, parses and validates a scene file.
+pub fn load(path: impl AsRef<Path>) -> Result<Loaded, SceneError> {
+    let path = path.as_ref();
+    let file_name = path.display().to_string();
+    let text = std::fs::read_to_string(path)
+        .map_err(|e| SceneError::Io { file: file_name.clone(), message: e.to_string() })?;
+    let stem = path.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_default();
+    parse(&text, &file_name, &stem)
+}
+
+/// Parses and validates scene text; `file` names it in errors, `default_name` names the scene.
+pub fn parse(text: &str, file: &str, default_name: &str) -> Result<Loaded, SceneError> {
+    let parsed: SceneFile = toml::from_str(text)
+        .map_err(|e| SceneError::Parse { file: file.into(), message: e.to_string().trim_end().to_string() })?;
+    from_file(parsed, file, default_name)
+}
+
+/// Validates an already parsed file.
+pub fn from_file(parsed: SceneFile, file: &str, default_name: &str) -> Result<Loaded, SceneError> {
+    let v = Validator { file };
+    let name = parsed.name.clone().unwrap_or_else(|| default_name.to_string());
+    if parsed.chain.is_some() && (parsed.frame.is_some() || parsed.balls.is_some()) {
+        return Err(v.err("chain", "cannot be combined with [frame] or [balls]: a chain file describes only the KER experiment"));
+    }
+    let scene = match (&parsed.frame, &parsed.chain) {
+        (Some(_), _) => Some(build_damper(&parsed, &name, &v)?),
+        (None, None) => return Err(v.err("frame", "is missing: a scene needs a [frame] table (or a [chain] table)")),
+        (None, Some(_)) => None,
+    };
+    let chain = match &parsed.chain {
+        Some(c) => Some(build_chain(c, &parsed.run, &name, &v)?),
+        None => None,
+    };
+    if let (Some(sweep), Some(_)) = (&parsed.sweep, &scene) {
+        if sweep.values.is_empty() {
+            return Err(v.err("sweep.values", "is empty: give at least one value"));
+        }
+        for (i, value) in sweep.values.iter().enumerate() {
+            let varied = apply_sweep_value(&parsed, &sweep.parameter, *value)
+                .map_err(|rule| v.err("sweep.parameter", &rule))?;
+            build_damper(&varied, &name, &v).map_err(|e| match e {
+                SceneError::Invalid { file, field, rule } => SceneError::Invalid {
+                    file,
+                    field: format!("sweep.values[{i}] (as {field})"),
+                    rule,
+                },
+                other => other,
+            })?;
+        }
+    } else if parsed.sweep.is_some() {
+        return Err(v.err("sweep", "needs a damper scene ([frame] and [balls])"));
+    }
+    Ok(Loaded { file: parsed, path: file.to_string(), scene, chain })
+}
+
+/// Parameters a `[sweep]` may vary.
+pub const SWEEP_PARAMETERS: &[&str] = &[
+    "clearance",
+    "gap",
+    "mass_ratio",
+    "restitution",
+    "large_mass",
+    "density",
+    "frame_mass",
+    "stiffness",
+    "damping",
+    "initial_displacement",
+];
+
+/// The scene file with one parameter set to `value`.
+pub fn apply_sweep_value(file: &SceneFile, parameter: &str, value: Length) -> Result<SceneFile, String> {
+    let mut f = file.clone();
+    f.sweep = None;
+    let number = || match value {
+        Length::Metres(x) => Ok(x),
+        Length::Rr(_) => Err(format!("`{parameter}` is not a length: its values must be plain numbers")),
+    };
+    let frame = f.frame.as_mut().ok_or("needs a [frame] table")?;
+    match parameter {
+        "frame_mass" => frame.mass = number()?,
+        "stiffness" => frame.stiffness = number()?,
+        "damping" => frame.damping = number()?,
+        "initial_displacement" => frame.initial_displacement = value,
+        _ => {
+            let balls = f.balls.as_mut().ok_or("needs a [balls] table")?;
+            match parameter {
+                "clearance" => {
+                    balls.clearance = Some(value);
+                    balls.container_length = None;
+                }
+                "gap" => balls.gap = value,
+                "mass_ratio" => balls.mass_ratio = number()?,
+                "restitution" => balls.restitution = number()?,
+                "large_mass" => balls.large_mass = number()?,
+                "density" => balls.density = number()?,
+                other => {
+                    return Err(format!(
+                        "`{other}` cannot be swept; choose one of {}",
+                        SWEEP_PARAMETERS.join(", ")
+                    ))
+                }
+            }
+        }
+    }
+    Ok(f)
+}
+
+struct Validator<'a> {
+    file: &'a str,
+}
+
+impl Validator<'_> {
+    fn err(&self, field: &str, rule: &str) -> SceneError {
+        SceneError::Invalid { file: self.file.into(), field: field.into(), rule: rule.into() }
+    }
+    fn finite(&self, field: &str, x: f64) -> Result<f64, SceneError> {
+        if x.is_finite() {
+            Ok(x)
+        } else {
+            Err(self.err(field, &format!("must be a finite number (got {x})")))
+        }
+    }
+    fn positive(&self, field: &str, x: f64) -> Result<f64, SceneError> {
+        self.finite(field, x)?;
+        if x > 0.0 {
+            Ok(x)
+        } else {
+            Err(self.err(field, &format!("must be positive (got {x})")))
+        }
+    }
+    fn non_negative(&self, field: &str, x: f64) -> Result<f64, SceneError> {
+        self.finite(field, x)?;
+        if x >= 0.0 {
+            Ok(x)
+        } else {
+            Err(self.err(field, &format!("must not be negative (got {x})")))
+        }
+    }
+    fn restitution(&self, field: &str, e: f64) -> Result<f64, SceneError> {
+        self.finite(field, e)?;
+        if (0.0..=1.0).contains(&e) {
+            Ok(e)
+        } else {
+            Err(self.err(field, &format!("is a coefficient of restitution and must lie in [0, 1] (got {e})")))
+        }
+    }
+    fn run(&self, run: &format::RunFile, default_horizon: f64) -> Result<(f64, f64), SceneError> {
+        let horizon = self.positive("run.horizon", run.horizon.unwrap_or(default_horizon))?;
+        let dt = self.positive("run.sample_dt", run.sample_dt.unwrap_or(DEFAULT_SAMPLE_DT))?;
+        check_sample_dt(horizon, dt).map_err(|rule| self.err("run.sample_dt", &rule))?;
+        Ok((horizon, dt))
+    }
+}
+
+/// The rule an output step must keep: no longer than the horizon, at most [`MAX_SAMPLES`] samples.
+pub fn check_sample_dt(horizon: f64, dt: f64) -> Result<(), String> {
+    if !(dt.is_finite() && dt > 0.0) {
+        return Err(format!("must be a positive finite step (got {dt})"));
+    }
+    if dt > horizon {
+        return Err(format!("({dt} s) is longer than the horizon ({horizon} s): no sample would be written"));
+    }
+    if horizon / dt > MAX_SAMPLES {
+        return Err(format!(
+            "({dt} s) would write {:.0} samples over {horizon} s; at most {MAX_SAMPLES:.0} are allowed",
+            horizon / dt
+        ));
+    }
+    Ok(())
+}
+
+fn build_damper(f: &SceneFile, name: &str, v: &Validator) -> Result<Scene, SceneError> {
+    let fr = f.frame.as_ref().expect("checked by caller");
+    let frame = Frame {
+        mass: v.positive("frame.mass", fr.mass)?,
+        stiffness: v.non_negative("frame.stiffness", fr.stiffness)?,
+        damping: v.non_negative("frame.damping", fr.damping)?,
+    };
+    let (horizon, sample_dt) = v.run(&f.run, DEFAULT_HORIZON)?;
+    let rapier = rapier_settings(&f.rapier, v)?;
+    let Some(b) = &f.balls else {
+        let xs0 = v.finite("frame.initial_displacement", fr.initial_displacement.metres(0.0))?;
+        if matches!(fr.initial_displacement, Length::Rr(_)) {
+            return Err(v.err("frame.initial_displacement", "is given in Rr but the scene has no balls to define Rr"));
+        }
+        return Ok(Scene {
+            name: name.into(),
+            frame: Some(frame),
+            container: None,
+            balls: vec![],
+            restitution: 1.0,
+            initial_displacement: xs0,
+            initial_positions: vec![],
+            initial_velocities: vec![],
+            horizon,
+            sample_dt,
+            rapier,
+            reference_radius: 0.0,
+        });
+    };
+    let large_mass = v.positive("balls.large_mass", b.large_mass)?;
+    let mass_ratio = v.positive("balls.mass_ratio", b.mass_ratio)?;
+    let density = v.positive("balls.density", b.density)?;
+    let restitution = v.restitution("balls.restitution", b.restitution)?;
+    let rr = ball_radius(large_mass, density);
+    let balls = arrangement_balls(&b.arrangement, large_mass, mass_ratio, density, "balls.arrangement", v)?;
+    let xs0 = v.finite("frame.initial_displacement", fr.initial_displacement.metres(rr))?;
+    let gap = v.finite("balls.gap", b.gap.metres(rr))?;
+    if gap < 0.0 {
+        return Err(v.err("balls.gap", &format!("must not be negative: neighbouring balls would overlap (got {gap} m)")));
+    }
+    let sum_d: f64 = balls.iter().map(|b| 2.0 * b.radius).sum();
+    let n = balls.len() as f64;
+    let (length, clearance) = match (b.clearance, b.container_length) {
+        (Some(_), Some(_)) => {
+            return Err(v.err("balls.container_length", "and `balls.clearance` are both given: give one (Eq. 11 ties them)"))
+        }
+        (None, None) => return Err(v.err("balls.clearance", "is missing: give the clearance or the container length")),
+        (Some(lc), None) => {
+            let lc = v.non_negative("balls.clearance", lc.metres(rr))?;
+            (n * gap + sum_d + lc, lc)
+        }
+        (None, Some(le)) => {
+            let le = v.positive("balls.container_length", le.metres(rr))?;
+            let lc = le - n * gap - sum_d;
+            if lc < 0.0 {
+                return Err(v.err(
+                    "balls.container_length",
+                    &format!(
+                        "is {le} m but the balls and gaps need {} m: the balls cannot fit",
+                        n * gap + sum_d
+                    ),
+                ));
+            }
+            (le, lc)
+        }
+    };
+    let mut positions = Vec::with_capacity(balls.len());
+    let mut x = xs0 + gap;
+    for ball in &balls {
+        positions.push(x + ball.radius);
+        x += 2.0 * ball.radius + gap;
+    }
+    Ok(Scene {
+        name: name.into(),
+        frame: Some(frame),
+        container: Some(Container { length, gap, clearance }),
+        initial_velocities: vec![0.0; balls.len()],
+        balls,
+        restitution,
+        initial_displacement: xs0,
+        initial_positions: positions,
+        horizon,
+        sample_dt,
+        rapier,
+        reference_radius: rr,
+    })
+}
+
+fn rapier_settings(r: &format::RapierFile, v: &Validator) -> Result<RapierSettings, SceneError> {
+    if let Some(dt) = r.dt {
+        v.positive("rapier.dt", dt)?;
+        if dt > 0.1 {
+            return Err(v.err("rapier.dt", &format!("({dt} s) is longer than 0.1 s: far too long for centimetre balls")));
+        }
+    }
+    if let Some(it) = r.solver_iterations {
+        if it == 0 || it > 1000 {
+            return Err(v.err("rapier.solver_iterations", &format!("must lie in 1..=1000 (got {it})")));
+        }
+    }
+    Ok(RapierSettings { dt: r.dt, solver_iterations: r.solver_iterations })
+}
+
+fn arrangement_balls(
+    a: &Arrangement,
+    large_mass: f64,
+    mass_ratio: f64,
+    density: f64,
+    field: &str,
+    v: &Validator,
+) -> Result<Vec<Ball>, SceneError> {
+    let small_mass = large_mass / mass_ratio;
+    match a {
+        Arrangement::Letters(s) => s
+            .chars()
+            .filter(|c| !c.is_whitespace() && *c != '-')
+            .map(|c| match c.to_ascii_uppercase() {
+                'L' => Ok(Ball { mass: large_mass, radius: ball_radius(large_mass, density), kind: BallKind::Large }),
+                'S' => Ok(Ball { mass: small_mass, radius: ball_radius(small_mass, density), kind: BallKind::Small }),
+                other => Err(v.err(field, &format!("has the unknown letter `{other}`: use L (large) and S (small)"))),
+            })
+            .collect(),
+        Arrangement::List(list) => list
+            .iter()
+            .enumerate()
+            .map(|(i, b)| {
+                let m = v.positive(&format!("{field}[{i}].mass"), b.mass)?;
+                let rho = v.positive(&format!("{field}[{i}].density"), b.density.unwrap_or(density))?;
+                Ok(Ball { mass: m, radius: ball_radius(m, rho), kind: BallKind::Custom })
+            })
+            .collect(),
+    }
+}
+
+fn build_chain(c: &format::ChainFile, run: &format::RunFile, name: &str, v: &Validator) -> Result<Vec<ChainCase>, SceneError> {
+    let large_mass = v.positive("chain.large_mass", c.large_mass)?;
+    let mass_ratio = v.positive("chain.mass_ratio", c.mass_ratio)?;
+    let density = v.positive("chain.density", c.density)?;
+    let restitution = v.restitution("chain.restitution", c.restitution)?;
+    let speed = v.positive("chain.incident_speed", c.incident_speed)?;
+    let rr = ball_radius(large_mass, density);
+    let gap = v.non_negative("chain.gap", c.gap.metres(rr))?;
+    let (horizon, sample_dt) = v.run(run, CHAIN_HORIZON)?;
+    if c.large_counts.is_empty() {
+        return Err(v.err("chain.large_counts", "is empty"));
+    }
+    if c.small_balls.is_empty() {
+        return Err(v.err("chain.small_balls", "is empty: give [false], [true] or both"));
+    }
+    let mut cases = Vec::new();
+    for &small in &c.small_balls {
+        for &nl in &c.large_counts {
+            if !(1..=1000).contains(&nl) {
+                return Err(v.err("chain.large_counts", &format!("must lie in 1..=1000 (got {nl})")));
+            }
+            let mut letters = String::from("L");
+            for i in 0..nl {
+                if i > 0 && small {
+                    letters.push('S');
+                }
+                letters.push('L');
+            }
+            let balls = arrangement_balls(&Arrangement::Letters(letters), large_mass, mass_ratio, density, "chain", v)?;
+            let mut positions = Vec::with_capacity(balls.len());
+            let mut x = 0.0;
+            for (i, b) in balls.iter().enumerate() {
+                if i > 0 {
+                    x += gap + b.radius;
+                }
+                positions.push(x);
+                x += b.radius;
+            }
+            let mut velocities = vec![0.0; balls.len()];
+            velocities[0] = speed;
+            cases.push(ChainCase {
+                large: nl,
+                small,
+                scene: Scene {
+                    name: format!("{name}-{nl}L{}", if small { format!("-{}S", nl - 1) } else { String::new() }),
+                    frame: None,
+                    container: None,
+                    balls,
+                    restitution,
+                    initial_displacement: 0.0,
+                    initial_positions: positions,
+                    initial_velocities: velocities,
+                    horizon,
+                    sample_dt,
+                    rapier: RapierSettings::default(),
+                    reference_radius: rr,
+                },
+            });
+        }
+    }
+    Ok(cases)
+}
+
+/// Loads a file that must describe a damper scene.
+pub fn load_scene(path: impl AsRef<Path>) -> Result<Scene, SceneError> {
+    let loaded = load(path)?;
+    let file = loaded.path.clone();
+    loaded.scene.ok_or(SceneError::Invalid {
+        file,
+        field: "frame".into(),
+        rule: "is missing: this command needs a damper scene, not a chain experiment".into(),
+    })
+}
+
+/// The scenes directory shipped with the crate, for tests and `lpc check`.
+pub fn scenes_dir() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes")
+}
