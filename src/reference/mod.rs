@@ -64,6 +64,21 @@ pub fn simulate(scene: &Scene) -> Result<Run, ReferenceError> {
     Ok(run)
 }
 
+/// Samples stepped by the transition matrix between two closed-form evaluations.
+const REANCHOR: u32 = 32;
+
+/// Where frame sampling stands: the last sample's state and the step matrix of its segment.
+#[derive(Debug, Clone, Copy)]
+struct SampleCursor {
+    seg_t0: f64,
+    k: usize,
+    x: f64,
+    v: f64,
+    steps: u32,
+    mass: f64,
+    transition: [[f64; 2]; 2],
+}
+
 /// Which wall a stuck ball is held by.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 enum Hold {
@@ -164,10 +179,12 @@ struct Solver<'a> {
     damping_loss: f64,
     impact_loss: f64,
     impacts: Vec<Impact>,
+    last_impact: Vec<Option<usize>>,
     events: u64,
     series: Series,
     next_sample: usize,
     sample_count: usize,
+    cursor: SampleCursor,
 }
 
 impl<'a> Solver<'a> {
@@ -232,10 +249,12 @@ impl<'a> Solver<'a> {
             damping_loss: 0.0,
             impact_loss: 0.0,
             impacts: Vec::new(),
+            last_impact: vec![None; n + 1],
             events: 0,
             series: Series::with_capacity(n, samples),
             next_sample: 0,
             sample_count: samples,
+            cursor: SampleCursor { seg_t0: f64::NAN, k: 0, x: 0.0, v: 0.0, steps: 0, mass: f64::NAN, transition: [[0.0; 2]; 2] },
         };
         s.span = s.group_span();
         s
@@ -482,6 +501,15 @@ impl<'a> Solver<'a> {
         let a = if p == 0 { Body::LeftWall } else { Body::Ball(p - 1) };
         let b = if p == self.n { Body::RightWall } else { Body::Ball(p) };
         self.impact_loss += energy_lost;
+        // Sequential impulses across one pair at one instant are one impact of that pair.
+        if let Some(k) = self.last_impact[p] {
+            let last = &mut self.impacts[k];
+            if last.t == self.t {
+                last.energy_lost += energy_lost;
+                return;
+            }
+        }
+        self.last_impact[p] = Some(self.impacts.len());
         self.impacts.push(Impact { t: self.t, a, b, approach_speed, energy_lost });
     }
 
@@ -677,7 +705,7 @@ impl<'a> Solver<'a> {
                 break;
             }
             let has_frame = self.has_frame();
-            let (xs, vs) = if has_frame { self.seg.state(ts) } else { (0.0, 0.0) };
+            let (xs, vs) = if has_frame { self.frame_sample(ts) } else { (0.0, 0.0) };
             let s = &mut self.series;
             s.t.push(ts);
             s.xs.push(xs);
@@ -693,6 +721,29 @@ impl<'a> Solver<'a> {
             }
             self.next_sample += 1;
         }
+    }
+
+    /// The frame's state at sample `self.next_sample` (time `ts`): one step of the exact
+    /// transition matrix from the previous sample when it lies in the same segment, the closed
+    /// form every [`REANCHOR`] samples so that round-off cannot drift.
+    fn frame_sample(&mut self, ts: f64) -> (f64, f64) {
+        let c = &mut self.cursor;
+        let k = self.next_sample;
+        if c.seg_t0 == self.seg.t0 && c.k + 1 == k && c.steps < REANCHOR && k > 0 {
+            let [[a, b], [cc, d]] = c.transition;
+            (c.x, c.v) = (a * c.x + b * c.v, cc * c.x + d * c.v);
+            c.steps += 1;
+        } else {
+            if c.mass != self.seg.osc.mass {
+                c.transition = self.seg.osc.transition(self.scene.sample_dt);
+                c.mass = self.seg.osc.mass;
+            }
+            (c.x, c.v) = self.seg.state(ts);
+            c.seg_t0 = self.seg.t0;
+            c.steps = 0;
+        }
+        c.k = k;
+        (c.x, c.v)
     }
 
     fn run(&mut self) -> Result<(), ReferenceError> {

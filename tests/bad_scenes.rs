@@ -1,0 +1,149 @@
+//! Bad input: every impossible scene gets an error naming the file, the field and the rule,
+//! with exit status 2, no panic and nothing written.
+
+use std::path::Path;
+use std::process::Command;
+
+const GOOD: &str = r#"
+name = "t"
+[frame]
+mass = 1.35
+stiffness = 865.0
+damping = 1.092
+initial_displacement = 0.0185
+[balls]
+arrangement = "LSL"
+large_mass = 0.11
+mass_ratio = 10.0
+density = 8000.0
+restitution = 0.9
+gap = "0.25 Rr"
+clearance = "2 Rr"
+[run]
+horizon = 5.0
+sample_dt = 0.001
+"#;
+
+/// Runs `lpc run` on `text` written to a file; returns (status, stderr, out dir existed).
+fn run_lpc(text: &str, extra: &[&str]) -> (i32, String, bool) {
+    let dir = tempfile::tempdir().unwrap();
+    let file = dir.path().join("scene.toml");
+    std::fs::write(&file, text).unwrap();
+    let out = dir.path().join("out");
+    let o = Command::new(env!("CARGO_BIN_EXE_lpc"))
+        .arg("run")
+        .arg(&file)
+        .arg("--out")
+        .arg(&out)
+        .args(extra)
+        .output()
+        .unwrap();
+    (o.status.code().unwrap_or(-1), String::from_utf8_lossy(&o.stderr).into_owned(), out.exists())
+}
+
+fn expect_error(text: &str, extra: &[&str], field: &str, rule_words: &str) {
+    let (code, stderr, wrote) = run_lpc(text, extra);
+    assert_eq!(code, 2, "exit status for `{field}`: {stderr}");
+    assert!(stderr.contains("scene.toml"), "file not named: {stderr}");
+    assert!(stderr.contains(field), "field `{field}` not named: {stderr}");
+    assert!(stderr.to_lowercase().contains(rule_words), "rule `{rule_words}` not stated: {stderr}");
+    assert!(!stderr.contains("panicked"), "{stderr}");
+    assert!(!wrote, "an output directory was written for `{field}`");
+}
+
+fn with(key: &str, value: &str) -> String {
+    let mut done = false;
+    let out: Vec<String> = GOOD
+        .lines()
+        .map(|l| {
+            if !done && l.split('=').next().map(str::trim) == Some(key) {
+                done = true;
+                format!("{key} = {value}")
+            } else {
+                l.to_string()
+            }
+        })
+        .collect();
+    assert!(done, "no key {key}");
+    out.join("\n")
+}
+
+#[test]
+fn the_good_scene_runs() {
+    let (code, stderr, wrote) = run_lpc(GOOD, &[]);
+    assert_eq!(code, 0, "{stderr}");
+    assert!(wrote);
+}
+
+#[test]
+fn restitution_outside_0_1() {
+    expect_error(&with("restitution", "1.5"), &[], "balls.restitution", "[0, 1]");
+    expect_error(&with("restitution", "-0.1"), &[], "balls.restitution", "[0, 1]");
+}
+
+#[test]
+fn non_positive_mass_density_horizon() {
+    expect_error(&with("large_mass", "-0.11"), &[], "balls.large_mass", "positive");
+    expect_error(&with("mass", "0.0"), &[], "frame.mass", "positive");
+    expect_error(&with("density", "0"), &[], "balls.density", "positive");
+    expect_error(&with("horizon", "-5.0"), &[], "run.horizon", "positive");
+    expect_error(GOOD, &["--horizon", "0"], "--horizon", "positive");
+}
+
+#[test]
+fn negative_stiffness_damping_gap_clearance() {
+    expect_error(&with("stiffness", "-865.0"), &[], "frame.stiffness", "negative");
+    expect_error(&with("damping", "-1.0"), &[], "frame.damping", "negative");
+    expect_error(&with("gap", "\"-0.25 Rr\""), &[], "balls.gap", "overlap");
+    expect_error(&with("clearance", "-0.001"), &[], "balls.clearance", "negative");
+}
+
+#[test]
+fn nan_and_infinity() {
+    expect_error(&with("damping", "nan"), &[], "frame.damping", "finite");
+    expect_error(&with("initial_displacement", "inf"), &[], "frame.initial_displacement", "finite");
+    expect_error(&with("mass_ratio", "-inf"), &[], "balls.mass_ratio", "finite");
+}
+
+#[test]
+fn unknown_letters_and_keys() {
+    expect_error(&with("arrangement", "\"LXL\""), &[], "balls.arrangement", "unknown letter");
+    let extra = GOOD.replace("[run]", "[run]\nhorizn = 3.0");
+    expect_error(&extra, &[], "horizn", "unknown field");
+}
+
+#[test]
+fn balls_that_cannot_fit() {
+    let text = with("clearance", "0.0").replace("clearance = 0.0", "container_length = 0.05");
+    expect_error(&text, &[], "balls.container_length", "cannot fit");
+}
+
+#[test]
+fn absurd_output_step() {
+    expect_error(&with("sample_dt", "10.0"), &[], "run.sample_dt", "longer than the horizon");
+    expect_error(&with("sample_dt", "1e-9"), &[], "run.sample_dt", "samples");
+    expect_error(GOOD, &["--sample-dt=-1"], "--sample-dt", "positive");
+}
+
+#[test]
+fn not_toml_at_all() {
+    let (code, stderr, wrote) = run_lpc("this is [not toml", &[]);
+    assert_eq!(code, 2, "{stderr}");
+    assert!(stderr.contains("scene.toml") && !wrote);
+}
+
+#[test]
+fn missing_file() {
+    let o = Command::new(env!("CARGO_BIN_EXE_lpc")).args(["run", "no/such/scene.toml"]).output().unwrap();
+    assert_eq!(o.status.code(), Some(2));
+    let stderr = String::from_utf8_lossy(&o.stderr);
+    assert!(stderr.contains("no/such/scene.toml") && stderr.contains("cannot read"), "{stderr}");
+}
+
+#[test]
+fn every_shipped_scene_is_valid() {
+    for entry in std::fs::read_dir(Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes")).unwrap() {
+        let p = entry.unwrap().path();
+        lpc_damper::scene::load(&p).unwrap_or_else(|e| panic!("{}: {e}", p.display()));
+    }
+}

@@ -1,0 +1,87 @@
+//! Known-solution problems shared by the integration tests (in the spirit of diffsol's
+//! problem collection): scenes built in code whose answers are known by hand.
+#![allow(dead_code)]
+
+use lpc_damper::scene::{ball_radius, Ball, BallKind, Container, Frame, RapierSettings, Scene};
+
+/// The paper's frame (Table 1).
+pub const PAPER_FRAME: Frame = Frame { mass: 1.35, stiffness: 865.0, damping: 1.092 };
+
+/// A damper scene from explicit parts: balls (mass, kind) left to right with gap `gap`,
+/// clearance `clearance`, density 8000.
+pub fn damper(frame: Frame, xs0: f64, masses: &[f64], e: f64, gap: f64, clearance: f64, horizon: f64) -> Scene {
+    let balls: Vec<Ball> = masses
+        .iter()
+        .map(|&m| Ball { mass: m, radius: ball_radius(m, 8000.0), kind: BallKind::Custom })
+        .collect();
+    let mut positions = Vec::new();
+    let mut x = xs0 + gap;
+    for b in &balls {
+        positions.push(x + b.radius);
+        x += 2.0 * b.radius + gap;
+    }
+    let length = x - gap + clearance - xs0;
+    Scene {
+        name: "test".into(),
+        frame: Some(frame),
+        container: Some(Container { length, gap, clearance }),
+        initial_velocities: vec![0.0; balls.len()],
+        reference_radius: balls.first().map_or(0.0, |b| b.radius),
+        balls,
+        restitution: e,
+        initial_displacement: xs0,
+        initial_positions: positions,
+        horizon,
+        sample_dt: 1e-3,
+        rapier: RapierSettings::default(),
+    }
+}
+
+/// Every scene file shipped in `scenes/`, expanded: damper scenes, every sweep value and every
+/// chain case.
+pub fn all_paper_scenes() -> Vec<Scene> {
+    let mut out = Vec::new();
+    let mut paths: Vec<_> = std::fs::read_dir(lpc_damper::scene::scenes_dir())
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .filter(|p| p.extension().is_some_and(|x| x == "toml"))
+        .collect();
+    paths.sort();
+    for p in paths {
+        let loaded = lpc_damper::scene::load(&p).unwrap();
+        if loaded.file.sweep.is_some() {
+            out.extend(lpc_damper::sweep::sweep_scenes(&loaded).unwrap().into_iter().map(|(_, s)| s));
+        } else if let Some(s) = loaded.scene {
+            out.push(s);
+        }
+        if let Some(cases) = loaded.chain {
+            out.extend(cases.into_iter().map(|c| c.scene));
+        }
+    }
+    out
+}
+
+/// Smallest gap between neighbours (walls included) over every sample, relative to nothing:
+/// negative means overlap or a ball outside the container.
+pub fn min_gap(scene: &Scene, run: &lpc_damper::run::Run) -> f64 {
+    let s = &run.series;
+    let n = scene.balls.len();
+    let mut min = f64::INFINITY;
+    for k in 0..s.len() {
+        for i in 0..n {
+            let r = scene.balls[i].radius;
+            if i + 1 < n {
+                min = min.min(s.x[i + 1][k] - scene.balls[i + 1].radius - s.x[i][k] - r);
+            }
+            if let Some(c) = scene.container {
+                if i == 0 {
+                    min = min.min(s.x[0][k] - r - s.xs[k]);
+                }
+                if i + 1 == n {
+                    min = min.min(s.xs[k] + c.length - s.x[i][k] - r);
+                }
+            }
+        }
+    }
+    min
+}

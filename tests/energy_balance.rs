@@ -1,0 +1,44 @@
+//! Energy balance (initial = mechanical now + damping dissipation + impact losses) to 1e-12 on
+//! every paper scene, every sweep value and every chain; no ball ever leaves the container.
+
+mod common;
+
+use lpc_damper::reference::simulate;
+
+#[test]
+fn every_paper_scene_balances_energy_and_keeps_balls_inside() {
+    let scenes = common::all_paper_scenes();
+    assert!(scenes.len() >= 5 + 14 + 10, "expected every paper scene, got {}", scenes.len());
+    for scene in scenes {
+        let run = simulate(&scene).unwrap();
+        assert!(run.energy.balance_error.abs() <= 1e-12, "{}: balance error {:e}", scene.name, run.energy.balance_error);
+        assert!(run.impacts.iter().all(|i| i.energy_lost >= 0.0), "{}", scene.name);
+        // Contact tolerance is 1e-12 of the container length (< 1e-13 m).
+        let min_gap = common::min_gap(&scene, &run);
+        assert!(min_gap >= -1e-12, "{}: overlap {min_gap:e} m", scene.name);
+    }
+}
+
+#[test]
+fn runs_are_bitwise_repeatable() {
+    let scene = lpc_damper::scene::load_scene(lpc_damper::scene::scenes_dir().join("lpc-lslsl.toml")).unwrap();
+    let a = simulate(&scene).unwrap();
+    let b = simulate(&scene).unwrap();
+    assert_eq!(a.series, b.series);
+    assert_eq!(a.impacts, b.impacts);
+}
+
+#[test]
+fn damper_beats_no_damper_on_the_paper_scene() {
+    // Qualitative result of the paper (Figs. 8-9): with the LPC damper the frame settles much
+    // sooner than with the conventional damper, and both beat the bare frame.
+    let load = |n: &str| lpc_damper::scene::load_scene(lpc_damper::scene::scenes_dir().join(n)).unwrap();
+    let metrics = |n: &str| lpc_damper::metrics::metrics(&simulate(&load(n)).unwrap());
+    let bare = metrics("no-damper.toml");
+    let conventional = metrics("conventional.toml");
+    let lsl = metrics("lpc-lsl.toml");
+    assert!(bare.settling_time.is_none());
+    assert!(lsl.settling_time.unwrap() < conventional.settling_time.unwrap());
+    assert!(lsl.peak_displacement < conventional.peak_displacement);
+    assert!(conventional.peak_displacement < bare.peak_displacement);
+}
