@@ -18,9 +18,12 @@
 #![warn(missing_docs)]
 
 pub mod chain;
+pub mod compare;
 pub mod metrics;
 pub mod model;
+pub mod oscillator;
 pub mod output;
+pub mod rapier;
 pub mod reference;
 pub mod run;
 pub mod scene;

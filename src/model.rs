@@ -8,16 +8,19 @@ use crate::scene::Scene;
 pub enum Model {
     /// The exact event-driven impulse solver.
     Reference,
+    /// Rapier colliders in a headless Bevy app.
+    Rapier,
 }
 
 impl Model {
     /// Every model, in report order.
-    pub const ALL: &'static [Model] = &[Model::Reference];
+    pub const ALL: &'static [Model] = &[Model::Reference, Model::Rapier];
 
     /// Name used on the command line and in outputs.
     pub fn name(self) -> &'static str {
         match self {
             Model::Reference => "reference",
+            Model::Rapier => "rapier",
         }
     }
 
@@ -25,6 +28,7 @@ impl Model {
     pub fn simulate(self, scene: &Scene) -> Result<Run, ModelError> {
         match self {
             Model::Reference => Ok(crate::reference::simulate(scene)?),
+            Model::Rapier => crate::rapier::simulate(scene),
         }
     }
 }

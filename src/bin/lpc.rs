@@ -12,6 +12,7 @@ use clap::{Parser, Subcommand, ValueEnum};
 use indicatif::{ProgressBar, ProgressStyle};
 
 use lpc_damper::chain::{run_chain, KerRow};
+use lpc_damper::compare::{errors, Errors};
 use lpc_damper::output::{text_summary, write_atomic, write_run_dir, RunSummary};
 use lpc_damper::scene::{self, Scene, SceneError};
 use lpc_damper::sweep::{run_sweep, sweep_scenes};
@@ -32,6 +33,8 @@ enum Command {
     Sweep(SweepArgs),
     /// The chain experiment (Fig. 5): kinetic energy ratio against the number of large balls.
     Chain(ChainArgs),
+    /// Run several models on one scene and report each one's errors against the reference.
+    Compare(CompareArgs),
 }
 
 #[derive(Clone, Copy, ValueEnum, PartialEq, Eq)]
@@ -53,6 +56,8 @@ struct RunArgs {
     /// Output sampling step, s (default 1 ms).
     #[arg(long)]
     sample_dt: Option<f64>,
+    #[command(flatten)]
+    rapier: RapierArgs,
     /// Write series.csv, impacts.csv and summary.json into this directory.
     #[arg(long)]
     out: Option<PathBuf>,
@@ -79,6 +84,62 @@ struct SweepArgs {
     out: Option<PathBuf>,
 }
 
+/// Settings of the Rapier model that every command accepts.
+#[derive(clap::Args, Clone, Copy)]
+struct RapierArgs {
+    /// Rapier model: `aligned` (steps end at contacts) or `fixed` steps.
+    #[arg(long)]
+    stepping: Option<lpc_damper::rapier::Stepping>,
+    /// Rapier model: physics step (the longest one when aligned), s.
+    #[arg(long)]
+    dt: Option<f64>,
+    /// Rapier model: solver iterations per step (overrides the scene's).
+    #[arg(long)]
+    solver_iterations: Option<u32>,
+}
+
+impl RapierArgs {
+    fn apply(self, scene: &mut Scene, path: &Path) -> Result<(), SceneError> {
+        let invalid = |field: &str, rule: String| SceneError::Invalid { file: path.display().to_string(), field: field.into(), rule };
+        if let Some(s) = self.stepping {
+            scene.rapier.stepping = Some(s);
+        }
+        if let Some(dt) = self.dt {
+            if !(dt.is_finite() && dt > 0.0 && dt <= 0.1) {
+                return Err(invalid("--dt", format!("must be a step in (0, 0.1] s (got {dt})")));
+            }
+            scene.rapier.dt = Some(dt);
+        }
+        if let Some(it) = self.solver_iterations {
+            if !(1..=1000).contains(&it) {
+                return Err(invalid("--solver-iterations", format!("must lie in 1..=1000 (got {it})")));
+            }
+            scene.rapier.solver_iterations = Some(it);
+        }
+        Ok(())
+    }
+}
+
+#[derive(clap::Args)]
+struct CompareArgs {
+    /// Scene file.
+    scene: PathBuf,
+    /// Models to compare with the reference, comma-separated.
+    #[arg(long, value_delimiter = ',', default_value = "reference,rapier")]
+    models: Vec<Model>,
+    /// Simulated time, s (overrides the scene's).
+    #[arg(long)]
+    horizon: Option<f64>,
+    #[command(flatten)]
+    rapier: RapierArgs,
+    /// Output format on standard output.
+    #[arg(long, value_enum, default_value_t = Format::Text)]
+    format: Format,
+    /// Write each model's series.csv, impacts.csv and summary.json into DIR/MODEL/.
+    #[arg(long)]
+    out: Option<PathBuf>,
+}
+
 #[derive(clap::Args)]
 struct ChainArgs {
     /// Chain scene file (default: scenes/chain-ker.toml).
@@ -97,6 +158,7 @@ fn main() -> ExitCode {
         Command::Run(a) => cmd_run(a),
         Command::Sweep(a) => cmd_sweep(a),
         Command::Chain(a) => cmd_chain(a),
+        Command::Compare(a) => cmd_compare(a),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,
@@ -135,6 +197,7 @@ fn print_json<T: serde::Serialize>(value: &T) -> Result<()> {
 fn cmd_run(a: RunArgs) -> Result<()> {
     let mut scene = scene::load_scene(&a.scene)?;
     override_run(&mut scene, &a.scene, a.horizon, a.sample_dt)?;
+    a.rapier.apply(&mut scene, &a.scene)?;
     let run = a.model.simulate(&scene)?;
     let summary = RunSummary::of(&run);
     if let Some(dir) = &a.out {
@@ -218,6 +281,84 @@ fn cmd_chain(a: ChainArgs) -> Result<()> {
             println!("{:>7} {:>7} {:>10}", "large", "small", "KER");
             for r in &rows {
                 println!("{:>7} {:>7} {:>10.4}", r.large, r.small, r.ker);
+            }
+        }
+    }
+    Ok(())
+}
+
+/// One model's entry in `lpc compare`'s JSON.
+#[derive(serde::Serialize)]
+struct ModelComparison {
+    summary: RunSummary,
+    errors: Errors,
+}
+
+/// `lpc compare`'s JSON.
+#[derive(serde::Serialize)]
+struct Comparison {
+    scene: String,
+    reference: RunSummary,
+    models: std::collections::BTreeMap<String, ModelComparison>,
+}
+
+fn cmd_compare(a: CompareArgs) -> Result<()> {
+    let mut scene = scene::load_scene(&a.scene)?;
+    override_run(&mut scene, &a.scene, a.horizon, None)?;
+    a.rapier.apply(&mut scene, &a.scene)?;
+    let reference = Model::Reference.simulate(&scene)?;
+    let mut models = std::collections::BTreeMap::new();
+    let mut runs = vec![];
+    for &m in a.models.iter().filter(|m| **m != Model::Reference) {
+        let run = m.simulate(&scene)?;
+        models.insert(m.name().to_string(), ModelComparison { summary: RunSummary::of(&run), errors: errors(&run, &reference) });
+        runs.push(run);
+    }
+    if let Some(dir) = &a.out {
+        for run in std::iter::once(&reference).chain(&runs) {
+            let d = dir.join(&run.model);
+            write_run_dir(run, &d).with_context(|| format!("writing outputs to {}", d.display()))?;
+        }
+    }
+    let comparison = Comparison { scene: scene.name.clone(), reference: RunSummary::of(&reference), models };
+    match a.format {
+        Format::Json => print_json(&comparison)?,
+        Format::Text => {
+            let st = lpc_damper::rapier::settings(&scene);
+            println!(
+                "scene {} (rapier: {} steps, dt {} s, {} solver iterations)",
+                scene.name,
+                st.stepping.name(),
+                st.dt,
+                st.solver_iterations
+            );
+            println!(
+                "{:>10} {:>10} {:>10} {:>12} {:>12} {:>12} {:>12} {:>8}",
+                "model", "wall ms", "x realtime", "rms xs mm", "early xs mm", "settle d s", "loss d %E0", "impacts"
+            );
+            let row = |name: &str, s: &RunSummary, e: Option<&Errors>| {
+                let e = e.copied();
+                println!(
+                    "{:>10} {:>10.3} {:>10.0} {:>12} {:>12} {:>12} {:>12} {:>8}",
+                    name,
+                    s.wall_time_s * 1e3,
+                    s.horizon / s.wall_time_s,
+                    e.map_or("-".into(), |e| format!("{:.4}", e.rms_xs * 1e3)),
+                    e.map_or("-".into(), |e| format!("{:.4}", e.max_xs_early * 1e3)),
+                    e.map_or("-".into(), |e| e.settling_time_diff.map_or("n/a".into(), |d| format!("{d:+.3}"))),
+                    e.map_or("-".into(), |e| format!("{:+.3}", e.impact_loss_diff * 100.0)),
+                    match e {
+                        Some(e) => format!("{}{:+}", s.impact_count, e.impact_count_diff),
+                        None => s.impact_count.to_string(),
+                    }
+                );
+            };
+            row("reference", &comparison.reference, None);
+            for (name, m) in &comparison.models {
+                row(name, &m.summary, Some(&m.errors));
+            }
+            if let Some(dir) = &a.out {
+                println!("wrote every model's series to {}/MODEL/", dir.display());
             }
         }
     }

@@ -1,7 +1,7 @@
 //! The reference model: an exact event-driven impulse-momentum solver (MODEL.md §1-3), f64,
 //! no engine. It is the ground truth every other model is measured against.
 //!
-//! Between events the frame moves in closed form ([`oscillator`]) and free balls fly in straight
+//! Between events the frame moves in closed form ([`crate::oscillator`]) and free balls fly in straight
 //! lines, so the state at any time is exact up to round-off. Events are
 //! - ball-ball contacts, whose times are exact (linear gaps);
 //! - contacts between a ball and the frame (a wall, or a ball stuck to it), found by
@@ -19,14 +19,13 @@
 //! a bounded number of events with the energy balance intact.
 
 pub mod impact_law;
-pub mod oscillator;
 
 use std::time::Instant;
 
 use crate::run::{EnergyAccount, Impact, Run, Series};
 use crate::scene::{Body, Scene};
 pub use impact_law::impact_law;
-pub use oscillator::Oscillator;
+pub use crate::oscillator::Oscillator;
 
 /// Why the reference could not finish a scene.
 #[derive(Debug, thiserror::Error)]

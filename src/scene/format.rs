@@ -99,7 +99,9 @@ pub struct RunFile {
 #[derive(Debug, Clone, Deserialize, Serialize, Default)]
 #[serde(deny_unknown_fields)]
 pub struct RapierFile {
-    /// Fixed physics step, s.
+    /// `"aligned"` (steps end at contacts) or `"fixed"`.
+    pub stepping: Option<crate::rapier::Stepping>,
+    /// Fixed physics step (the longest step when aligned), s.
     pub dt: Option<f64>,
     /// Solver iterations per step.
     pub solver_iterations: Option<u32>,

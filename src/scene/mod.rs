@@ -109,7 +109,9 @@ pub struct Container {
 /// Settings of the Rapier model that a scene may fix.
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
 pub struct RapierSettings {
-    /// Fixed step, s.
+    /// How steps are chosen.
+    pub stepping: Option<crate::rapier::Stepping>,
+    /// Fixed step (longest step when aligned), s.
     pub dt: Option<f64>,
     /// Solver iterations.
     pub solver_iterations: Option<u32>,
@@ -478,7 +480,7 @@ fn rapier_settings(r: &format::RapierFile, v: &Validator) -> Result<RapierSettin
             return Err(v.err("rapier.solver_iterations", &format!("must lie in 1..=1000 (got {it})")));
         }
     }
-    Ok(RapierSettings { dt: r.dt, solver_iterations: r.solver_iterations })
+    Ok(RapierSettings { stepping: r.stepping, dt: r.dt, solver_iterations: r.solver_iterations })
 }
 
 fn arrangement_balls(

@@ -1,4 +1,4 @@
-//! The frame between events: `M x'' + c x' + k x = 0` in closed form, for every damping regime
+//! The frame's motion between impulses, shared by every model: `M x'' + c x' + k x = 0` in closed form, for every damping regime
 //! (under-, critically and over-damped, `k = 0`, `c = 0`) through one formula,
 //!
 //! `x(t) = x0 E(t) + (v0 + sigma x0) F(t)`, `v(t) = v0 E(t) - (w0^2 x0 + sigma v0) F(t)`,

@@ -1,0 +1,121 @@
+//! The contact model: the balls are Rapier colliders in a headless Bevy app, the frame is a
+//! kinematic body moved by the exact damped-oscillator step, and every ball-wall impact is fed
+//! back into the frame as the opposite of the balls' momentum change.
+//!
+//! Where it departs from the impulse model (MODEL.md §3), and why:
+//! - Rapier bounces a contact only on the step in which it is new (it carried no impulse the
+//!   step before); a contact that stays loaded is treated plastically. Balls that touch, or
+//!   whose gap closes within one step of another impact, therefore do not exchange momentum
+//!   pairwise in sequence as in Eq. 9-10: the chain shares it at once and partly sticks.
+//! - Each impact lands at the end of the step in which it happens, so it is up to `dt` late; the
+//!   frame's motion between impulses is exact.
+//! - Restitution is one end-of-step pass; a ball-wall contact gets `e' = (e ms - m)/(ms + m)`
+//!   so that the rigid-wall bounce plus the frame feedback equal Eq. 9-10. A ball heavier than
+//!   `e ms` cannot be modelled so and the scene is refused.
+
+pub mod hooks;
+pub mod plugin;
+pub mod record;
+pub mod stepping;
+
+use std::time::Instant;
+
+use bevy::prelude::*;
+
+use crate::model::ModelError;
+use crate::run::{EnergyAccount, Run};
+use crate::scene::{Body, Scene};
+pub use plugin::{DamperSet, LpcDamperPlugins, StepSettings};
+pub use stepping::Stepping;
+
+/// Default stepping (from the accuracy study in docs/BENCHMARKS.md).
+pub const DEFAULT_STEPPING: Stepping = Stepping::Aligned;
+/// Default longest step, s.
+pub const DEFAULT_DT: f64 = 1e-3;
+/// Default solver iterations.
+pub const DEFAULT_SOLVER_ITERATIONS: usize = 4;
+
+/// The stepping a scene asks for, with the defaults filled in.
+pub fn settings(scene: &Scene) -> StepSettings {
+    StepSettings {
+        stepping: scene.rapier.stepping.unwrap_or(DEFAULT_STEPPING),
+        dt: scene.rapier.dt.unwrap_or(DEFAULT_DT),
+        solver_iterations: scene.rapier.solver_iterations.map_or(DEFAULT_SOLVER_ITERATIONS, |i| i as usize),
+    }
+}
+
+/// Refuses scenes the kinematic-frame coupling cannot reproduce.
+pub fn check(scene: &Scene) -> Result<(), ModelError> {
+    if let Some(f) = scene.frame {
+        for (i, b) in scene.balls.iter().enumerate() {
+            if hooks::wall_restitution(scene.restitution, f.mass, b.mass).is_none() {
+                return Err(ModelError::Refused(format!(
+                    "scene `{}`: {} ({} kg) is heavier than e x frame mass ({} kg): a kinematic frame cannot give \
+                     the two-body bounce of Eq. 9-10 for it; use --model reference",
+                    scene.name,
+                    Scene::body_name(Body::Ball(i)),
+                    b.mass,
+                    scene.restitution * f.mass
+                )));
+            }
+        }
+    }
+    Ok(())
+}
+
+/// A headless app (no window, renderer or audio) simulating `scene`: one Rapier step per
+/// `app.update()`, never paced to real time.
+pub fn headless_app(scene: &Scene, settings: StepSettings) -> App {
+    let mut app = App::new();
+    // Rapier reads `Time` although fixed steps never use its value.
+    app.init_resource::<Time>();
+    app.add_plugins(LpcDamperPlugins { scene: scene.clone(), settings });
+    app.finish();
+    app.cleanup();
+    app
+}
+
+/// Runs the contact model on `scene`.
+pub fn simulate(scene: &Scene) -> Result<Run, ModelError> {
+    check(scene)?;
+    let start = Instant::now();
+    let settings = settings(scene);
+    let mut app = headless_app(scene, settings);
+    while app.world().get_resource::<plugin::StepClock>().is_none_or(|c| c.t < scene.horizon * (1.0 - 1e-12)) {
+        app.update();
+    }
+    let steps = app.world().resource::<plugin::StepClock>().steps;
+    let mut run = collect(app.world_mut(), scene, steps);
+    run.wall_time_s = start.elapsed().as_secs_f64();
+    Ok(run)
+}
+
+/// The [`Run`] recorded in `world`.
+pub fn collect(world: &mut World, scene: &Scene, steps: u64) -> Run {
+    let rec = world.remove_resource::<record::Recording>().expect("recording");
+    let frame = world.get_resource::<plugin::FrameState>().copied();
+    let (xs, vs) = frame.map_or((0.0, 0.0), |f| f.now);
+    let f = scene.frame;
+    let final_ = f.map_or(0.0, |f| 0.5 * f.mass * vs * vs + 0.5 * f.stiffness * xs * xs)
+        + scene.balls.iter().zip(&rec.v).map(|(b, v)| 0.5 * b.mass * v * v).sum::<f64>();
+    let energy = EnergyAccount::new(
+        scene.initial_energy(),
+        final_,
+        frame.map_or(0.0, |f| f.damping_loss),
+        rec.impact_loss,
+    );
+    Run {
+        scene: scene.name.clone(),
+        model: "rapier".into(),
+        horizon: scene.horizon,
+        sample_dt: scene.sample_dt,
+        initial_displacement: scene.initial_displacement,
+        damped_period: f.map_or(0.0, |f| f.damped_period()),
+        series: rec.series,
+        impacts: rec.impacts,
+        energy,
+        events: steps,
+        final_velocities: rec.v,
+        wall_time_s: 0.0,
+    }
+}

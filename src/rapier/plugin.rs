@@ -1,0 +1,271 @@
+//! The Bevy plug-in group: spawns a scene as Rapier bodies, drives the kinematic spring-damped
+//! frame, feeds impacts back into it and records what happened. Each small plug-in owns its
+//! systems and resources; [`DamperSet`] orders them around Rapier's [`PhysicsSet`].
+
+use bevy::app::PluginGroupBuilder;
+use bevy::prelude::*;
+use bevy_rapier3d::prelude::*;
+use bevy_rapier3d::rapier::dynamics::IntegrationParameters;
+
+use super::hooks::{ContactRole, RestitutionConfig, RestitutionHooks};
+use super::record::{feedback, record_samples, Recording};
+use super::stepping::{plan_step, StepPlan, Stepping};
+use crate::oscillator::Oscillator;
+use crate::scene::Scene;
+
+/// Rapier's length unit: the balls are centimetres, so are the tolerances.
+pub const LENGTH_UNIT: f32 = 0.01;
+
+/// How the contact model steps.
+#[derive(Resource, Debug, Clone, Copy, PartialEq)]
+pub struct StepSettings {
+    /// How steps are chosen.
+    pub stepping: Stepping,
+    /// Physics step (the longest one with aligned stepping), s.
+    pub dt: f64,
+    /// Rapier solver iterations per step.
+    pub solver_iterations: usize,
+}
+
+/// The scene being simulated.
+#[derive(Resource, Debug, Clone)]
+pub struct DamperScene(pub Scene);
+
+/// Entities of the scene, balls left to right.
+#[derive(Resource, Debug, Clone, Default)]
+pub struct Bodies {
+    /// The kinematic frame carrying the walls.
+    pub frame: Option<Entity>,
+    /// Left and right wall colliders.
+    pub walls: Option<(Entity, Entity)>,
+    /// Ball bodies (each is its own collider).
+    pub balls: Vec<Entity>,
+}
+
+/// Marks the frame's kinematic body.
+#[derive(Component, Debug)]
+pub struct FrameBody;
+
+/// The frame's exact state (f64), advanced in closed form; impacts arrive as velocity jumps.
+#[derive(Resource, Debug, Clone, Copy)]
+pub struct FrameState {
+    /// The bare frame's oscillator.
+    pub osc: Oscillator,
+    /// Displacement and velocity at the start of the current step.
+    pub start: (f64, f64),
+    /// Displacement and velocity at the end of the step, before the impact impulses.
+    pub before_impulses: (f64, f64),
+    /// Displacement and velocity now (end of the last step, impulses included).
+    pub now: (f64, f64),
+    /// Energy dissipated by `cs` so far, J.
+    pub damping_loss: f64,
+}
+
+/// Steps taken so far and the simulated time they cover.
+#[derive(Resource, Debug, Clone, Copy, Default)]
+pub struct StepClock {
+    /// Steps taken.
+    pub steps: u64,
+    /// Time at the end of the last step, s.
+    pub t: f64,
+}
+
+/// Ordering of the plug-in's systems within one physics step.
+#[derive(SystemSet, Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub enum DamperSet {
+    /// Before the Rapier step: choose its length.
+    Plan,
+    /// Before the Rapier step: move the kinematic frame to where the oscillator will be.
+    DriveFrame,
+    /// After the step: measure the balls' velocity jumps and feed the impulse to the frame.
+    Feedback,
+    /// After the feedback: write samples.
+    Record,
+}
+
+/// Everything the contact model needs, as one group of small plug-ins.
+pub struct LpcDamperPlugins {
+    /// The scene to spawn.
+    pub scene: Scene,
+    /// Stepping.
+    pub settings: StepSettings,
+}
+
+impl PluginGroup for LpcDamperPlugins {
+    fn build(self) -> PluginGroupBuilder {
+        PluginGroupBuilder::start::<Self>()
+            .add(ContactPhysicsPlugin { scene: self.scene.clone(), settings: self.settings })
+            .add(SceneSpawnPlugin { scene: self.scene.clone() })
+            .add(FramePlugin)
+            .add(RecordPlugin)
+    }
+}
+
+/// Rapier with fixed steps, centimetre tolerances, no gravity and the restitution hook.
+pub struct ContactPhysicsPlugin {
+    /// For the speed scale of the prediction distance and the frame mass of the hook.
+    pub scene: Scene,
+    /// Stepping.
+    pub settings: StepSettings,
+}
+
+impl Plugin for ContactPhysicsPlugin {
+    fn build(&self, app: &mut App) {
+        let dt = self.settings.dt as f32;
+        // Contacts must be found before they close: at least twice the closing distance of one
+        // step at the fastest speed the scene can reach.
+        let speed = speed_scale(&self.scene) as f32;
+        let prediction = (4.0 * speed * dt).max(0.02 * LENGTH_UNIT);
+        let integration_parameters = IntegrationParameters {
+            dt,
+            length_unit: LENGTH_UNIT,
+            num_solver_iterations: self.settings.solver_iterations,
+            normalized_prediction_distance: prediction / LENGTH_UNIT,
+            // The default clamps every body at 400 length units per second (4 m/s here).
+            normalized_max_linear_velocity: f32::MAX,
+            ..IntegrationParameters::default()
+        };
+        let rapier_configuration = RapierConfiguration { gravity: Vec3::ZERO, ..RapierConfiguration::new(LENGTH_UNIT) };
+        app.insert_resource(TimestepMode::Fixed { dt, substeps: 1 })
+            .insert_resource(self.settings)
+            .insert_resource(RestitutionConfig {
+                restitution: self.scene.restitution,
+                frame_mass: self.scene.frame.map_or(f64::INFINITY, |f| f.mass),
+            })
+            .add_plugins(RapierPhysicsPlugin::<RestitutionHooks>::default().with_custom_initialization(
+                RapierContextInitialization::InitializeDefaultRapierContext { integration_parameters, rapier_configuration },
+            ))
+            .insert_resource(StepPlan { h: self.settings.dt, horizon: self.scene.horizon })
+            .add_systems(Update, plan_step.in_set(DamperSet::Plan))
+            .configure_sets(Update, (DamperSet::Plan, DamperSet::DriveFrame).chain())
+            .configure_sets(
+                PostUpdate,
+                (DamperSet::Feedback, DamperSet::Record).chain().after(PhysicsSet::Writeback),
+            );
+    }
+}
+
+/// The fastest speed the scene is expected to reach: the frame's initial peak speed and the
+/// balls' initial speeds, doubled for what impacts can add.
+pub fn speed_scale(scene: &Scene) -> f64 {
+    let frame = scene.frame.map_or(0.0, |f| (f.stiffness / f.mass).sqrt() * scene.initial_displacement.abs());
+    2.0 * scene.initial_velocities.iter().fold(frame, |m, v| m.max(v.abs()))
+}
+
+/// Spawns the frame (a kinematic body carrying both walls) and the balls.
+pub struct SceneSpawnPlugin {
+    /// The scene to spawn.
+    pub scene: Scene,
+}
+
+impl Plugin for SceneSpawnPlugin {
+    fn build(&self, app: &mut App) {
+        app.insert_resource(DamperScene(self.scene.clone())).add_systems(Startup, spawn_scene);
+    }
+}
+
+fn spawn_scene(mut commands: Commands, scene: Res<DamperScene>) {
+    let scene = &scene.0;
+    let mut bodies = Bodies::default();
+    let r_max = scene.balls.iter().map(|b| b.radius).fold(0.0, f64::max) as f32;
+    if let (Some(_), Some(c)) = (scene.frame, scene.container) {
+        // Thick walls, so that no ball can tunnel through one in a step.
+        let half = (0.5 * c.length as f32).max(4.0 * r_max).max(0.01);
+        let side = 2.0 * r_max.max(0.005);
+        let mut walls = Vec::new();
+        let frame = commands
+            .spawn((
+                FrameBody,
+                RigidBody::KinematicPositionBased,
+                Transform::from_xyz(scene.initial_displacement as f32, 0.0, 0.0),
+                Sleeping::disabled(),
+            ))
+            .with_children(|p| {
+                for centre in [-half, c.length as f32 + half] {
+                    walls.push(
+                        p.spawn((
+                            ContactRole::Wall,
+                            Transform::from_xyz(centre, 0.0, 0.0),
+                            Collider::cuboid(half, side, side),
+                            Friction { coefficient: 0.0, combine_rule: CoefficientCombineRule::Min },
+                            ActiveHooks::MODIFY_SOLVER_CONTACTS,
+                        ))
+                        .id(),
+                    );
+                }
+            })
+            .id();
+        bodies.frame = Some(frame);
+        bodies.walls = Some((walls[0], walls[1]));
+    }
+    for (i, (ball, (&x, &v))) in
+        scene.balls.iter().zip(scene.initial_positions.iter().zip(&scene.initial_velocities)).enumerate()
+    {
+        let id = commands
+            .spawn((
+                ContactRole::Ball { index: i, mass: ball.mass },
+                RigidBody::Dynamic,
+                Transform::from_xyz(x as f32, 0.0, 0.0),
+                Velocity::linear(Vec3::new(v as f32, 0.0, 0.0)),
+                Collider::ball(ball.radius as f32),
+                ColliderMassProperties::Mass(ball.mass as f32),
+                Friction { coefficient: 0.0, combine_rule: CoefficientCombineRule::Min },
+                LockedAxes::ROTATION_LOCKED | LockedAxes::TRANSLATION_LOCKED_Y | LockedAxes::TRANSLATION_LOCKED_Z,
+                Sleeping::disabled(),
+                ActiveHooks::MODIFY_SOLVER_CONTACTS,
+            ))
+            .id();
+        bodies.balls.push(id);
+    }
+    commands.insert_resource(bodies);
+}
+
+/// Advances the kinematic frame with the exact damped-oscillator step.
+pub struct FramePlugin;
+
+impl Plugin for FramePlugin {
+    fn build(&self, app: &mut App) {
+        app.add_systems(Startup, init_frame).add_systems(Update, drive_frame.in_set(DamperSet::DriveFrame));
+    }
+}
+
+fn init_frame(mut commands: Commands, scene: Res<DamperScene>) {
+    if let Some(f) = scene.0.frame {
+        let x0 = (scene.0.initial_displacement, 0.0);
+        commands.insert_resource(FrameState {
+            osc: Oscillator::new(f.mass, f.damping, f.stiffness),
+            start: x0,
+            before_impulses: x0,
+            now: x0,
+            damping_loss: 0.0,
+        });
+    }
+}
+
+/// Moves the frame to where the closed form puts it at the end of the coming step; Rapier
+/// gives it the step's mean velocity for its contacts.
+fn drive_frame(plan: Res<StepPlan>, frame: Option<ResMut<FrameState>>, mut body: Query<&mut Transform, With<FrameBody>>) {
+    let Some(mut frame) = frame else { return };
+    let (x, v) = frame.now;
+    frame.start = (x, v);
+    frame.before_impulses = frame.osc.state(x, v, plan.h);
+    frame.damping_loss += frame.osc.dissipated(x, v, plan.h);
+    if let Ok(mut t) = body.single_mut() {
+        t.translation.x = frame.before_impulses.0 as f32;
+    }
+}
+
+/// Measures impacts, feeds them back into the frame and records the series.
+pub struct RecordPlugin;
+
+impl Plugin for RecordPlugin {
+    fn build(&self, app: &mut App) {
+        app.add_systems(Startup, init_recording)
+            .add_systems(PostUpdate, (feedback.in_set(DamperSet::Feedback), record_samples.in_set(DamperSet::Record)));
+    }
+}
+
+fn init_recording(mut commands: Commands, scene: Res<DamperScene>) {
+    commands.insert_resource(StepClock::default());
+    commands.insert_resource(Recording::new(&scene.0));
+}

@@ -1,0 +1,329 @@
+//! After each Rapier step: the balls' velocity jumps give the contact impulses (`m dv`, not the
+//! impulses Rapier reports, which are unreliable in rapier 0.35.0), the frame receives the
+//! opposite of their sum, impacts are attributed to their pair, and samples are written.
+
+use bevy::prelude::*;
+use bevy_rapier3d::prelude::*;
+
+use super::hooks::RestitutionConfig;
+use super::plugin::{Bodies, DamperScene, FrameState, StepClock};
+use super::stepping::StepPlan;
+use crate::run::{Impact, Series};
+use crate::scene::{Body, Scene};
+
+/// What the contact model has recorded so far.
+#[derive(Resource, Debug, Clone)]
+pub struct Recording {
+    /// Samples every `sample_dt`.
+    pub series: Series,
+    /// Impacts, in time order.
+    pub impacts: Vec<Impact>,
+    /// Kinetic energy lost in contacts, J.
+    pub impact_loss: f64,
+    /// Ball positions and velocities at the start of the current step.
+    pub x: Vec<f64>,
+    /// See `x`.
+    pub v: Vec<f64>,
+    /// Impulse across each pair in the last step (pair `p` between body `p-1` and body `p`).
+    pub last_impulse: Vec<f64>,
+    /// Index in `impacts` of each pair's latest impact.
+    pub last_impact: Vec<Option<usize>>,
+    /// Next sample to write.
+    pub next_sample: usize,
+    /// Number of samples over the horizon.
+    pub sample_count: usize,
+    /// Impulses below this are numerical noise (f32 velocities), N s.
+    pub impulse_floor: f64,
+}
+
+impl Recording {
+    /// An empty recording for `scene`.
+    pub fn new(scene: &Scene) -> Self {
+        let n = scene.balls.len();
+        let samples = (scene.horizon / scene.sample_dt * (1.0 + 1e-12)).floor() as usize + 1;
+        let m_min = scene.balls.iter().map(|b| b.mass).fold(f64::INFINITY, f64::min);
+        Recording {
+            series: Series::with_capacity(n, samples),
+            impacts: Vec::new(),
+            impact_loss: 0.0,
+            x: scene.initial_positions.clone(),
+            v: scene.initial_velocities.clone(),
+            last_impulse: vec![0.0; n + 1],
+            last_impact: vec![None; n + 1],
+            next_sample: 0,
+            sample_count: samples,
+            impulse_floor: 1e-6 * m_min * super::plugin::speed_scale(scene).max(1e-6),
+        }
+    }
+}
+
+/// Impulses across the pairs from the balls' momentum changes `dp[i] = J[i] - J[i+1]`, where
+/// pairs that carried no contact have `J = 0`. A run of active pairs is integrated from its
+/// inactive end; a container in contact wall to wall (no inactive pair) takes the least
+/// compressive solution.
+pub fn pair_impulses(dp: &[f64], active: &[bool], out: &mut [f64]) {
+    let n = dp.len();
+    out.iter_mut().for_each(|j| *j = 0.0);
+    match active.iter().position(|a| !a) {
+        Some(k) => {
+            for p in (0..k).rev() {
+                out[p] = dp[p] + out[p + 1];
+            }
+            for p in k + 1..=n {
+                out[p] = if active[p] { out[p - 1] - dp[p - 1] } else { 0.0 };
+            }
+        }
+        None => {
+            // J[p] = J[0] - sum_{i<p} dp[i]; choose J[0] so the smallest impulse is zero.
+            let mut partial = 0.0;
+            let mut max_partial: f64 = 0.0;
+            for &d in dp {
+                partial += d;
+                max_partial = max_partial.max(partial);
+            }
+            out[0] = max_partial;
+            for p in 1..=n {
+                out[p] = out[p - 1] - dp[p - 1];
+            }
+        }
+    }
+}
+
+/// Per-step working arrays, kept to avoid allocating in the step.
+#[derive(Debug, Clone, Default)]
+pub struct Scratch {
+    x: Vec<f64>,
+    v: Vec<f64>,
+    dp: Vec<f64>,
+    active: Vec<bool>,
+    j: Vec<f64>,
+}
+
+/// The after-step system: velocity jumps, the restitution Rapier skipped, frame feedback,
+/// impacts and energy.
+#[allow(clippy::too_many_arguments)]
+pub fn feedback(
+    mut clock: ResMut<StepClock>,
+    plan: Res<StepPlan>,
+    scene: Res<DamperScene>,
+    hook: Res<RestitutionConfig>,
+    bodies: Option<Res<Bodies>>,
+    frame: Option<ResMut<FrameState>>,
+    mut rec: ResMut<Recording>,
+    mut balls: Query<(&mut Velocity, &Transform)>,
+    rapier: ReadRapierContext,
+    mut scratch: Local<Scratch>,
+) {
+    let Some(bodies) = bodies else { return };
+    let scene = &scene.0;
+    let rec: &mut Recording = &mut rec;
+    let n = scene.balls.len();
+    let t0 = clock.t;
+    clock.steps += 1;
+    clock.t += plan.h;
+    let Scratch { x: x_new, v: v_new, dp, active, j } = &mut *scratch;
+    x_new.clear();
+    v_new.clear();
+    for &e in &bodies.balls {
+        let (v, t) = balls.get(e).expect("ball entity");
+        x_new.push(t.translation.x as f64);
+        v_new.push(v.linear.x as f64);
+    }
+    let mass = |i: usize| scene.balls[i].mass;
+    let impulses = |v_new: &[f64], v_old: &[f64], dp: &mut Vec<f64>, active: &[bool], j: &mut Vec<f64>| {
+        dp.clear();
+        dp.extend((0..n).map(|i| mass(i) * (v_new[i] - v_old[i])));
+        j.clear();
+        j.resize(n + 1, 0.0);
+        if n > 0 {
+            pair_impulses(dp, active, j);
+        }
+    };
+
+    // Which pairs were in contact this step (only whether, not how hard).
+    let ctx = rapier.single().ok();
+    let collider = |body: isize| -> Option<Entity> {
+        match (body, bodies.walls) {
+            (-1, Some((l, _))) => Some(l),
+            (b, Some((_, r))) if b == n as isize => Some(r),
+            (b, _) if b >= 0 && (b as usize) < n => Some(bodies.balls[b as usize]),
+            _ => None,
+        }
+    };
+    active.clear();
+    active.extend((0..=n).map(|p| {
+        let (Some(a), Some(b), Some(ctx)) = (collider(p as isize - 1), collider(p as isize), ctx.as_ref()) else {
+            return false;
+        };
+        ctx.contact_pair(a, b).is_some_and(|pair| pair.manifolds().any(|m| m.points().any(|pt| pt.impulse() > 0.0)))
+    }));
+    impulses(v_new, &rec.v, dp, active, j);
+
+    // Rapier bounces a contact only when it carried no impulse the step before; rapier 0.35.0
+    // leaves a stale impulse on a pair that separates within the prediction distance, so a
+    // genuinely new contact can be solved plastically. Where a pair that carried no impulse
+    // last step (by m dv) approached and was not bounced, apply the bounce Rapier skipped.
+    let (frame_start, frame_end) = frame.as_ref().map_or(((0.0, 0.0), (0.0, 0.0)), |f| (f.start, f.before_impulses));
+    let wall_v = (frame_end.0 - frame_start.0) / plan.h; // the kinematic velocity Rapier used
+    let vel = |v: &[f64], vf: f64, body: isize| if body < 0 || body >= n as isize { vf } else { v[body as usize] };
+    let mut corrected = false;
+    for p in 0..=n {
+        let (a, b) = (p as isize - 1, p as isize);
+        let u = vel(&rec.v, wall_v, a) - vel(&rec.v, wall_v, b);
+        if !(j[p] > rec.impulse_floor && rec.last_impulse[p] <= rec.impulse_floor && u > 0.0) {
+            continue;
+        }
+        let u_after = vel(v_new, wall_v, a) - vel(v_new, wall_v, b);
+        let (inv_a, inv_b) = (
+            if a >= 0 { 1.0 / mass(a as usize) } else { 0.0 },
+            if b < n as isize { 1.0 / mass(b as usize) } else { 0.0 },
+        );
+        let e = if a < 0 || b >= n as isize {
+            let ball = if a < 0 { b } else { a } as usize;
+            super::hooks::wall_restitution(hook.restitution, hook.frame_mass, mass(ball)).unwrap_or(0.0)
+        } else {
+            hook.restitution
+        };
+        // Rapier's own bounce leaves u_after = -e u; a plastic solve leaves about 0.
+        if u_after > -0.5 * e * u {
+            let dj = (e * u + u_after) / (inv_a + inv_b);
+            if a >= 0 {
+                v_new[a as usize] -= dj * inv_a;
+            }
+            if b < n as isize {
+                v_new[b as usize] += dj * inv_b;
+            }
+            corrected = true;
+        }
+    }
+    if corrected {
+        for (i, &e) in bodies.balls.iter().enumerate() {
+            let (mut v, _) = balls.get_mut(e).expect("ball entity");
+            v.linear.x = v_new[i] as f32;
+            v_new[i] = v.linear.x as f64; // what Rapier will carry on with
+        }
+        impulses(v_new, &rec.v, dp, active, j);
+    }
+
+    // The frame takes the opposite of the balls' total momentum change.
+    let (frame_pre, frame_post) = match frame {
+        Some(mut f) => {
+            let (x, v) = f.before_impulses;
+            let dv = -dp.iter().sum::<f64>() / scene.frame.expect("frame").mass;
+            f.now = (x, v + dv);
+            (v, v + dv)
+        }
+        None => (0.0, 0.0),
+    };
+    let frame_mass = scene.frame.map_or(0.0, |f| f.mass);
+    let ke = |v: &[f64], vf: f64| {
+        0.5 * frame_mass * vf * vf + scene.balls.iter().zip(v).map(|(b, v)| 0.5 * b.mass * v * v).sum::<f64>()
+    };
+    let step_loss = ke(&rec.v, frame_pre) - ke(v_new, frame_post);
+    rec.impact_loss += step_loss;
+
+    // Attribute: a pair whose impulse starts this step while approaching is a new impact,
+    // timed where the gap at the step's start closes at the approach speed.
+    let length = scene.container.map_or(0.0, |c| c.length);
+    let edge = |body: isize, right: bool| -> f64 {
+        if body < 0 {
+            frame_start.0
+        } else if body >= n as isize {
+            frame_start.0 + length
+        } else {
+            let r = scene.balls[body as usize].radius;
+            rec.x[body as usize] + if right { r } else { -r }
+        }
+    };
+    for p in 0..=n {
+        let (a, b) = (p as isize - 1, p as isize);
+        if !active[p] && j[p] == 0.0 {
+            rec.last_impulse[p] = 0.0;
+            continue;
+        }
+        let u = vel(&rec.v, frame_pre, a) - vel(&rec.v, frame_pre, b);
+        let u_after = vel(v_new, frame_post, a) - vel(v_new, frame_post, b);
+        let lost = j[p] * 0.5 * (u + u_after);
+        let starts = j[p] > rec.impulse_floor && rec.last_impulse[p] <= rec.impulse_floor && u > 0.0;
+        if starts {
+            let gap = edge(b, false) - edge(a, true);
+            rec.last_impact[p] = Some(rec.impacts.len());
+            rec.impacts.push(Impact {
+                t: t0 + (gap / u).clamp(0.0, plan.h),
+                a: body_of(a, n),
+                b: body_of(b, n),
+                approach_speed: u,
+                energy_lost: lost,
+            });
+        } else if let Some(k) = rec.last_impact[p] {
+            rec.impacts[k].energy_lost += lost;
+        }
+        rec.last_impulse[p] = j[p];
+    }
+    rec.x.clone_from(x_new);
+    rec.v.clone_from(v_new);
+}
+
+fn body_of(body: isize, n: usize) -> Body {
+    if body < 0 {
+        Body::LeftWall
+    } else if body as usize >= n {
+        Body::RightWall
+    } else {
+        Body::Ball(body as usize)
+    }
+}
+
+/// Writes the samples that fall in the step just taken: the frame exactly (closed form from the
+/// step's start; impulses land at its end), the balls along their straight path within the step.
+pub fn record_samples(
+    clock: Res<StepClock>,
+    plan: Res<StepPlan>,
+    scene: Res<DamperScene>,
+    frame: Option<Res<FrameState>>,
+    mut rec: ResMut<Recording>,
+    mut prev_x: Local<Vec<f64>>,
+) {
+    let scene = &scene.0;
+    let n = scene.balls.len();
+    let dt = plan.h;
+    let t1 = clock.t;
+    let t0 = t1 - dt;
+    if prev_x.is_empty() {
+        *prev_x = scene.initial_positions.clone();
+    }
+    let f = scene.frame;
+    let accel = |x: f64, v: f64| f.map_or(0.0, |f| -(f.damping * v + f.stiffness * x) / f.mass);
+    while rec.next_sample < rec.sample_count {
+        let k = rec.next_sample;
+        let ts = k as f64 * scene.sample_dt;
+        // A sample on the step's end (within round-off) belongs to this step, after impulses.
+        let at_end = (ts - t1).abs() <= 1e-9 * dt;
+        if ts > t1 && !at_end {
+            break;
+        }
+        let (xs, vs) = match &frame {
+            Some(_) if k == 0 => (scene.initial_displacement, 0.0),
+            Some(fr) if at_end => fr.now,
+            Some(fr) => fr.osc.state(fr.start.0, fr.start.1, (ts - t0).max(0.0)),
+            None => (0.0, 0.0),
+        };
+        let s = &mut rec.series;
+        s.t.push(ts);
+        s.xs.push(xs);
+        s.vs.push(vs);
+        s.a.push(accel(xs, vs));
+        for i in 0..n {
+            let (x, v) = if k == 0 {
+                (scene.initial_positions[i], scene.initial_velocities[i])
+            } else {
+                let w = ((ts - t0) / dt).clamp(0.0, 1.0);
+                (prev_x[i] + w * (rec.x[i] - prev_x[i]), rec.v[i])
+            };
+            rec.series.x[i].push(x);
+            rec.series.v[i].push(v);
+        }
+        rec.next_sample += 1;
+    }
+    prev_x.clone_from(&rec.x);
+}

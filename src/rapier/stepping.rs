@@ -1,0 +1,169 @@
+//! Choosing each physics step. `Fixed` takes steps of `dt`. `Aligned` ends a step at the
+//! next contact, found with parry's time-of-impact queries, and otherwise takes steps of up to
+//! `dt`. Between impacts balls fly freely and the frame moves in closed form, so long steps
+//! lose nothing there, while each contact lands at a step boundary: Rapier then sees contacts
+//! one at a time, as new contacts that bounce, instead of several per step that it would treat
+//! plastically. Rapier still resolves every contact.
+
+use bevy::prelude::*;
+use bevy_rapier3d::parry::math::Pose;
+use bevy_rapier3d::parry::query::{cast_shapes, ShapeCastOptions};
+use bevy_rapier3d::parry::shape::{Ball, HalfSpace};
+use bevy_rapier3d::prelude::*;
+
+use super::plugin::{Bodies, DamperScene, FrameState, StepClock, StepSettings};
+
+/// How steps are chosen.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord, serde::Serialize, serde::Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Stepping {
+    /// Every step is `dt` long.
+    Fixed,
+    /// Steps end at contacts; `dt` is the longest step.
+    Aligned,
+}
+
+impl Stepping {
+    /// Name on the command line and in outputs.
+    pub fn name(self) -> &'static str {
+        match self {
+            Stepping::Fixed => "fixed",
+            Stepping::Aligned => "aligned",
+        }
+    }
+}
+
+impl std::str::FromStr for Stepping {
+    type Err = String;
+    fn from_str(s: &str) -> Result<Self, String> {
+        match s {
+            "fixed" => Ok(Stepping::Fixed),
+            "aligned" => Ok(Stepping::Aligned),
+            other => Err(format!("unknown stepping `{other}`; choose fixed or aligned")),
+        }
+    }
+}
+
+/// The length of the step about to be taken, s.
+#[derive(Resource, Debug, Clone, Copy)]
+pub struct StepPlan {
+    /// Step length, s.
+    pub h: f64,
+    /// Time at which the run ends, s.
+    pub horizon: f64,
+}
+
+/// Shortest step: a contact found at time-of-impact `toi` ends a step of `toi + MIN_STEP`, so
+/// that it closes within the step.
+pub const MIN_STEP: f64 = 1e-6;
+/// A wall contact is approached with a final step no longer than this, so that the wall's
+/// mean velocity over that step (what Rapier's contact sees) is its velocity at the impact.
+pub const APPROACH_STEP: f64 = 2e-5;
+/// Steps before a contact leave at least `APPROACH_RATIO - 1` times their own length to go.
+///
+/// Rapier's speculative contact allows a closing speed of `gap / dt` for the whole step but
+/// re-checks it at every solver substep, so a step that starts closer than about `2 u dt` to
+/// a contact (`u` the approach speed) clamps the approach in a late substep, loads the contact
+/// and bounces it before it touches. Approaching geometrically keeps every step clear of that
+/// until the one that ends at the contact.
+pub const APPROACH_RATIO: f64 = 2.2;
+/// Pairs closer than this are already in contact: Rapier handles them as resting contacts.
+pub const TOUCHING: f32 = 1e-6;
+
+/// Sets the next step's length (and Rapier's fixed timestep to it).
+#[allow(clippy::too_many_arguments)]
+pub fn plan_step(
+    settings: Res<StepSettings>,
+    clock: Res<StepClock>,
+    scene: Res<DamperScene>,
+    bodies: Option<Res<Bodies>>,
+    frame: Option<Res<FrameState>>,
+    balls: Query<(&Transform, &Velocity)>,
+    mut plan: ResMut<StepPlan>,
+    mut timestep: ResMut<TimestepMode>,
+) {
+    let remaining = plan.horizon - clock.t;
+    let mut h = settings.dt;
+    if settings.stepping == Stepping::Aligned {
+        if let Some(bodies) = bodies {
+            h = aligned_step(&scene.0, &bodies, frame.as_deref(), &balls, settings.dt);
+        }
+    }
+    // Land exactly on the horizon rather than leave a sliver of a step.
+    if remaining <= h * (1.0 + 1e-9) {
+        h = remaining.max(MIN_STEP);
+    }
+    plan.h = h;
+    *timestep = TimestepMode::Fixed { dt: h as f32, substeps: 1 };
+}
+
+fn aligned_step(
+    scene: &crate::scene::Scene,
+    bodies: &Bodies,
+    frame: Option<&FrameState>,
+    balls: &Query<(&Transform, &Velocity)>,
+    longest: f64,
+) -> f64 {
+    let n = bodies.balls.len();
+    let state = |i: usize| {
+        let (t, v) = balls.get(bodies.balls[i]).expect("ball");
+        (Vec3::new(t.translation.x, 0.0, 0.0), Vec3::new(v.linear.x, 0.0, 0.0))
+    };
+    // Look far enough ahead to start the geometric approach in time.
+    let options = ShapeCastOptions::with_max_time_of_impact((2.0 * APPROACH_RATIO * longest) as f32);
+    let mut ball_toi = f64::INFINITY;
+    for i in 1..n {
+        let ((p1, v1), (p2, v2)) = (state(i - 1), state(i));
+        let (r1, r2) = (scene.balls[i - 1].radius as f32, scene.balls[i].radius as f32);
+        if (p2.x - p1.x) - (r1 + r2) <= TOUCHING {
+            continue;
+        }
+        let hit = cast_shapes(
+            &Pose::from_translation(p1),
+            v1,
+            &Ball::new(r1),
+            &Pose::from_translation(p2),
+            v2,
+            &Ball::new(r2),
+            options,
+        );
+        if let Ok(Some(hit)) = hit {
+            ball_toi = ball_toi.min(hit.time_of_impact as f64);
+        }
+    }
+    let mut wall_toi = f64::INFINITY;
+    if let (Some(frame), Some(c)) = (frame, scene.container) {
+        let (xs, vs) = frame.now;
+        let vw = Vec3::new(vs as f32, 0.0, 0.0);
+        // Walls as half-spaces moving with the frame's current velocity (its change over the
+        // step is why the last approach is a short step).
+        let walls = [(0, xs as f32, Vec3::X), (n - 1, (xs + c.length) as f32, -Vec3::X)];
+        for (i, surface, normal) in walls.into_iter().filter(|_| n > 0) {
+            let (p, v) = state(i);
+            let r = scene.balls[i].radius as f32;
+            if (p.x - surface) * normal.x - r <= TOUCHING {
+                continue;
+            }
+            let hit = cast_shapes(
+                &Pose::from_translation(Vec3::new(surface, 0.0, 0.0)),
+                vw,
+                &HalfSpace::new(normal),
+                &Pose::from_translation(p),
+                v,
+                &Ball::new(r),
+                options,
+            );
+            if let Ok(Some(hit)) = hit {
+                wall_toi = wall_toi.min(hit.time_of_impact as f64);
+            }
+        }
+    }
+    let (toi, limit) = if wall_toi < ball_toi { (wall_toi, APPROACH_STEP.min(longest)) } else { (ball_toi, longest) };
+    let h = if toi <= limit {
+        toi + MIN_STEP
+    } else {
+        (toi / APPROACH_RATIO).min(longest)
+    };
+    h.clamp(MIN_STEP, longest)
+}
+
