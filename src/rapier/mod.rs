@@ -31,7 +31,7 @@ pub use stepping::Stepping;
 /// Default stepping (from the accuracy study in docs/BENCHMARKS.md).
 pub const DEFAULT_STEPPING: Stepping = Stepping::Aligned;
 /// Default longest step, s.
-pub const DEFAULT_DT: f64 = 1e-3;
+pub const DEFAULT_DT: f64 = 2e-3;
 /// Default solver iterations.
 pub const DEFAULT_SOLVER_ITERATIONS: usize = 4;
 

@@ -282,15 +282,17 @@ pub fn record_samples(
     scene: Res<DamperScene>,
     frame: Option<Res<FrameState>>,
     mut rec: ResMut<Recording>,
-    mut prev_x: Local<Vec<f64>>,
+    mut prev: Local<(Vec<f64>, Vec<f64>)>,
 ) {
     let scene = &scene.0;
     let n = scene.balls.len();
     let dt = plan.h;
     let t1 = clock.t;
     let t0 = t1 - dt;
-    if prev_x.is_empty() {
+    let (prev_x, prev_v) = &mut *prev;
+    if prev_x.len() != n {
         *prev_x = scene.initial_positions.clone();
+        *prev_v = scene.initial_velocities.clone();
     }
     let f = scene.frame;
     let accel = |x: f64, v: f64| f.map_or(0.0, |f| -(f.damping * v + f.stiffness * x) / f.mass);
@@ -316,9 +318,12 @@ pub fn record_samples(
         for i in 0..n {
             let (x, v) = if k == 0 {
                 (scene.initial_positions[i], scene.initial_velocities[i])
+            } else if at_end {
+                (rec.x[i], rec.v[i])
             } else {
+                // Impulses land at the step's end: inside it, balls keep their old velocity.
                 let w = ((ts - t0) / dt).clamp(0.0, 1.0);
-                (prev_x[i] + w * (rec.x[i] - prev_x[i]), rec.v[i])
+                (prev_x[i] + w * (rec.x[i] - prev_x[i]), prev_v[i])
             };
             rec.series.x[i].push(x);
             rec.series.v[i].push(v);
@@ -326,4 +331,5 @@ pub fn record_samples(
         rec.next_sample += 1;
     }
     prev_x.clone_from(&rec.x);
+    prev_v.clone_from(&rec.v);
 }
