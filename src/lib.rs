@@ -17,6 +17,7 @@
 //! ```
 #![warn(missing_docs)]
 
+pub mod bench;
 pub mod chain;
 pub mod compare;
 pub mod metrics;

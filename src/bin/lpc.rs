@@ -35,6 +35,45 @@ enum Command {
     Chain(ChainArgs),
     /// Run several models on one scene and report each one's errors against the reference.
     Compare(CompareArgs),
+    /// Run time against error for every model and setting; marks the Pareto front.
+    Bench(BenchArgs),
+}
+
+#[derive(Clone, Copy, ValueEnum, PartialEq, Eq)]
+enum TableFormat {
+    Text,
+    Json,
+    Csv,
+}
+
+#[derive(clap::Args)]
+struct BenchArgs {
+    /// Scene files (default: the paper's damper scenes).
+    scenes: Vec<PathBuf>,
+    /// Models, comma-separated.
+    #[arg(long, value_delimiter = ',', default_value = "reference,rapier")]
+    models: Vec<Model>,
+    /// Rapier steppings, comma-separated.
+    #[arg(long, value_delimiter = ',', default_value = "fixed,aligned")]
+    stepping: Vec<lpc_damper::rapier::Stepping>,
+    /// Rapier steps (longest steps when aligned), s, comma-separated.
+    #[arg(long, value_delimiter = ',', default_value = "0.0001,0.0002,0.0005,0.001,0.002")]
+    dt: Vec<f64>,
+    /// Rapier solver iterations, comma-separated.
+    #[arg(long, value_delimiter = ',', default_value = "4")]
+    solver_iterations: Vec<u32>,
+    /// Runs per setting; the median time is reported.
+    #[arg(long, default_value_t = 3)]
+    repeat: usize,
+    /// Simulated time, s (overrides the scenes').
+    #[arg(long)]
+    horizon: Option<f64>,
+    /// Output format on standard output.
+    #[arg(long, value_enum, default_value_t = TableFormat::Text)]
+    format: TableFormat,
+    /// Write bench.csv, bench.json and error_vs_cost.svg into this directory.
+    #[arg(long)]
+    out: Option<PathBuf>,
 }
 
 #[derive(Clone, Copy, ValueEnum, PartialEq, Eq)]
@@ -82,6 +121,8 @@ struct SweepArgs {
     /// Also write sweep.json into this directory.
     #[arg(long)]
     out: Option<PathBuf>,
+    #[command(flatten)]
+    rapier: RapierArgs,
 }
 
 /// Settings of the Rapier model that every command accepts.
@@ -150,6 +191,8 @@ struct ChainArgs {
     /// Output format on standard output.
     #[arg(long, value_enum, default_value_t = Format::Text)]
     format: Format,
+    #[command(flatten)]
+    rapier: RapierArgs,
 }
 
 fn main() -> ExitCode {
@@ -159,6 +202,7 @@ fn main() -> ExitCode {
         Command::Sweep(a) => cmd_sweep(a),
         Command::Chain(a) => cmd_chain(a),
         Command::Compare(a) => cmd_compare(a),
+        Command::Bench(a) => cmd_bench(a),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,
@@ -228,6 +272,7 @@ fn cmd_sweep(a: SweepArgs) -> Result<()> {
     let mut scenes = sweep_scenes(&loaded)?;
     for (_, s) in &mut scenes {
         override_run(s, &a.scene, a.horizon, None)?;
+        a.rapier.apply(s, &a.scene)?;
     }
     let parameter = loaded.file.sweep.as_ref().map(|s| s.parameter.clone()).unwrap_or_default();
     let bar = progress_bar(scenes.len(), "sweep");
@@ -242,7 +287,13 @@ fn cmd_sweep(a: SweepArgs) -> Result<()> {
     match a.format {
         Format::Json => print_json(&points)?,
         Format::Text => {
-            println!("sweep of `{parameter}` ({}, {} runs in {:.3} s)", a.model.name(), points.len(), elapsed);
+            println!(
+                "sweep of `{parameter}` ({}, {} runs in {:.3} s: {:.1} scene-runs per second)",
+                a.model.name(),
+                points.len(),
+                elapsed,
+                points.len() as f64 / elapsed
+            );
             println!(
                 "{:>10} {:>8} {:>12} {:>12} {:>10} {:>10} {:>9}",
                 parameter, "impacts", "peak xs mm", "peak a m/s2", "rms xs mm", "settle s", "E left %"
@@ -273,6 +324,10 @@ fn cmd_chain(a: ChainArgs) -> Result<()> {
         field: "chain".into(),
         rule: "is missing: `lpc chain` needs a scene file with a [chain] table".into(),
     })?;
+    let mut cases = cases;
+    for c in &mut cases {
+        a.rapier.apply(&mut c.scene, &path)?;
+    }
     let rows: Vec<KerRow> = run_chain(&cases, a.model)?;
     match a.format {
         Format::Json => print_json(&rows)?,
@@ -363,4 +418,103 @@ fn cmd_compare(a: CompareArgs) -> Result<()> {
         }
     }
     Ok(())
+}
+
+fn cmd_bench(a: BenchArgs) -> Result<()> {
+    let paths = if a.scenes.is_empty() {
+        ["conventional", "lpc-lsl", "lpc-lslsl", "chain-lll"].iter().map(|n| PathBuf::from(format!("scenes/{n}.toml"))).collect()
+    } else {
+        a.scenes.clone()
+    };
+    for &dt in &a.dt {
+        if !(dt.is_finite() && dt > 0.0 && dt <= 0.1) {
+            return Err(SceneError::Invalid { file: "(command line)".into(), field: "--dt".into(), rule: format!("must be a step in (0, 0.1] s (got {dt})") }.into());
+        }
+    }
+    let plan = lpc_damper::bench::Plan {
+        models: a.models.clone(),
+        steppings: a.stepping.clone(),
+        dts: a.dt.clone(),
+        solver_iterations: a.solver_iterations.clone(),
+        repeat: a.repeat,
+    };
+    let per_scene = a.models.iter().map(|m| match m {
+        Model::Reference => 1,
+        Model::Rapier => plan.steppings.len() * plan.dts.len() * plan.solver_iterations.len(),
+    }).sum::<usize>();
+    let bar = progress_bar(per_scene * paths.len(), "bench");
+    let mut rows = Vec::new();
+    for p in &paths {
+        let mut scene = scene::load_scene(p)?;
+        override_run(&mut scene, p, a.horizon, None)?;
+        rows.extend(lpc_damper::bench::bench_scene(&scene, &plan, &|| bar.inc(1))?);
+    }
+    bar.finish_and_clear();
+    let csv_bytes = bench_csv(&rows)?;
+    if let Some(dir) = &a.out {
+        write_atomic(&dir.join("bench.csv"), &csv_bytes)?;
+        write_atomic(&dir.join("bench.json"), &serde_json::to_vec_pretty(&rows)?)?;
+        let svg = dir.join("error_vs_cost.svg");
+        lpc_damper::output::plot::error_vs_cost(&rows, &svg).map_err(|e| anyhow::anyhow!("drawing {}: {e}", svg.display()))?;
+    }
+    match a.format {
+        TableFormat::Json => print_json(&rows)?,
+        TableFormat::Csv => print!("{}", String::from_utf8(csv_bytes)?),
+        TableFormat::Text => {
+            println!(
+                "{:>14} {:>9} {:>8} {:>8} {:>4} {:>12} {:>10} {:>9} {:>11} {:>10} {:>9} {:>7}",
+                "scene", "model", "stepping", "dt", "it", "s per sim s", "steps/s", "rms mm", "early mm", "settle s", "loss %", "pareto"
+            );
+            for r in &rows {
+                let e = &r.errors;
+                println!(
+                    "{:>14} {:>9} {:>8} {:>8} {:>4} {:>12.5} {:>10.0} {:>9.4} {:>11.5} {:>10} {:>9.3} {:>7}",
+                    r.scene,
+                    r.model,
+                    r.settings.stepping,
+                    r.settings.dt.map_or("-".into(), |d| format!("{d}")),
+                    r.settings.solver_iterations.map_or("-".into(), |i| i.to_string()),
+                    r.wall_s_per_sim_s,
+                    r.steps_per_sim_s,
+                    e.rms_xs * 1e3,
+                    e.max_xs_early * 1e3,
+                    e.settling_time_diff.map_or("n/a".into(), |d| format!("{d:+.3}")),
+                    e.impact_loss_diff * 100.0,
+                    if r.pareto { "*" } else { "" }
+                );
+            }
+            if let Some(dir) = &a.out {
+                println!("wrote bench.csv, bench.json, error_vs_cost.svg to {}", dir.display());
+            }
+        }
+    }
+    Ok(())
+}
+
+fn bench_csv(rows: &[lpc_damper::bench::BenchRow]) -> Result<Vec<u8>> {
+    let mut w = csv::Writer::from_writer(Vec::new());
+    w.write_record([
+        "scene", "model", "stepping", "dt", "solver_iterations", "wall_s_per_sim_s", "steps_per_sim_s", "rms_xs",
+        "max_xs_early", "settling_time_diff", "impact_loss_diff", "impact_count_diff", "pareto",
+    ])?;
+    let opt = |x: Option<f64>| x.map_or(String::new(), |v| v.to_string());
+    for r in rows {
+        let e = &r.errors;
+        w.write_record([
+            r.scene.clone(),
+            r.model.to_string(),
+            r.settings.stepping.to_string(),
+            opt(r.settings.dt),
+            r.settings.solver_iterations.map_or(String::new(), |i| i.to_string()),
+            r.wall_s_per_sim_s.to_string(),
+            r.steps_per_sim_s.to_string(),
+            e.rms_xs.to_string(),
+            e.max_xs_early.to_string(),
+            opt(e.settling_time_diff),
+            e.impact_loss_diff.to_string(),
+            e.impact_count_diff.to_string(),
+            r.pareto.to_string(),
+        ])?;
+    }
+    Ok(w.into_inner()?)
 }

@@ -2,6 +2,7 @@
 //! of `--out DIR` (`series.csv`, `impacts.csv`, `summary.json`), each written atomically.
 
 pub mod files;
+pub mod plot;
 
 use serde::{Deserialize, Serialize};
 

@@ -81,8 +81,12 @@ pub fn simulate(scene: &Scene) -> Result<Run, ModelError> {
     let start = Instant::now();
     let settings = settings(scene);
     let mut app = headless_app(scene, settings);
-    while app.world().get_resource::<plugin::StepClock>().is_none_or(|c| c.t < scene.horizon * (1.0 - 1e-12)) {
-        app.update();
+    // The first update spawns the scene, lets bevy_rapier create its bodies and takes the
+    // first step; the rest run the lean step schedule alone.
+    app.update();
+    let world = app.world_mut();
+    while world.resource::<plugin::StepClock>().t < scene.horizon * (1.0 - 1e-12) {
+        world.run_schedule(plugin::DamperStep);
     }
     let steps = app.world().resource::<plugin::StepClock>().steps;
     let mut run = collect(app.world_mut(), scene, steps);

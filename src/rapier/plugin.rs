@@ -70,6 +70,14 @@ pub struct StepClock {
     pub t: f64,
 }
 
+/// A lean schedule holding one physics step and nothing else: the plug-in's systems and
+/// Rapier's step, without Bevy's main schedule or bevy_rapier's ECS synchronisation
+/// (transform propagation, change detection, writeback), which only a renderer needs.
+/// Headless runs call it directly after one `app.update()` has spawned and initialised the
+/// bodies; rendered runs use `app.update()` throughout.
+#[derive(bevy::ecs::schedule::ScheduleLabel, Debug, Clone, PartialEq, Eq, Hash)]
+pub struct DamperStep;
+
 /// Ordering of the plug-in's systems within one physics step.
 #[derive(SystemSet, Debug, Clone, Copy, PartialEq, Eq, Hash)]
 pub enum DamperSet {
@@ -141,6 +149,17 @@ impl Plugin for ContactPhysicsPlugin {
             .configure_sets(
                 PostUpdate,
                 (DamperSet::Feedback, DamperSet::Record).chain().after(PhysicsSet::Writeback),
+            )
+            .add_systems(
+                DamperStep,
+                (
+                    plan_step,
+                    drive_frame,
+                    bevy_rapier3d::plugin::systems::step_simulation::<RestitutionHooks>,
+                    feedback,
+                    record_samples,
+                )
+                    .chain(),
             );
     }
 }
@@ -243,15 +262,22 @@ fn init_frame(mut commands: Commands, scene: Res<DamperScene>) {
 }
 
 /// Moves the frame to where the closed form puts it at the end of the coming step; Rapier
-/// gives it the step's mean velocity for its contacts.
-fn drive_frame(plan: Res<StepPlan>, frame: Option<ResMut<FrameState>>, mut body: Query<&mut Transform, With<FrameBody>>) {
-    let Some(mut frame) = frame else { return };
+/// gives it the step's mean velocity for its contacts. (Before the first step Rapier has not
+/// created the body yet; the walls are far from every ball then.)
+pub fn drive_frame(
+    plan: Res<StepPlan>,
+    frame: Option<ResMut<FrameState>>,
+    bodies: Option<Res<Bodies>>,
+    mut sets: Query<&mut RapierRigidBodySet>,
+) {
+    let (Some(mut frame), Some(bodies)) = (frame, bodies) else { return };
     let (x, v) = frame.now;
     frame.start = (x, v);
     frame.before_impulses = frame.osc.state(x, v, plan.h);
     frame.damping_loss += frame.osc.dissipated(x, v, plan.h);
-    if let Ok(mut t) = body.single_mut() {
-        t.translation.x = frame.before_impulses.0 as f32;
+    let (Some(entity), Ok(mut set)) = (bodies.frame, sets.single_mut()) else { return };
+    if let Some(&h) = set.entity2body().get(&entity) {
+        set.bodies[h].set_next_kinematic_translation(Vec3::new(frame.before_impulses.0 as f32, 0.0, 0.0));
     }
 }
 

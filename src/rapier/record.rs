@@ -4,6 +4,7 @@
 
 use bevy::prelude::*;
 use bevy_rapier3d::prelude::*;
+use bevy_rapier3d::rapier::dynamics::RigidBodyHandle;
 
 use super::hooks::RestitutionConfig;
 use super::plugin::{Bodies, DamperScene, FrameState, StepClock};
@@ -24,6 +25,10 @@ pub struct Recording {
     pub x: Vec<f64>,
     /// See `x`.
     pub v: Vec<f64>,
+    /// Ball positions and velocities at the start of the last step taken.
+    pub prev_x: Vec<f64>,
+    /// See `prev_x`.
+    pub prev_v: Vec<f64>,
     /// Impulse across each pair in the last step (pair `p` between body `p-1` and body `p`).
     pub last_impulse: Vec<f64>,
     /// Index in `impacts` of each pair's latest impact.
@@ -48,6 +53,8 @@ impl Recording {
             impact_loss: 0.0,
             x: scene.initial_positions.clone(),
             v: scene.initial_velocities.clone(),
+            prev_x: scene.initial_positions.clone(),
+            prev_v: scene.initial_velocities.clone(),
             last_impulse: vec![0.0; n + 1],
             last_impact: vec![None; n + 1],
             next_sample: 0,
@@ -92,6 +99,7 @@ pub fn pair_impulses(dp: &[f64], active: &[bool], out: &mut [f64]) {
 /// Per-step working arrays, kept to avoid allocating in the step.
 #[derive(Debug, Clone, Default)]
 pub struct Scratch {
+    handles: Vec<RigidBodyHandle>,
     x: Vec<f64>,
     v: Vec<f64>,
     dp: Vec<f64>,
@@ -110,8 +118,7 @@ pub fn feedback(
     bodies: Option<Res<Bodies>>,
     frame: Option<ResMut<FrameState>>,
     mut rec: ResMut<Recording>,
-    mut balls: Query<(&mut Velocity, &Transform)>,
-    rapier: ReadRapierContext,
+    mut context: Query<(&RapierContextSimulation, &RapierContextColliders, &mut RapierRigidBodySet)>,
     mut scratch: Local<Scratch>,
 ) {
     let Some(bodies) = bodies else { return };
@@ -121,13 +128,18 @@ pub fn feedback(
     let t0 = clock.t;
     clock.steps += 1;
     clock.t += plan.h;
-    let Scratch { x: x_new, v: v_new, dp, active, j } = &mut *scratch;
+    let Ok((sim, colliders, mut set)) = context.single_mut() else { return };
+    let Scratch { x: x_new, v: v_new, dp, active, j, handles } = &mut *scratch;
+    if handles.len() != n {
+        handles.clear();
+        handles.extend(bodies.balls.iter().map(|e| set.entity2body()[e]));
+    }
     x_new.clear();
     v_new.clear();
-    for &e in &bodies.balls {
-        let (v, t) = balls.get(e).expect("ball entity");
-        x_new.push(t.translation.x as f64);
-        v_new.push(v.linear.x as f64);
+    for &h in handles.iter() {
+        let body = &set.bodies[h];
+        x_new.push(body.translation().x as f64);
+        v_new.push(body.linvel().x as f64);
     }
     let mass = |i: usize| scene.balls[i].mass;
     let impulses = |v_new: &[f64], v_old: &[f64], dp: &mut Vec<f64>, active: &[bool], j: &mut Vec<f64>| {
@@ -141,7 +153,6 @@ pub fn feedback(
     };
 
     // Which pairs were in contact this step (only whether, not how hard).
-    let ctx = rapier.single().ok();
     let collider = |body: isize| -> Option<Entity> {
         match (body, bodies.walls) {
             (-1, Some((l, _))) => Some(l),
@@ -152,10 +163,11 @@ pub fn feedback(
     };
     active.clear();
     active.extend((0..=n).map(|p| {
-        let (Some(a), Some(b), Some(ctx)) = (collider(p as isize - 1), collider(p as isize), ctx.as_ref()) else {
+        let (Some(a), Some(b)) = (collider(p as isize - 1), collider(p as isize)) else {
             return false;
         };
-        ctx.contact_pair(a, b).is_some_and(|pair| pair.manifolds().any(|m| m.points().any(|pt| pt.impulse() > 0.0)))
+        sim.contact_pair(colliders, &set, a, b)
+            .is_some_and(|pair| pair.manifolds().any(|m| m.points().any(|pt| pt.impulse() > 0.0)))
     }));
     impulses(v_new, &rec.v, dp, active, j);
 
@@ -197,10 +209,12 @@ pub fn feedback(
         }
     }
     if corrected {
-        for (i, &e) in bodies.balls.iter().enumerate() {
-            let (mut v, _) = balls.get_mut(e).expect("ball entity");
-            v.linear.x = v_new[i] as f32;
-            v_new[i] = v.linear.x as f64; // what Rapier will carry on with
+        for (i, &h) in handles.iter().enumerate() {
+            let body = &mut set.bodies[h];
+            let mut lin = body.linvel();
+            lin.x = v_new[i] as f32;
+            body.set_linvel(lin, true);
+            v_new[i] = lin.x as f64; // what Rapier will carry on with
         }
         impulses(v_new, &rec.v, dp, active, j);
     }
@@ -260,6 +274,8 @@ pub fn feedback(
         }
         rec.last_impulse[p] = j[p];
     }
+    std::mem::swap(&mut rec.prev_x, &mut rec.x);
+    std::mem::swap(&mut rec.prev_v, &mut rec.v);
     rec.x.clone_from(x_new);
     rec.v.clone_from(v_new);
 }
@@ -282,18 +298,13 @@ pub fn record_samples(
     scene: Res<DamperScene>,
     frame: Option<Res<FrameState>>,
     mut rec: ResMut<Recording>,
-    mut prev: Local<(Vec<f64>, Vec<f64>)>,
 ) {
     let scene = &scene.0;
     let n = scene.balls.len();
     let dt = plan.h;
     let t1 = clock.t;
     let t0 = t1 - dt;
-    let (prev_x, prev_v) = &mut *prev;
-    if prev_x.len() != n {
-        *prev_x = scene.initial_positions.clone();
-        *prev_v = scene.initial_velocities.clone();
-    }
+    let rec: &mut Recording = &mut rec;
     let f = scene.frame;
     let accel = |x: f64, v: f64| f.map_or(0.0, |f| -(f.damping * v + f.stiffness * x) / f.mass);
     while rec.next_sample < rec.sample_count {
@@ -323,13 +334,11 @@ pub fn record_samples(
             } else {
                 // Impulses land at the step's end: inside it, balls keep their old velocity.
                 let w = ((ts - t0) / dt).clamp(0.0, 1.0);
-                (prev_x[i] + w * (rec.x[i] - prev_x[i]), prev_v[i])
+                (rec.prev_x[i] + w * (rec.x[i] - rec.prev_x[i]), rec.prev_v[i])
             };
             rec.series.x[i].push(x);
             rec.series.v[i].push(v);
         }
         rec.next_sample += 1;
     }
-    prev_x.clone_from(&rec.x);
-    prev_v.clone_from(&rec.v);
 }

@@ -11,7 +11,8 @@ use bevy_rapier3d::parry::query::{cast_shapes, ShapeCastOptions};
 use bevy_rapier3d::parry::shape::{Ball, HalfSpace};
 use bevy_rapier3d::prelude::*;
 
-use super::plugin::{Bodies, DamperScene, FrameState, StepClock, StepSettings};
+use super::plugin::{DamperScene, FrameState, StepClock, StepSettings};
+use super::record::Recording;
 
 /// How steps are chosen.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord, serde::Serialize, serde::Deserialize)]
@@ -76,17 +77,16 @@ pub fn plan_step(
     settings: Res<StepSettings>,
     clock: Res<StepClock>,
     scene: Res<DamperScene>,
-    bodies: Option<Res<Bodies>>,
     frame: Option<Res<FrameState>>,
-    balls: Query<(&Transform, &Velocity)>,
+    rec: Option<Res<Recording>>,
     mut plan: ResMut<StepPlan>,
     mut timestep: ResMut<TimestepMode>,
 ) {
     let remaining = plan.horizon - clock.t;
     let mut h = settings.dt;
     if settings.stepping == Stepping::Aligned {
-        if let Some(bodies) = bodies {
-            h = aligned_step(&scene.0, &bodies, frame.as_deref(), &balls, settings.dt);
+        if let Some(rec) = rec {
+            h = aligned_step(&scene.0, &rec.x, &rec.v, frame.as_deref(), settings.dt);
         }
     }
     // Land exactly on the horizon rather than leave a sliver of a step.
@@ -97,18 +97,11 @@ pub fn plan_step(
     *timestep = TimestepMode::Fixed { dt: h as f32, substeps: 1 };
 }
 
-fn aligned_step(
-    scene: &crate::scene::Scene,
-    bodies: &Bodies,
-    frame: Option<&FrameState>,
-    balls: &Query<(&Transform, &Velocity)>,
-    longest: f64,
-) -> f64 {
-    let n = bodies.balls.len();
-    let state = |i: usize| {
-        let (t, v) = balls.get(bodies.balls[i]).expect("ball");
-        (Vec3::new(t.translation.x, 0.0, 0.0), Vec3::new(v.linear.x, 0.0, 0.0))
-    };
+/// The next step's length from the balls' positions `x` and velocities `v` (as Rapier holds
+/// them, at the start of the step) and the frame's state.
+fn aligned_step(scene: &crate::scene::Scene, x: &[f64], v: &[f64], frame: Option<&FrameState>, longest: f64) -> f64 {
+    let n = x.len();
+    let state = |i: usize| (Vec3::new(x[i] as f32, 0.0, 0.0), Vec3::new(v[i] as f32, 0.0, 0.0));
     // Look far enough ahead to start the geometric approach in time.
     let options = ShapeCastOptions::with_max_time_of_impact((2.0 * APPROACH_RATIO * longest) as f32);
     let mut ball_toi = f64::INFINITY;
