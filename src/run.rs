@@ -55,6 +55,9 @@ pub struct Impact {
     pub approach_speed: f64,
     /// Kinetic energy lost, J.
     pub energy_lost: f64,
+    /// Momentum exchanges this impact stands for (sequential impulses at one instant, or the
+    /// bodies of a merged run): each rounds momentum once, which bounds round-off.
+    pub impulses: u32,
 }
 
 /// Where the energy went. `balance_error = (initial - final - damping_loss - impact_loss) / initial`.

@@ -268,9 +268,13 @@ pub fn feedback(
                 b: body_of(b, n),
                 approach_speed: u,
                 energy_lost: lost,
+                impulses: 1,
             });
         } else if let Some(k) = rec.last_impact[p] {
             rec.impacts[k].energy_lost += lost;
+            if j[p] > rec.impulse_floor {
+                rec.impacts[k].impulses += 1;
+            }
         }
         rec.last_impulse[p] = j[p];
     }

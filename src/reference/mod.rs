@@ -496,7 +496,7 @@ impl<'a> Solver<'a> {
         self.dirty[i + 1] = true;
     }
 
-    fn record(&mut self, p: usize, approach_speed: f64, energy_lost: f64) {
+    fn record(&mut self, p: usize, approach_speed: f64, energy_lost: f64, impulses: u32) {
         let a = if p == 0 { Body::LeftWall } else { Body::Ball(p - 1) };
         let b = if p == self.n { Body::RightWall } else { Body::Ball(p) };
         self.impact_loss += energy_lost;
@@ -505,11 +505,12 @@ impl<'a> Solver<'a> {
             let last = &mut self.impacts[k];
             if last.t == self.t {
                 last.energy_lost += energy_lost;
+                last.impulses += impulses;
                 return;
             }
         }
         self.last_impact[p] = Some(self.impacts.len());
-        self.impacts.push(Impact { t: self.t, a, b, approach_speed, energy_lost });
+        self.impacts.push(Impact { t: self.t, a, b, approach_speed, energy_lost, impulses });
     }
 
     /// An impact with restitution `e` across pair `p`.
@@ -523,7 +524,7 @@ impl<'a> Solver<'a> {
                 self.v[j] = vj;
                 self.touch_ball(i);
                 self.touch_ball(j);
-                self.record(p, approach_speed, lost);
+                self.record(p, approach_speed, lost, 1);
             }
             Gap::Frame { ball, .. } => {
                 let (_, vs) = self.seg.state(self.t);
@@ -532,7 +533,7 @@ impl<'a> Solver<'a> {
                 self.v[ball] = vb;
                 self.touch_ball(ball);
                 self.set_frame(vf);
-                self.record(p, approach_speed, lost);
+                self.record(p, approach_speed, lost, 1);
             }
         }
     }
@@ -599,7 +600,7 @@ impl<'a> Solver<'a> {
             }
             self.set_frame(vc);
         }
-        self.record(p, approach_speed, lost);
+        self.record(p, approach_speed, lost, balls.len() as u32 + with_frame as u32);
     }
 
     fn left_body_free(&self, p: usize) -> bool {
@@ -675,7 +676,9 @@ impl<'a> Solver<'a> {
                     }
                     _ => false,
                 };
-                if u >= self.v_stick && !bounce_returns_fast && impulses < MAX_IMPULSES_PER_INSTANT {
+                // With e = 0 a touching approaching run ends as one body: merge it at once
+                // instead of converging to that through a geometric series of impulses.
+                if self.e > 0.0 && u >= self.v_stick && !bounce_returns_fast && impulses < MAX_IMPULSES_PER_INSTANT {
                     self.collide(p, u);
                     impulses += 1;
                 } else {
