@@ -28,6 +28,7 @@ pub mod rapier;
 pub mod reference;
 pub mod run;
 pub mod scene;
+pub mod stress;
 pub mod sweep;
 
 pub use model::Model;

@@ -37,6 +37,30 @@ enum Command {
     Compare(CompareArgs),
     /// Run time against error for every model and setting; marks the Pareto front.
     Bench(BenchArgs),
+    /// Random valid scenes through every model, checked for instability; failures shrunk.
+    Stress(StressArgs),
+}
+
+#[derive(clap::Args)]
+struct StressArgs {
+    /// Scenes per model.
+    #[arg(long, default_value_t = 200)]
+    count: u64,
+    /// First seed (scene k uses seed + k).
+    #[arg(long, default_value_t = 1)]
+    seed: u64,
+    /// Models, comma-separated.
+    #[arg(long, value_delimiter = ',', default_value = "reference,rapier")]
+    models: Vec<Model>,
+    /// Longest horizon drawn, s.
+    #[arg(long, default_value_t = 100.0)]
+    max_horizon: f64,
+    /// Output format on standard output.
+    #[arg(long, value_enum, default_value_t = Format::Text)]
+    format: Format,
+    /// Write each failure's minimal scene into this directory.
+    #[arg(long)]
+    out: Option<PathBuf>,
 }
 
 #[derive(Clone, Copy, ValueEnum, PartialEq, Eq)]
@@ -203,6 +227,7 @@ fn main() -> ExitCode {
         Command::Chain(a) => cmd_chain(a),
         Command::Compare(a) => cmd_compare(a),
         Command::Bench(a) => cmd_bench(a),
+        Command::Stress(a) => cmd_stress(a),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,
@@ -517,4 +542,44 @@ fn bench_csv(rows: &[lpc_damper::bench::BenchRow]) -> Result<Vec<u8>> {
         ])?;
     }
     Ok(w.into_inner()?)
+}
+
+fn cmd_stress(a: StressArgs) -> Result<()> {
+    let mut outcomes = Vec::new();
+    let start = std::time::Instant::now();
+    for &model in &a.models {
+        let bar = progress_bar(a.count as usize, &format!("stress {}", model.name()));
+        outcomes.extend(lpc_damper::stress::stress(model, a.seed, a.count, a.max_horizon, &|| bar.inc(1)));
+        bar.finish_and_clear();
+    }
+    let failures: Vec<_> = outcomes.iter().filter(|o| o.failure.is_some()).collect();
+    if let Some(dir) = &a.out {
+        for o in &failures {
+            let path = dir.join(format!("stress-{}-{}.toml", o.model, o.seed));
+            write_atomic(&path, o.minimal_scene.as_deref().unwrap_or("").as_bytes())?;
+        }
+    }
+    match a.format {
+        Format::Json => print_json(&outcomes)?,
+        Format::Text => {
+            for o in &failures {
+                let f = o.failure.as_ref().expect("failure");
+                println!("FAIL {} seed {}: {} ({})", o.model, o.seed, f.check, f.detail);
+                if let Some(m) = &o.minimal_scene {
+                    println!("minimal scene:\n{m}");
+                }
+            }
+            for &model in &a.models {
+                let total = outcomes.iter().filter(|o| o.model == model.name()).count();
+                let failed = failures.iter().filter(|o| o.model == model.name()).count();
+                println!("{}: {} passed, {} failed", model.name(), total - failed, failed);
+            }
+            println!("({:.1} s)", start.elapsed().as_secs_f64());
+        }
+    }
+    if failures.is_empty() {
+        Ok(())
+    } else {
+        Err(anyhow::anyhow!("{} of {} stressed runs failed", failures.len(), outcomes.len()))
+    }
 }

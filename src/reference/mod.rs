@@ -44,6 +44,9 @@ pub enum ReferenceError {
 
 /// Most events one run may process before it is declared stalled.
 pub const MAX_EVENTS: u64 = 20_000_000;
+/// Most events at one instant: everything at an instant is resolved by one `resolve`, so a
+/// second event at the same time already means two judgements disagree.
+const MAX_EVENTS_PER_INSTANT: u64 = 1000;
 /// Most impacts resolved at one instant before the touching run is merged.
 const MAX_IMPULSES_PER_INSTANT: usize = 10_000;
 /// Contact tolerance relative to the scene's length scale.
@@ -318,12 +321,28 @@ impl<'a> Solver<'a> {
         (s * (xb - xs) + k, s * (self.v[ball] - vs))
     }
 
-    /// The frame's acceleration just after `t` (sign taken mid-way to its next sign change, so
-    /// that `t` lying on a sign change does not matter).
+    /// The frame's acceleration just after `t`: its value, with the sign of the first
+    /// derivative that is not round-off when the acceleration itself is (at a sign change).
+    /// Every sign involved is that of `-(c v + k x)` and its derivatives, whatever the mass
+    /// the frame carries, so holding and releasing a ball always agree.
     fn accel_ahead(&self, t: f64) -> f64 {
-        let next = self.seg.next_sign_change(t).min(t + self.span);
-        let mid = if next.is_finite() { 0.5 * (t + next) } else { t + 1.0 };
-        self.seg.accel(mid)
+        let (x, v) = self.seg.state(t);
+        let o = &self.seg.osc;
+        let a = o.accel(x, v);
+        if a.abs() > 1e-9 * (o.w0sq * x.abs() + 2.0 * o.sigma * v.abs()) {
+            return a;
+        }
+        let jerk = -2.0 * o.sigma * a - o.w0sq * v;
+        let sign = if jerk.abs() > 1e-9 * (2.0 * o.sigma * a.abs() + o.w0sq * v.abs()) {
+            jerk.signum()
+        } else {
+            let snap = -2.0 * o.sigma * jerk - o.w0sq * a;
+            if snap == 0.0 {
+                return 0.0;
+            }
+            snap.signum()
+        };
+        sign * a.abs().max(f64::MIN_POSITIVE)
     }
 
     // ---- event search ---------------------------------------------------------------------
@@ -393,7 +412,10 @@ impl<'a> Solver<'a> {
     fn concave_root(&self, ball: usize, s: f64, k: f64, a: f64, b: f64) -> Option<f64> {
         let (ga, gpa) = self.frame_gap_at(ball, s, k, a);
         if ga <= self.tol && gpa <= 0.0 {
-            return Some(a); // touching and pressed together: contact now
+            // Touching and not separating: a contact now if the wall presses, judged exactly as
+            // `resolve` judges it (a piece can be an ulp long at a sign change, and its
+            // midpoint then disagrees); otherwise the ball is about to leave the wall.
+            return (-s * self.accel_ahead(a) < 0.0).then_some(a);
         }
         let (gb, _) = self.frame_gap_at(ball, s, k, b);
         if gb > self.tol {
@@ -749,6 +771,7 @@ impl<'a> Solver<'a> {
     }
 
     fn run(&mut self) -> Result<(), ReferenceError> {
+        let mut same_instant = 0u64;
         self.resolve();
         loop {
             self.refresh_candidates();
@@ -773,9 +796,10 @@ impl<'a> Solver<'a> {
                 }
             }
             self.sample_until(t, false);
+            same_instant = if t == self.t { same_instant + 1 } else { 0 };
             self.advance(t);
             self.events += 1;
-            if self.events > MAX_EVENTS {
+            if self.events > MAX_EVENTS || same_instant > MAX_EVENTS_PER_INSTANT {
                 return Err(ReferenceError::Stalled { scene: self.scene.name.clone(), events: self.events, t });
             }
             if release {

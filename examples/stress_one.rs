@@ -1,0 +1,24 @@
+//! Runs one stress scene by seed and prints its time: `cargo run --release --example
+//! stress_one -- SEED [MAX_HORIZON] [MODEL]`; with `--toml` prints the scene file instead.
+fn main() {
+    let args: Vec<String> = std::env::args().collect();
+    if args[1].ends_with(".toml") {
+        let scene = lpc_damper::scene::load_scene(&args[1]).unwrap();
+        let run = lpc_damper::reference::simulate(&scene).unwrap();
+        println!("events {} impacts {} held-time events/s {:.0}", run.events, run.impacts.len(), run.events as f64 / scene.horizon);
+        return;
+    }
+    let seed: u64 = args[1].parse().unwrap();
+    let max_h: f64 = args.get(2).map_or(100.0, |s| s.parse().unwrap());
+    let model: lpc_damper::Model = args.get(3).map_or("reference", |s| s).parse().unwrap();
+    let file = lpc_damper::stress::random_scene_file(seed, max_h);
+    if args.iter().any(|a| a == "--toml") {
+        println!("{}", toml::to_string(&file).unwrap());
+        return;
+    }
+    let scene = lpc_damper::scene::from_file(file, "s", "s").unwrap().scene.unwrap();
+    let t = std::time::Instant::now();
+    let r = lpc_damper::stress::check_run(model, &scene);
+    if let Err(f) = &r { println!("{}", f.detail); }
+    println!("seed {seed}: {:.3} s balls {} horizon {:.2} -> {:?}", t.elapsed().as_secs_f64(), scene.balls.len(), scene.horizon, r.map(|r| (r.events, r.impacts.len())).map_err(|f| f.check));
+}

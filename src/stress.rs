@@ -1,0 +1,269 @@
+//! Stress tests of numerical stability: seeded random valid scenes through every model, each
+//! run checked for panics, non-finite values, energy gained, impacts that lose more than an
+//! impact can, momentum drift, balls outside the container and stalls. A failure is shrunk to
+//! a minimal scene file that reproduces it.
+
+use std::panic::{catch_unwind, AssertUnwindSafe};
+
+use rand::{Rng, SeedableRng};
+use rand_pcg::Pcg64;
+use serde::Serialize;
+
+use crate::model::Model;
+use crate::run::Run;
+use crate::scene::format::{BallsFile, FrameFile, RunFile};
+use crate::scene::{self, Arrangement, Length, Scene, SceneFile};
+
+/// Most events (reference) or steps (Rapier) per simulated second before a run counts as
+/// stalled. The densest valid scenes reach a few 10^5 (see docs/BENCHMARKS.md).
+pub const STALL_EVENTS_PER_SIM_S: f64 = 2e6;
+
+/// How a run failed.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Failure {
+    /// Which check: `panic`, `error`, `non-finite`, `energy-gained`, `impact-loss`,
+    /// `momentum`, `outside`, `stall`.
+    pub check: &'static str,
+    /// Details.
+    pub detail: String,
+}
+
+/// One stressed scene's outcome (the JSON of `lpc stress`).
+#[derive(Debug, Clone, Serialize)]
+pub struct Outcome {
+    /// Seed of this scene.
+    pub seed: u64,
+    /// Model.
+    pub model: &'static str,
+    /// `None` when every check passed.
+    pub failure: Option<Failure>,
+    /// The shrunk scene that still fails, as TOML.
+    pub minimal_scene: Option<String>,
+}
+
+/// A random valid scene file: 1 to 50 balls, mass ratios 1 to 1000, e in [0, 1], gaps from 0
+/// to large, clearance from 0, frame periods 1 ms to 10 s, xs0 up to ten times the clearance,
+/// horizons up to `max_horizon`; a fifth of the frames are free (no spring, no damper) so that
+/// momentum can be checked.
+pub fn random_scene_file(seed: u64, max_horizon: f64) -> SceneFile {
+    let mut rng = Pcg64::seed_from_u64(seed);
+    let log_uniform = |rng: &mut Pcg64, lo: f64, hi: f64| (rng.random_range(lo.ln()..hi.ln())).exp();
+    let n = if rng.random_bool(0.5) { rng.random_range(1..=5) } else { rng.random_range(1..=50) };
+    let letters: String = (0..n).map(|_| if rng.random_bool(0.5) { 'L' } else { 'S' }).collect();
+    let mass = 1.35;
+    let free = rng.random_bool(0.2);
+    let period = log_uniform(&mut rng, 1e-3, 10.0);
+    let stiffness = if free { 0.0 } else { mass * (2.0 * std::f64::consts::PI / period).powi(2) };
+    let damping = if free { 0.0 } else { rng.random_range(0.0..0.3) * 2.0 * (stiffness * mass).sqrt() };
+    let gap = if rng.random_bool(0.2) { 0.0 } else { log_uniform(&mut rng, 1e-3, 5.0) };
+    let clearance = if rng.random_bool(0.2) { 0.0 } else { log_uniform(&mut rng, 1e-2, 5.0) };
+    let xs0 = rng.random_range(0.0..=10.0) * clearance.max(0.1) * if rng.random_bool(0.5) { 1.0 } else { -1.0 };
+    let horizon = log_uniform(&mut rng, 0.05, max_horizon.max(0.06));
+    SceneFile {
+        name: Some(format!("stress-{seed}")),
+        frame: Some(FrameFile { mass, stiffness, damping, initial_displacement: Length::Rr(xs0) }),
+        balls: Some(BallsFile {
+            arrangement: Arrangement::Letters(letters),
+            large_mass: 0.11,
+            mass_ratio: log_uniform(&mut rng, 1.0, 1000.0),
+            density: 8000.0,
+            restitution: if rng.random_bool(0.1) { 0.0 } else if rng.random_bool(0.1) { 1.0 } else { rng.random_range(0.0..=1.0) },
+            gap: Length::Rr(gap),
+            clearance: Some(Length::Rr(clearance)),
+            container_length: None,
+        }),
+        run: RunFile { horizon: Some(horizon), sample_dt: Some((horizon / 2000.0).max(1e-4)) },
+        ..SceneFile::default()
+    }
+}
+
+/// Runs `model` on `scene` and checks the run.
+pub fn check_run(model: Model, scene: &Scene) -> Result<Run, Failure> {
+    let outcome = catch_unwind(AssertUnwindSafe(|| model.simulate(scene)));
+    let run = match outcome {
+        Err(panic) => {
+            let msg = panic
+                .downcast_ref::<String>()
+                .cloned()
+                .or_else(|| panic.downcast_ref::<&str>().map(|s| s.to_string()))
+                .unwrap_or_default();
+            return Err(Failure { check: "panic", detail: msg });
+        }
+        Ok(Err(crate::model::ModelError::Refused(_))) => return Ok(refused_run(scene)),
+        Ok(Err(e)) => {
+            let check = if e.to_string().contains("stalled") { "stall" } else { "error" };
+            return Err(Failure { check, detail: e.to_string() });
+        }
+        Ok(Ok(run)) => run,
+    };
+    check(model, scene, &run)?;
+    Ok(run)
+}
+
+/// A stand-in for a scene the model refuses with a reason (that is a correct answer).
+fn refused_run(scene: &Scene) -> Run {
+    Run {
+        scene: scene.name.clone(),
+        model: "refused".into(),
+        horizon: 0.0,
+        sample_dt: scene.sample_dt,
+        initial_displacement: scene.initial_displacement,
+        damped_period: 0.0,
+        series: Default::default(),
+        impacts: vec![],
+        energy: Default::default(),
+        events: 0,
+        final_velocities: vec![],
+        wall_time_s: 0.0,
+    }
+}
+
+fn check(model: Model, scene: &Scene, run: &Run) -> Result<(), Failure> {
+    let fail = |check, detail: String| Err(Failure { check, detail });
+    let s = &run.series;
+    let finite = |v: &[f64]| v.iter().all(|x| x.is_finite());
+    if !(finite(&s.xs) && finite(&s.vs) && finite(&s.a) && s.x.iter().all(|v| finite(v)) && s.v.iter().all(|v| finite(v)))
+        || ![run.energy.final_, run.energy.damping_loss, run.energy.impact_loss].iter().all(|x| x.is_finite())
+    {
+        return fail("non-finite", "a series or the energy account holds NaN or infinity".into());
+    }
+    let e0 = run.energy.initial.max(1e-300);
+    // Reference: exact to round-off. Rapier: f32 velocities, one rounding per impulse.
+    let (balance_tol, impact_tol) = match model {
+        Model::Reference => (1e-9, 1e-9),
+        Model::Rapier => (1e-3, 1e-3),
+    };
+    if run.energy.final_ > e0 * (1.0 + balance_tol) {
+        return fail("energy-gained", format!("final energy {} > initial {}", run.energy.final_, e0));
+    }
+    if model == Model::Reference && run.energy.balance_error.abs() > balance_tol {
+        return fail("energy-gained", format!("balance error {:e}", run.energy.balance_error));
+    }
+    for imp in &run.impacts {
+        // A perfectly inelastic impact at approach speed u loses mu u^2 / 2. A side held by
+        // the frame moves with the frame's mass, so mu is bounded by the free ball's mass: at
+        // most the larger of the pair's ball masses (the ball's mass for a wall).
+        let ball_mass = |b: scene::Body| match b {
+            scene::Body::Ball(i) => scene.balls[i].mass,
+            _ => 0.0,
+        };
+        let most = 0.5 * ball_mass(imp.a).max(ball_mass(imp.b)) * imp.approach_speed.powi(2);
+        // (Only a single impulse is so bounded: a cascade at one instant or a merged run can
+        // pass on energy from the neighbours.)
+        let single = model == Model::Reference && imp.impulses == 1;
+        if imp.energy_lost < -impact_tol * e0 || (single && imp.energy_lost > most * (1.0 + 1e-9) + 1e-12 * e0) {
+            return fail("impact-loss", format!("impact at t = {} loses {} J (at most {most} J)", imp.t, imp.energy_lost));
+        }
+    }
+    if let (Some(f), true) = (scene.frame, !s.is_empty()) {
+        if f.stiffness == 0.0 && f.damping == 0.0 {
+            let p = |k: usize| f.mass * s.vs[k] + (0..scene.balls.len()).map(|i| scene.balls[i].mass * s.v[i][k]).sum::<f64>();
+            let scale = f.mass * s.vs.iter().fold(0.0f64, |m, v| m.max(v.abs()))
+                + scene.balls.iter().enumerate().map(|(i, b)| b.mass * s.v[i].iter().fold(0.0f64, |m, v| m.max(v.abs()))).sum::<f64>();
+            let tol = match model {
+                Model::Reference => 1e-9,
+                Model::Rapier => 1e-5,
+            } * scale.max(1e-300);
+            for k in 0..s.len() {
+                if (p(k) - p(0)).abs() > tol {
+                    return fail("momentum", format!("total momentum {} at t = {} (was {})", p(k), s.t[k], p(0)));
+                }
+            }
+        }
+    }
+    if let Some(c) = scene.container {
+        // Reference: contact tolerance; Rapier: its allowed overlap (5e-5 m) before correction.
+        let tol = match model {
+            Model::Reference => 1e-9 * c.length.max(1e-3),
+            Model::Rapier => 5e-5 + 1e-6,
+        };
+        for k in 0..s.len() {
+            for (i, b) in scene.balls.iter().enumerate() {
+                let (lo, hi) = (s.x[i][k] - b.radius - s.xs[k], s.xs[k] + c.length - s.x[i][k] - b.radius);
+                if lo < -tol || hi < -tol {
+                    return fail("outside", format!("ball{} outside the container by {:e} m at t = {}", i + 1, -lo.min(hi), s.t[k]));
+                }
+            }
+        }
+    }
+    let rate = run.events as f64 / run.horizon.max(1e-300);
+    if rate > STALL_EVENTS_PER_SIM_S {
+        return fail("stall", format!("{rate:.3e} events per simulated second"));
+    }
+    Ok(())
+}
+
+fn validate(file: &SceneFile) -> Option<Scene> {
+    scene::from_file(file.clone(), "stress", "stress").ok()?.scene
+}
+
+/// Smaller and simpler variants of a scene file, for shrinking.
+fn simplifications(f: &SceneFile) -> Vec<SceneFile> {
+    let mut out = vec![];
+    let balls = f.balls.as_ref().expect("damper");
+    if let Arrangement::Letters(l) = &balls.arrangement {
+        for cut in [l.len() / 2, l.len() - 1] {
+            if cut >= 1 && cut < l.len() {
+                for keep in [&l[..cut], &l[l.len() - cut..]] {
+                    let mut g = f.clone();
+                    g.balls.as_mut().unwrap().arrangement = Arrangement::Letters(keep.to_string());
+                    out.push(g);
+                }
+            }
+        }
+    }
+    let horizon = f.run.horizon.unwrap_or(5.0);
+    if horizon > 0.01 {
+        let mut g = f.clone();
+        g.run.horizon = Some(horizon / 2.0);
+        g.run.sample_dt = Some((horizon / 2.0 / 2000.0).max(1e-5));
+        out.push(g);
+    }
+    let mut tweak = |edit: &dyn Fn(&mut SceneFile)| {
+        let mut g = f.clone();
+        edit(&mut g);
+        if toml::to_string(&g).ok() != toml::to_string(f).ok() {
+            out.push(g);
+        }
+    };
+    tweak(&|g| g.balls.as_mut().unwrap().mass_ratio = 10.0);
+    tweak(&|g| g.balls.as_mut().unwrap().restitution = 0.9);
+    tweak(&|g| g.balls.as_mut().unwrap().gap = Length::Rr(0.25));
+    tweak(&|g| g.balls.as_mut().unwrap().clearance = Some(Length::Rr(1.0)));
+    tweak(&|g| g.frame.as_mut().unwrap().damping = 0.0);
+    out
+}
+
+/// Shrinks a failing scene: keeps applying simplifications while the same check still fails.
+pub fn shrink(model: Model, file: &SceneFile, check_name: &str) -> SceneFile {
+    let mut current = file.clone();
+    'outer: for _ in 0..200 {
+        for candidate in simplifications(&current) {
+            if let Some(scene) = validate(&candidate) {
+                if matches!(check_run(model, &scene), Err(f) if f.check == check_name) {
+                    current = candidate;
+                    continue 'outer;
+                }
+            }
+        }
+        break;
+    }
+    current
+}
+
+/// Stresses `model` with `count` scenes from `seed` on; failing scenes are shrunk.
+pub fn stress(model: Model, seed: u64, count: u64, max_horizon: f64, progress: &(dyn Fn() + Sync)) -> Vec<Outcome> {
+    use rayon::prelude::*;
+    (seed..seed + count)
+        .into_par_iter()
+        .map(|s| {
+            let file = random_scene_file(s, max_horizon);
+            let scene = validate(&file).expect("generated scenes are valid");
+            let failure = check_run(model, &scene).err();
+            let minimal_scene =
+                failure.as_ref().map(|f| toml::to_string(&shrink(model, &file, f.check)).unwrap_or_default());
+            progress();
+            Outcome { seed: s, model: model.name(), failure, minimal_scene }
+        })
+        .collect()
+}
