@@ -127,7 +127,9 @@ fn check(model: Model, scene: &Scene, run: &Run) -> Result<(), Failure> {
     {
         return fail("non-finite", "a series or the energy account holds NaN or infinity".into());
     }
-    let e0 = run.energy.initial.max(1e-300);
+    // Energy scale: the initial energy, or for a scene at rest the work its impacts could do
+    // (none), so that round-off on zero is not "energy gained".
+    let e0 = run.energy.initial.max(1e-12);
     // Reference: exact to round-off. Rapier: f32 velocities, one rounding per impulse.
     let (balance_tol, impact_tol) = match model {
         Model::Reference => (1e-9, 1e-9),

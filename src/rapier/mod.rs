@@ -35,11 +35,21 @@ pub const DEFAULT_DT: f64 = 2e-3;
 /// Default solver iterations.
 pub const DEFAULT_SOLVER_ITERATIONS: usize = 4;
 
-/// The stepping a scene asks for, with the defaults filled in.
+/// Steps per period of the frame at least: Rapier sees the walls move in a straight line over
+/// a step, which must stay close to the frame's true path.
+pub const STEPS_PER_FRAME_PERIOD: f64 = 40.0;
+
+/// The stepping a scene asks for, with the defaults filled in and the step kept inside the
+/// stable region: at most a 40th of the frame's natural period.
 pub fn settings(scene: &Scene) -> StepSettings {
+    let dt = scene.rapier.dt.unwrap_or(DEFAULT_DT);
+    let period_bound = scene
+        .frame
+        .filter(|f| f.stiffness > 0.0)
+        .map_or(f64::INFINITY, |f| 2.0 * std::f64::consts::PI * (f.mass / f.stiffness).sqrt() / STEPS_PER_FRAME_PERIOD);
     StepSettings {
         stepping: scene.rapier.stepping.unwrap_or(DEFAULT_STEPPING),
-        dt: scene.rapier.dt.unwrap_or(DEFAULT_DT),
+        dt: dt.min(period_bound),
         solver_iterations: scene.rapier.solver_iterations.map_or(DEFAULT_SOLVER_ITERATIONS, |i| i as usize),
     }
 }
