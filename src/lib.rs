@@ -19,6 +19,7 @@
 
 pub mod bench;
 pub mod chain;
+pub mod check;
 pub mod compare;
 pub mod metrics;
 pub mod model;

@@ -39,6 +39,27 @@ enum Command {
     Bench(BenchArgs),
     /// Random valid scenes through every model, checked for instability; failures shrunk.
     Stress(StressArgs),
+    /// Headless regression runs: every scene with every model against tests/golden/.
+    Check(CheckArgs),
+}
+
+#[derive(clap::Args)]
+struct CheckArgs {
+    /// Directory of scene files.
+    #[arg(default_value = "scenes")]
+    dir: PathBuf,
+    /// Directory of golden files.
+    #[arg(long, default_value = "tests/golden")]
+    golden: PathBuf,
+    /// Models, comma-separated.
+    #[arg(long, value_delimiter = ',', default_value = "reference,rapier")]
+    models: Vec<Model>,
+    /// Rewrite the golden files from this run.
+    #[arg(long)]
+    update: bool,
+    /// Print every compared value, not only the failures.
+    #[arg(long)]
+    verbose: bool,
 }
 
 #[derive(clap::Args)]
@@ -228,6 +249,7 @@ fn main() -> ExitCode {
         Command::Compare(a) => cmd_compare(a),
         Command::Bench(a) => cmd_bench(a),
         Command::Stress(a) => cmd_stress(a),
+        Command::Check(a) => return cmd_check(a),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,
@@ -581,5 +603,55 @@ fn cmd_stress(a: StressArgs) -> Result<()> {
         Ok(())
     } else {
         Err(anyhow::anyhow!("{} of {} stressed runs failed", failures.len(), outcomes.len()))
+    }
+}
+
+/// Exit status of `lpc check` when a value left its tolerance.
+const EXIT_REGRESSION: u8 = 3;
+
+fn cmd_check(a: CheckArgs) -> ExitCode {
+    use lpc_damper::check;
+    let run = || -> Result<Vec<check::Row>> {
+        let now = check::current(&a.dir, &a.models)?;
+        let mut rows = Vec::new();
+        for g in &now {
+            if a.update {
+                check::write_golden(&a.golden, g)?;
+            }
+            let golden = if a.update { Some(g.clone()) } else { check::read_golden(&a.golden, g)? };
+            rows.extend(check::compare(g, golden.as_ref()));
+        }
+        Ok(rows)
+    };
+    let rows = match run() {
+        Ok(rows) => rows,
+        Err(e) => {
+            eprintln!("error: {e:#}");
+            return if e.chain().any(|c| c.is::<SceneError>()) { ExitCode::from(2) } else { ExitCode::from(1) };
+        }
+    };
+    let fmt = |x: Option<f64>| x.map_or("-".to_string(), |v| format!("{v:.6e}"));
+    println!("{:<34} {:>9} {:<18} {:>14} {:>14} {:>10} {:>6}", "case", "model", "metric", "golden", "now", "tolerance", "");
+    for r in rows.iter().filter(|r| a.verbose || !r.ok) {
+        println!(
+            "{:<34} {:>9} {:<18} {:>14} {:>14} {:>10.1e} {:>6}",
+            r.case,
+            r.model,
+            r.metric,
+            fmt(r.golden),
+            fmt(r.now),
+            r.tolerance,
+            if r.ok { "ok" } else { "FAIL" }
+        );
+    }
+    let failed = rows.iter().filter(|r| !r.ok).count();
+    println!("{} passed, {} failed", rows.len() - failed, failed);
+    if a.update {
+        println!("golden files rewritten in {}", a.golden.display());
+    }
+    if failed == 0 {
+        ExitCode::SUCCESS
+    } else {
+        ExitCode::from(EXIT_REGRESSION)
     }
 }

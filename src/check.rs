@@ -1,0 +1,188 @@
+//! Headless regression runs (`lpc check`): every scene of a directory with every model, its
+//! summary compared with a golden file under a stated tolerance per metric.
+//!
+//! Tolerances: the reference is exact, so its metrics must agree to 1e-9 relative (room for a
+//! different libm) and its impact count exactly. The contact model is deterministic on one
+//! machine, but f32 arithmetic and another libm perturb it by about 1e-7 relative, and the
+//! paper scenes amplify such perturbations (docs/BENCHMARKS.md, "Sensitivity"): a 1e-6
+//! perturbation of the exact model moves the RMS displacement by up to 0.5 mm, the settling
+//! time by up to 0.8 s and the energy left by 0.13 % of E0. Its tolerances are those, with the
+//! peaks (set in the first periods, well-conditioned) at 2 %, and the impact count at 15 %.
+
+use std::path::{Path, PathBuf};
+
+use serde::{Deserialize, Serialize};
+
+use crate::chain::{run_chain, KerRow};
+use crate::metrics::{metrics, Metrics};
+use crate::model::{Model, ModelError};
+use crate::scene::{self, SceneError};
+use crate::sweep::sweep_scenes;
+
+/// What is kept of one run.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Golden {
+    /// Case name (scene, sweep value or chain).
+    pub case: String,
+    /// Model name.
+    pub model: String,
+    /// Impacts.
+    pub impact_count: usize,
+    /// Headline metrics.
+    pub metrics: Option<Metrics>,
+    /// KER rows, for a chain file.
+    pub ker: Vec<KerRow>,
+}
+
+/// One compared value.
+#[derive(Debug, Clone, Serialize)]
+pub struct Row {
+    /// Case name.
+    pub case: String,
+    /// Model name.
+    pub model: String,
+    /// Metric name.
+    pub metric: String,
+    /// Golden value (`None`: no golden).
+    pub golden: Option<f64>,
+    /// Value now.
+    pub now: Option<f64>,
+    /// Allowed difference.
+    pub tolerance: f64,
+    /// Within tolerance.
+    pub ok: bool,
+}
+
+/// A failure to run the check at all.
+#[derive(Debug, thiserror::Error)]
+pub enum CheckError {
+    /// A scene is invalid.
+    #[error(transparent)]
+    Scene(#[from] SceneError),
+    /// A model failed.
+    #[error(transparent)]
+    Model(#[from] ModelError),
+    /// A golden file could not be read or written.
+    #[error("{path}: {message}")]
+    Io {
+        /// Path.
+        path: String,
+        /// Why.
+        message: String,
+    },
+}
+
+/// Runs every case of every scene file in `dir` with every model.
+pub fn current(dir: &Path, models: &[Model]) -> Result<Vec<Golden>, CheckError> {
+    let mut paths: Vec<PathBuf> = std::fs::read_dir(dir)
+        .map_err(|e| CheckError::Io { path: dir.display().to_string(), message: e.to_string() })?
+        .filter_map(|e| e.ok().map(|e| e.path()))
+        .filter(|p| p.extension().is_some_and(|x| x == "toml"))
+        .collect();
+    paths.sort();
+    let mut out = Vec::new();
+    for path in paths {
+        let loaded = scene::load(&path)?;
+        let mut cases = Vec::new();
+        if loaded.file.sweep.is_some() {
+            cases.extend(sweep_scenes(&loaded)?.into_iter().map(|(_, s)| s));
+        } else if let Some(s) = &loaded.scene {
+            cases.push(s.clone());
+        }
+        for &model in models {
+            for s in &cases {
+                let run = model.simulate(s)?;
+                out.push(Golden {
+                    case: s.name.clone(),
+                    model: model.name().into(),
+                    impact_count: run.impacts.len(),
+                    metrics: Some(metrics(&run)),
+                    ker: vec![],
+                });
+            }
+            if let Some(chain) = &loaded.chain {
+                let name = loaded.file.name.clone().unwrap_or_else(|| "chain".into());
+                out.push(Golden { case: name, model: model.name().into(), impact_count: 0, metrics: None, ker: run_chain(chain, model)? });
+            }
+        }
+    }
+    Ok(out)
+}
+
+/// Golden file of one case and model.
+pub fn golden_path(golden_dir: &Path, case: &str, model: &str) -> PathBuf {
+    let safe: String = case.chars().map(|c| if c.is_ascii_alphanumeric() || c == '-' || c == '.' { c } else { '_' }).collect();
+    golden_dir.join(format!("{safe}.{model}.json"))
+}
+
+/// Reads the golden of `g`'s case and model, if any.
+pub fn read_golden(golden_dir: &Path, g: &Golden) -> Result<Option<Golden>, CheckError> {
+    let path = golden_path(golden_dir, &g.case, &g.model);
+    match std::fs::read(&path) {
+        Ok(bytes) => serde_json::from_slice(&bytes)
+            .map(Some)
+            .map_err(|e| CheckError::Io { path: path.display().to_string(), message: e.to_string() }),
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound => Ok(None),
+        Err(e) => Err(CheckError::Io { path: path.display().to_string(), message: e.to_string() }),
+    }
+}
+
+/// Tolerance of one metric for a model: `(relative, absolute)`.
+fn tolerance(model: &str, metric: &str) -> (f64, f64) {
+    if model == "reference" {
+        return if metric == "impact_count" { (0.0, 0.0) } else { (1e-9, 1e-15) };
+    }
+    match metric {
+        "peak_displacement" | "peak_acceleration" => (0.02, 0.0),
+        "rms_displacement" => (0.0, 0.5e-3),
+        "settling_time" => (0.0, 0.8),
+        "energy_remaining" => (0.0, 1.3e-3),
+        "impact_count" => (0.15, 1.0),
+        _ => (0.0, 0.01), // KER
+    }
+}
+
+/// Compares `now` with `golden` metric by metric.
+pub fn compare(now: &Golden, golden: Option<&Golden>) -> Vec<Row> {
+    let values = |g: &Golden| -> Vec<(String, Option<f64>)> {
+        let mut v = vec![("impact_count".to_string(), Some(g.impact_count as f64))];
+        if let Some(m) = &g.metrics {
+            v.push(("peak_displacement".into(), Some(m.peak_displacement)));
+            v.push(("peak_acceleration".into(), Some(m.peak_acceleration)));
+            v.push(("rms_displacement".into(), Some(m.rms_displacement)));
+            v.push(("settling_time".into(), m.settling_time));
+            v.push(("energy_remaining".into(), m.energy_remaining));
+        }
+        for r in &g.ker {
+            v.push((format!("ker {}L-{}S", r.large, r.small), Some(r.ker)));
+        }
+        v
+    };
+    let now_values = values(now);
+    let golden_values = golden.map(values);
+    now_values
+        .into_iter()
+        .enumerate()
+        .map(|(i, (metric, value))| {
+            let g = golden_values.as_ref().and_then(|gv| gv.get(i).filter(|(m, _)| *m == metric).map(|(_, v)| *v));
+            let (rel, abs) = tolerance(&now.model, &metric);
+            let (golden, ok, tol) = match (g, value) {
+                (None, _) => (None, false, abs),
+                (Some(None), None) => (None, true, abs),
+                (Some(Some(gv)), Some(v)) => {
+                    let tol = abs.max(rel * gv.abs());
+                    (Some(gv), (v - gv).abs() <= tol, tol)
+                }
+                (Some(gv), _) => (gv, false, abs),
+            };
+            Row { case: now.case.clone(), model: now.model.clone(), metric, golden, now: value, tolerance: tol, ok }
+        })
+        .collect()
+}
+
+/// Writes `g` as its golden file.
+pub fn write_golden(golden_dir: &Path, g: &Golden) -> Result<(), CheckError> {
+    let path = golden_path(golden_dir, &g.case, &g.model);
+    let bytes = serde_json::to_vec_pretty(g).expect("serialises");
+    crate::output::write_atomic(&path, &bytes).map_err(|e| CheckError::Io { path: path.display().to_string(), message: e.to_string() })
+}
