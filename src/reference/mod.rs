@@ -379,7 +379,9 @@ impl<'a> Solver<'a> {
         let mut a = from;
         loop {
             let b = self.seg.next_sign_change(a).min(limit);
-            let curvature = -s * self.seg.accel(0.5 * (a + b));
+            // The sign just after `a` holds over the whole piece; judged as `resolve` judges it,
+            // so that the two agree even where the acceleration is round-off (a frame at rest).
+            let curvature = -s * self.accel_ahead(a);
             let root = if curvature >= 0.0 {
                 self.convex_root(ball, s, k, a, b)
             } else {
@@ -821,6 +823,11 @@ impl<'a> Solver<'a> {
             if release {
                 self.release_at = f64::INFINITY;
                 self.frame_dirty = true;
+            }
+            if let Some(p) = pair {
+                // Searched again from now even if resolving changes nothing (a contact that
+                // turns out not to be one), or its cached time would fire forever.
+                self.dirty[p] = true;
             }
             self.resolve();
         }
