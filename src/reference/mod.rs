@@ -337,11 +337,13 @@ impl<'a> Solver<'a> {
         let (x, v) = self.seg.state(t);
         let o = &self.seg.osc;
         let a = o.accel(x, v);
-        if a.abs() > 1e-9 * (o.w0sq * x.abs() + 2.0 * o.sigma * v.abs()) {
+        // Scales of a and its derivative over the motion (w0 |v| matters where x passes 0).
+        let rate = 2.0 * o.sigma + o.w0sq.sqrt();
+        if a.abs() > 1e-9 * (o.w0sq * x.abs() + rate * v.abs()) {
             return a;
         }
         let jerk = -2.0 * o.sigma * a - o.w0sq * v;
-        let sign = if jerk.abs() > 1e-9 * (2.0 * o.sigma * a.abs() + o.w0sq * v.abs()) {
+        let sign = if jerk.abs() > 1e-9 * (rate * a.abs() + o.w0sq * v.abs()) {
             jerk.signum()
         } else {
             let snap = -2.0 * o.sigma * jerk - o.w0sq * a;
