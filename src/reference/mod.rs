@@ -118,11 +118,6 @@ impl Segment {
     fn state(&self, t: f64) -> (f64, f64) {
         self.osc.state(self.x0, self.v0, t - self.t0)
     }
-    #[inline]
-    fn accel(&self, t: f64) -> f64 {
-        let (x, v) = self.state(t);
-        self.osc.accel(x, v)
-    }
     /// Next time after `t` at which the frame's acceleration changes sign.
     fn next_sign_change(&self, t: f64) -> f64 {
         // A root just after `t` in segment time can round onto `t` in absolute time: take the
