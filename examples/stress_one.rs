@@ -1,11 +1,12 @@
-//! Runs one stress scene by seed and prints its time: `cargo run --release --example
-//! stress_one -- SEED [MAX_HORIZON] [MODEL]`; with `--toml` prints the scene file instead.
+//! Runs one stress scene (by seed, or a TOML file through the reference) and prints its time:
+//! `cargo run --release --example stress_one -- SEED [MAX_HORIZON] [MODEL]` (`--toml` prints
+//! the scene file instead) or `... -- scene.toml`.
 fn main() {
     let args: Vec<String> = std::env::args().collect();
     if args[1].ends_with(".toml") {
         let scene = lpc_damper::scene::load_scene(&args[1]).unwrap();
         let run = lpc_damper::reference::simulate(&scene).unwrap();
-        println!("events {} impacts {} held-time events/s {:.0}", run.events, run.impacts.len(), run.events as f64 / scene.horizon);
+        println!("events {} impacts {} events per simulated second {:.0}", run.events, run.impacts.len(), run.events as f64 / scene.horizon);
         return;
     }
     let seed: u64 = args[1].parse().unwrap();
