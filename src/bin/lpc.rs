@@ -478,6 +478,14 @@ fn cmd_bench(a: BenchArgs) -> Result<()> {
             return Err(SceneError::Invalid { file: "(command line)".into(), field: "--dt".into(), rule: format!("must be a step in (0, 0.1] s (got {dt})") }.into());
         }
     }
+    if let Some(&it) = a.solver_iterations.iter().find(|&&it| !(1..=1000).contains(&it)) {
+        return Err(SceneError::Invalid {
+            file: "(command line)".into(),
+            field: "--solver-iterations".into(),
+            rule: format!("must lie in 1..=1000 (got {it})"),
+        }
+        .into());
+    }
     let plan = lpc_damper::bench::Plan {
         models: a.models.clone(),
         steppings: a.stepping.clone(),
