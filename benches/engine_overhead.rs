@@ -5,7 +5,7 @@
 use bevy_rapier3d::rapier::prelude::*;
 use criterion::{criterion_group, criterion_main, BatchSize, Criterion};
 use lpc_damper::oscillator::Oscillator;
-use lpc_damper::rapier::plugin::{DamperStep, LENGTH_UNIT};
+use lpc_damper::rapier::plugin::{integration_parameters, DamperStep};
 use lpc_damper::rapier::{headless_app, Stepping, StepSettings};
 use lpc_damper::scene::{load_scene, scenes_dir, Scene};
 
@@ -88,15 +88,7 @@ fn bare(scene: &Scene) -> Bare {
         );
         balls.push(h);
     }
-    let speed = lpc_damper::rapier::plugin::speed_scale(scene) as f32;
-    let params = IntegrationParameters {
-        dt: DT as f32,
-        length_unit: LENGTH_UNIT,
-        num_solver_iterations: 4,
-        normalized_prediction_distance: (4.0 * speed * DT as f32).max(0.02 * LENGTH_UNIT) / LENGTH_UNIT,
-        normalized_max_linear_velocity: f32::MAX,
-        ..IntegrationParameters::default()
-    };
+    let params = integration_parameters(scene, StepSettings { stepping: Stepping::Fixed, dt: DT, solver_iterations: 4 });
     let wall_e = scene
         .balls
         .iter()

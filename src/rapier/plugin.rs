@@ -119,22 +119,9 @@ pub struct ContactPhysicsPlugin {
 
 impl Plugin for ContactPhysicsPlugin {
     fn build(&self, app: &mut App) {
-        let dt = self.settings.dt as f32;
-        // Contacts must be found before they close: at least twice the closing distance of one
-        // step at the fastest speed the scene can reach.
-        let speed = speed_scale(&self.scene) as f32;
-        let prediction = (4.0 * speed * dt).max(0.02 * LENGTH_UNIT);
-        let integration_parameters = IntegrationParameters {
-            dt,
-            length_unit: LENGTH_UNIT,
-            num_solver_iterations: self.settings.solver_iterations,
-            normalized_prediction_distance: prediction / LENGTH_UNIT,
-            // The default clamps every body at 400 length units per second (4 m/s here).
-            normalized_max_linear_velocity: f32::MAX,
-            ..IntegrationParameters::default()
-        };
+        let integration_parameters = integration_parameters(&self.scene, self.settings);
         let rapier_configuration = RapierConfiguration { gravity: Vec3::ZERO, ..RapierConfiguration::new(LENGTH_UNIT) };
-        app.insert_resource(TimestepMode::Fixed { dt, substeps: 1 })
+        app.insert_resource(TimestepMode::Fixed { dt: self.settings.dt as f32, substeps: 1 })
             .insert_resource(self.settings)
             .insert_resource(RestitutionConfig {
                 restitution: self.scene.restitution,
@@ -161,6 +148,26 @@ impl Plugin for ContactPhysicsPlugin {
                 )
                     .chain(),
             );
+    }
+}
+
+/// Rapier's integration parameters for `scene`: centimetre length unit, the solver
+/// iterations asked for, a prediction distance that sees contacts before they close, and no
+/// speed clamp.
+pub fn integration_parameters(scene: &Scene, settings: StepSettings) -> IntegrationParameters {
+    let dt = settings.dt as f32;
+    // Contacts must be found before they close: at least twice the closing distance of one
+    // step at the fastest speed the scene can reach.
+    let speed = speed_scale(scene) as f32;
+    let prediction = (4.0 * speed * dt).max(0.02 * LENGTH_UNIT);
+    IntegrationParameters {
+        dt,
+        length_unit: LENGTH_UNIT,
+        num_solver_iterations: settings.solver_iterations,
+        normalized_prediction_distance: prediction / LENGTH_UNIT,
+        // The default clamps every body at 400 length units per second (4 m/s here).
+        normalized_max_linear_velocity: f32::MAX,
+        ..IntegrationParameters::default()
     }
 }
 
