@@ -110,7 +110,7 @@ pub fn collect(world: &mut World, scene: &Scene, steps: u64) -> Run {
     let frame = world.get_resource::<plugin::FrameState>().copied();
     let (xs, vs) = frame.map_or((0.0, 0.0), |f| f.now);
     let f = scene.frame;
-    let final_ = f.map_or(0.0, |f| 0.5 * f.mass * vs * vs + 0.5 * f.stiffness * xs * xs)
+    let final_ = f.map_or(0.0, |f| f.energy(xs, vs))
         + scene.balls.iter().zip(&rec.v).map(|(b, v)| 0.5 * b.mass * v * v).sum::<f64>();
     let energy = EnergyAccount::new(
         scene.initial_energy(),

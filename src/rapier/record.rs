@@ -310,7 +310,7 @@ pub fn record_samples(
     let t0 = t1 - dt;
     let rec: &mut Recording = &mut rec;
     let f = scene.frame;
-    let accel = |x: f64, v: f64| f.map_or(0.0, |f| -(f.damping * v + f.stiffness * x) / f.mass);
+    let accel = |x: f64, v: f64| f.map_or(0.0, |f| f.acceleration(x, v));
     while rec.next_sample < rec.sample_count {
         let k = rec.next_sample;
         let ts = k as f64 * scene.sample_dt;

@@ -749,7 +749,7 @@ impl<'a> Solver<'a> {
             s.t.push(ts);
             s.xs.push(xs);
             s.vs.push(vs);
-            s.a.push(if has_frame { -(self.damping * vs + self.stiffness * xs) / self.frame_mass } else { 0.0 });
+            s.a.push(self.scene.frame.map_or(0.0, |f| f.acceleration(xs, vs)));
             for i in 0..self.n {
                 let (x, v) = match self.hold[i] {
                     Hold::Free => (self.x[i] + self.v[i] * (ts - self.t), self.v[i]),
@@ -835,7 +835,7 @@ impl<'a> Solver<'a> {
 
     fn mechanical_energy(&self) -> f64 {
         let (xs, vs) = if self.has_frame() { self.seg.state(self.t) } else { (0.0, 0.0) };
-        let frame = if self.has_frame() { 0.5 * self.frame_mass * vs * vs + 0.5 * self.stiffness * xs * xs } else { 0.0 };
+        let frame = self.scene.frame.map_or(0.0, |f| f.energy(xs, vs));
         frame
             + (0..self.n)
                 .map(|i| {

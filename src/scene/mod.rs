@@ -67,6 +67,15 @@ impl Frame {
         let wd2 = w0sq - sigma * sigma;
         (wd2 > 0.0).then(|| wd2.sqrt())
     }
+    /// The frame's acceleration without impulses and contact forces, `-(cs vs + ks xs)/ms`
+    /// (MODEL.md §4, free vibration), as every model reports it.
+    pub fn acceleration(&self, xs: f64, vs: f64) -> f64 {
+        -(self.damping * vs + self.stiffness * xs) / self.mass
+    }
+    /// The frame's kinetic plus spring energy.
+    pub fn energy(&self, xs: f64, vs: f64) -> f64 {
+        0.5 * self.mass * vs * vs + 0.5 * self.stiffness * xs * xs
+    }
     /// `T = 2 pi / omega_d`, or 0 when the bare frame does not oscillate.
     pub fn damped_period(&self) -> f64 {
         self.damped_omega().map_or(0.0, |w| 2.0 * PI / w)
@@ -154,7 +163,7 @@ pub fn ball_radius(mass: f64, density: f64) -> f64 {
 impl Scene {
     /// Initial mechanical energy: spring energy plus balls' kinetic energy.
     pub fn initial_energy(&self) -> f64 {
-        let spring = self.frame.map_or(0.0, |f| 0.5 * f.stiffness * self.initial_displacement.powi(2));
+        let spring = self.frame.map_or(0.0, |f| f.energy(self.initial_displacement, 0.0));
         spring
             + self
                 .balls
