@@ -6,7 +6,7 @@ use bevy_rapier3d::rapier::prelude::*;
 use criterion::{criterion_group, criterion_main, BatchSize, Criterion};
 use lpc_damper::oscillator::Oscillator;
 use lpc_damper::rapier::plugin::{integration_parameters, DamperStep};
-use lpc_damper::rapier::{headless_app, Stepping, StepSettings};
+use lpc_damper::rapier::{headless_app, StepSettings};
 use lpc_damper::scene::{load_scene, scenes_dir, Scene};
 
 const STEPS: usize = 2000;
@@ -88,7 +88,7 @@ fn bare(scene: &Scene) -> Bare {
         );
         balls.push(h);
     }
-    let params = integration_parameters(scene, StepSettings { stepping: Stepping::Fixed, dt: DT, solver_iterations: 4 });
+    let params = integration_parameters(scene, StepSettings::fixed(DT, 4));
     let wall_e = scene
         .balls
         .iter()
@@ -159,7 +159,7 @@ fn overhead(c: &mut Criterion) {
             BatchSize::LargeInput,
         )
     });
-    let settings = StepSettings { stepping: Stepping::Fixed, dt: DT, solver_iterations: 4 };
+    let settings = StepSettings::fixed(DT, 4);
     group.bench_function("bevy plug-in, lean step schedule (headless default)", |b| {
         b.iter_batched(
             || {

@@ -29,6 +29,7 @@ pub mod rapier;
 pub mod reference;
 pub mod run;
 pub mod scene;
+pub mod stability;
 pub mod stress;
 pub mod sweep;
 

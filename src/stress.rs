@@ -118,7 +118,8 @@ fn refused_run(scene: &Scene) -> Run {
     }
 }
 
-fn check(model: Model, scene: &Scene, run: &Run) -> Result<(), Failure> {
+/// The checks of a run of `model` on `scene` (see the module docs).
+pub fn check(model: Model, scene: &Scene, run: &Run) -> Result<(), Failure> {
     let fail = |check, detail: String| Err(Failure { check, detail });
     let s = &run.series;
     let finite = |v: &[f64]| v.iter().all(|x| x.is_finite());

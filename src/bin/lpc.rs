@@ -41,6 +41,15 @@ enum Command {
     Stress(StressArgs),
     /// Headless regression runs: every scene with every model against tests/golden/.
     Check(CheckArgs),
+    /// The contact model's stability map: step size x impact speed, with and without CCD.
+    Stability(StabilityArgs),
+}
+
+#[derive(clap::Args)]
+struct StabilityArgs {
+    /// Output format on standard output.
+    #[arg(long, value_enum, default_value_t = Format::Text)]
+    format: Format,
 }
 
 #[derive(clap::Args)]
@@ -182,6 +191,9 @@ struct RapierArgs {
     /// Rapier model: solver iterations per step (overrides the scene's).
     #[arg(long)]
     solver_iterations: Option<u32>,
+    /// Rapier model: turn on Rapier's swept CCD for the balls.
+    #[arg(long)]
+    ccd: bool,
 }
 
 impl RapierArgs {
@@ -201,6 +213,9 @@ impl RapierArgs {
                 return Err(invalid("--solver-iterations", format!("must lie in 1..=1000 (got {it})")));
             }
             scene.rapier.solver_iterations = Some(it);
+        }
+        if self.ccd {
+            scene.rapier.ccd = Some(true);
         }
         Ok(())
     }
@@ -249,6 +264,7 @@ fn main() -> ExitCode {
         Command::Compare(a) => cmd_compare(a),
         Command::Bench(a) => cmd_bench(a),
         Command::Stress(a) => cmd_stress(a),
+        Command::Stability(a) => cmd_stability(a),
         Command::Check(a) => return cmd_check(a),
     };
     match result {
@@ -612,6 +628,39 @@ fn cmd_stress(a: StressArgs) -> Result<()> {
     } else {
         Err(anyhow::anyhow!("{} of {} stressed runs failed", failures.len(), outcomes.len()))
     }
+}
+
+fn cmd_stability(a: StabilityArgs) -> Result<()> {
+    use lpc_damper::stability::{self, Case, CONFIGS, DTS, SPEEDS};
+    let cells = stability::map();
+    match a.format {
+        Format::Json => print_json(&cells)?,
+        Format::Text => {
+            println!("outcome per impact speed (rows, m/s) and step (columns, s); energy error vs the reference in %");
+            for case in Case::ALL {
+                for config in CONFIGS {
+                    println!("\n{} / {}", case.name(), config.name);
+                    print!("{:>8}", "u \\ dt");
+                    for dt in DTS {
+                        print!(" {:>22}", format!("{dt:e}"));
+                    }
+                    println!();
+                    for speed in SPEEDS {
+                        print!("{speed:>8}");
+                        for dt in DTS {
+                            let c = cells
+                                .iter()
+                                .find(|c| c.case == case && c.config == config.name && c.dt == dt && c.speed == speed)
+                                .expect("cell");
+                            print!(" {:>22}", format!("{} {:+.1}", c.outcome, 100.0 * c.energy_error));
+                        }
+                        println!();
+                    }
+                }
+            }
+        }
+    }
+    Ok(())
 }
 
 /// Exit status of `lpc check` when a value left its tolerance.

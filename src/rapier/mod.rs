@@ -51,6 +51,8 @@ pub fn settings(scene: &Scene) -> StepSettings {
         stepping: scene.rapier.stepping.unwrap_or(DEFAULT_STEPPING),
         dt: dt.min(period_bound),
         solver_iterations: scene.rapier.solver_iterations.map_or(DEFAULT_SOLVER_ITERATIONS, |i| i as usize),
+        ccd: scene.rapier.ccd.unwrap_or(false),
+        speculative_margin: true,
     }
 }
 
@@ -87,9 +89,13 @@ pub fn headless_app(scene: &Scene, settings: StepSettings) -> App {
 
 /// Runs the contact model on `scene`.
 pub fn simulate(scene: &Scene) -> Result<Run, ModelError> {
+    simulate_with(scene, settings(scene))
+}
+
+/// Runs the contact model on `scene` with `settings` as given (no step bound applied).
+pub fn simulate_with(scene: &Scene, settings: StepSettings) -> Result<Run, ModelError> {
     check(scene)?;
     let start = Instant::now();
-    let settings = settings(scene);
     let mut app = headless_app(scene, settings);
     // The first update spawns the scene, lets bevy_rapier create its bodies and takes the
     // first step; the rest run the lean step schedule alone.

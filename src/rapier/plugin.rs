@@ -25,6 +25,19 @@ pub struct StepSettings {
     pub dt: f64,
     /// Rapier solver iterations per step.
     pub solver_iterations: usize,
+    /// Rapier's swept CCD on the balls.
+    pub ccd: bool,
+    /// Contacts are predicted as far ahead as the scene's speed scale carries a ball in two
+    /// steps (the plug-in's choice), rather than Rapier's fixed 0.02 length units (only the
+    /// stability map turns this off, to show why it is needed).
+    pub speculative_margin: bool,
+}
+
+impl StepSettings {
+    /// Fixed steps of `dt` with the plug-in's other defaults.
+    pub fn fixed(dt: f64, solver_iterations: usize) -> Self {
+        StepSettings { stepping: Stepping::Fixed, dt, solver_iterations, ccd: false, speculative_margin: true }
+    }
 }
 
 /// The scene being simulated.
@@ -159,7 +172,7 @@ pub fn integration_parameters(scene: &Scene, settings: StepSettings) -> Integrat
     // Contacts must be found before they close: at least twice the closing distance of one
     // step at the fastest speed the scene can reach.
     let speed = speed_scale(scene) as f32;
-    let prediction = (4.0 * speed * dt).max(0.02 * LENGTH_UNIT);
+    let prediction = if settings.speculative_margin { (4.0 * speed * dt).max(0.02 * LENGTH_UNIT) } else { 0.02 * LENGTH_UNIT };
     IntegrationParameters {
         dt,
         length_unit: LENGTH_UNIT,
@@ -190,7 +203,7 @@ impl Plugin for SceneSpawnPlugin {
     }
 }
 
-fn spawn_scene(mut commands: Commands, scene: Res<DamperScene>) {
+fn spawn_scene(mut commands: Commands, scene: Res<DamperScene>, settings: Res<StepSettings>) {
     let scene = &scene.0;
     let mut bodies = Bodies::default();
     let r_max = scene.balls.iter().map(|b| b.radius).fold(0.0, f64::max) as f32;
@@ -241,6 +254,9 @@ fn spawn_scene(mut commands: Commands, scene: Res<DamperScene>) {
                 ActiveHooks::MODIFY_SOLVER_CONTACTS,
             ))
             .id();
+        if settings.ccd {
+            commands.entity(id).insert(Ccd::enabled());
+        }
         bodies.balls.push(id);
     }
     commands.insert_resource(bodies);

@@ -105,6 +105,9 @@ pub struct RapierFile {
     pub dt: Option<f64>,
     /// Solver iterations per step.
     pub solver_iterations: Option<u32>,
+    /// Rapier's swept continuous collision detection on the balls (off by default: the
+    /// plug-in's speculative margin already finds every contact, see docs/BENCHMARKS.md).
+    pub ccd: Option<bool>,
 }
 
 /// `[sweep]`: one parameter and its values.

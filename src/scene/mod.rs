@@ -124,6 +124,8 @@ pub struct RapierSettings {
     pub dt: Option<f64>,
     /// Solver iterations.
     pub solver_iterations: Option<u32>,
+    /// Rapier's swept CCD on the balls.
+    pub ccd: Option<bool>,
 }
 
 /// A validated system: what every model simulates.
@@ -489,7 +491,7 @@ fn rapier_settings(r: &format::RapierFile, v: &Validator) -> Result<RapierSettin
             return Err(v.err("rapier.solver_iterations", &format!("must lie in 1..=1000 (got {it})")));
         }
     }
-    Ok(RapierSettings { stepping: r.stepping, dt: r.dt, solver_iterations: r.solver_iterations })
+    Ok(RapierSettings { stepping: r.stepping, dt: r.dt, solver_iterations: r.solver_iterations, ccd: r.ccd })
 }
 
 fn arrangement_balls(
