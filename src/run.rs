@@ -117,3 +117,24 @@ pub struct Run {
     /// Computing time, s.
     pub wall_time_s: f64,
 }
+
+impl Run {
+    /// A run of nothing: no samples, no impacts, no energy (a stand-in for a refused scene,
+    /// or a shell to hold a series read back from a file).
+    pub fn empty(scene: &str, model: &str) -> Self {
+        Run {
+            scene: scene.into(),
+            model: model.into(),
+            horizon: 0.0,
+            sample_dt: 0.0,
+            initial_displacement: 0.0,
+            damped_period: 0.0,
+            series: Series::default(),
+            impacts: vec![],
+            energy: EnergyAccount::default(),
+            events: 0,
+            final_velocities: vec![],
+            wall_time_s: 0.0,
+        }
+    }
+}

@@ -102,20 +102,7 @@ pub fn check_run(model: Model, scene: &Scene) -> Result<Run, Failure> {
 
 /// A stand-in for a scene the model refuses with a reason (that is a correct answer).
 fn refused_run(scene: &Scene) -> Run {
-    Run {
-        scene: scene.name.clone(),
-        model: "refused".into(),
-        horizon: 0.0,
-        sample_dt: scene.sample_dt,
-        initial_displacement: scene.initial_displacement,
-        damped_period: 0.0,
-        series: Default::default(),
-        impacts: vec![],
-        energy: Default::default(),
-        events: 0,
-        final_velocities: vec![],
-        wall_time_s: 0.0,
-    }
+    Run { sample_dt: scene.sample_dt, initial_displacement: scene.initial_displacement, ..Run::empty(&scene.name, "refused") }
 }
 
 /// The checks of a run of `model` on `scene` (see the module docs).

@@ -43,6 +43,36 @@ enum Command {
     Check(CheckArgs),
     /// The contact model's stability map: step size x impact speed, with and without CCD.
     Stability(StabilityArgs),
+    /// The paper's figures (PNG and SVG) from a scene, a run directory or a compare directory.
+    Plot(PlotArgs),
+}
+
+#[derive(clap::Args)]
+struct PlotArgs {
+    /// A scene file (damper: Figs. 8-12; [sweep]: Figs. 13-16; [chain]: Fig. 5), a directory
+    /// written by `lpc run --out` (its series), or one written by `lpc compare --out` (overlay).
+    input: PathBuf,
+    /// Directory for the figures.
+    #[arg(long)]
+    out: PathBuf,
+    /// Model that runs a scene.
+    #[arg(long, default_value = "reference")]
+    model: Model,
+    /// Figure size in pixels, WIDTHxHEIGHT.
+    #[arg(long, default_value = "1000x640", value_parser = parse_size)]
+    size: (u32, u32),
+    #[command(flatten)]
+    rapier: RapierArgs,
+}
+
+fn parse_size(s: &str) -> Result<(u32, u32), String> {
+    let bad = || format!("`{s}` is not a size WIDTHxHEIGHT between 100x100 and 8000x8000");
+    let (w, h) = s.split_once(['x', 'X']).ok_or_else(bad)?;
+    let (w, h): (u32, u32) = (w.trim().parse().map_err(|_| bad())?, h.trim().parse().map_err(|_| bad())?);
+    if !(100..=8000).contains(&w) || !(100..=8000).contains(&h) {
+        return Err(bad());
+    }
+    Ok((w, h))
 }
 
 #[derive(clap::Args)]
@@ -265,6 +295,7 @@ fn main() -> ExitCode {
         Command::Bench(a) => cmd_bench(a),
         Command::Stress(a) => cmd_stress(a),
         Command::Stability(a) => cmd_stability(a),
+        Command::Plot(a) => cmd_plot(a),
         Command::Check(a) => return cmd_check(a),
     };
     match result {
@@ -628,6 +659,85 @@ fn cmd_stress(a: StressArgs) -> Result<()> {
     } else {
         Err(anyhow::anyhow!("{} of {} stressed runs failed", failures.len(), outcomes.len()))
     }
+}
+
+fn cmd_plot(a: PlotArgs) -> Result<()> {
+    use lpc_damper::output::figures::{self, Figure};
+    let mut figs: Vec<Figure> = vec![];
+    if a.input.is_dir() {
+        let series = |dir: &Path| dir.join("series.csv");
+        let name_of = |dir: &Path, key: &str| -> Option<String> {
+            let text = std::fs::read(dir.join("summary.json")).ok()?;
+            let v: serde_json::Value = serde_json::from_slice(&text).ok()?;
+            v.get(key)?.as_str().map(str::to_string)
+        };
+        if series(&a.input).is_file() {
+            let s = figures::read_series_csv(&series(&a.input))?;
+            let mut run = lpc_damper::run::Run::empty(
+                &name_of(&a.input, "scene").unwrap_or_else(|| "run".into()),
+                &name_of(&a.input, "model").unwrap_or_else(|| "model".into()),
+            );
+            run.series = s;
+            figs.extend(figures::time_histories(&run, None));
+            figs.push(figures::ball_positions(&run, None));
+        } else {
+            let mut models = vec![];
+            let mut entries: Vec<PathBuf> =
+                std::fs::read_dir(&a.input)?.filter_map(|e| e.ok().map(|e| e.path())).filter(|p| series(p).is_file()).collect();
+            entries.sort();
+            for dir in entries {
+                let name = dir.file_name().map_or("model".into(), |n| n.to_string_lossy().into_owned());
+                models.push((name, figures::read_series_csv(&series(&dir))?));
+            }
+            if models.is_empty() {
+                return Err(SceneError::Invalid {
+                    file: a.input.display().to_string(),
+                    field: "input".into(),
+                    rule: "holds no series.csv (expected a directory of `lpc run --out` or `lpc compare --out`)".into(),
+                }
+                .into());
+            }
+            let scene_name = name_of(&a.input.join(&models[0].0), "scene").unwrap_or_default();
+            figs.push(figures::overlay(&models, &scene_name));
+        }
+    } else {
+        let loaded = scene::load(&a.input)?;
+        if let Some(mut cases) = loaded.chain.clone() {
+            for c in &mut cases {
+                a.rapier.apply(&mut c.scene, &a.input)?;
+            }
+            figs.push(figures::ker_chart(&run_chain(&cases, a.model)?, a.model.name()));
+        } else if loaded.file.sweep.is_some() {
+            use rayon::prelude::*;
+            let mut scenes = lpc_damper::sweep::sweep_scenes(&loaded)?;
+            for (_, s) in &mut scenes {
+                a.rapier.apply(s, &a.input)?;
+            }
+            let parameter = loaded.file.sweep.as_ref().map_or(String::new(), |s| s.parameter.clone());
+            let values: Vec<String> = loaded.file.sweep.as_ref().map_or(vec![], |s| s.values.iter().map(|v| v.to_string()).collect());
+            let runs = scenes
+                .par_iter()
+                .zip(values)
+                .map(|((_, s), label)| Ok((label, a.model.simulate(s)?)))
+                .collect::<Result<Vec<_>, lpc_damper::model::ModelError>>()?;
+            figs.push(figures::sweep_curves(&parameter, &runs));
+        } else {
+            let mut s = loaded.scene.clone().expect("a scene file without [chain] has [frame]");
+            a.rapier.apply(&mut s, &a.input)?;
+            let run = a.model.simulate(&s)?;
+            let bare = lpc_damper::reference::simulate(&s.without_damper())?;
+            figs.extend(figures::time_histories(&run, (!s.balls.is_empty()).then_some(&bare)));
+            if !s.balls.is_empty() {
+                figs.push(figures::ball_positions(&run, s.container.map(|c| c.length)));
+            }
+        }
+    }
+    for f in &figs {
+        for p in figures::write(f, &a.out, a.size)? {
+            println!("{}", p.display());
+        }
+    }
+    Ok(())
 }
 
 fn cmd_stability(a: StabilityArgs) -> Result<()> {

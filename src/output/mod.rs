@@ -1,6 +1,7 @@
 //! Output of runs: the JSON contract ([`RunSummary`]), a readable text summary, and the files
 //! of `--out DIR` (`series.csv`, `impacts.csv`, `summary.json`), each written atomically.
 
+pub mod figures;
 pub mod files;
 pub mod plot;
 

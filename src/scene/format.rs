@@ -197,6 +197,15 @@ fn parse_rr(s: &str) -> Option<Length> {
     Some(Length::Rr(k))
 }
 
+impl std::fmt::Display for Length {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            Length::Metres(m) => write!(f, "{m} m"),
+            Length::Rr(k) => write!(f, "{k} Rr"),
+        }
+    }
+}
+
 impl Length {
     /// The length in metres for reference radius `rr`.
     pub fn metres(self, rr: f64) -> f64 {

@@ -175,6 +175,19 @@ impl Scene {
                 .sum::<f64>()
     }
 
+    /// The same frame without its damper: no container, no balls (the paper's "without
+    /// damper" curves of Figs. 8-11).
+    pub fn without_damper(&self) -> Scene {
+        Scene {
+            name: format!("{} without damper", self.name),
+            container: None,
+            balls: vec![],
+            initial_positions: vec![],
+            initial_velocities: vec![],
+            ..self.clone()
+        }
+    }
+
     /// Names of bodies in outputs: `left-wall`, `right-wall`, `ball1`..`ballN`.
     pub fn body_name(body: Body) -> String {
         match body {

@@ -1,0 +1,290 @@
+//! The paper's figures as PNG and SVG (plotters): time histories with and without the damper
+//! (Figs. 8-11), ball positions inside the moving container (Fig. 12), a sweep's curves
+//! (Figs. 13-16), the KER chart (Fig. 5) and an overlay of models. Every figure is written
+//! twice, `NAME.png` and `NAME.svg`, of the same size.
+
+use std::path::{Path, PathBuf};
+use std::sync::Once;
+
+use plotters::coord::Shift;
+use plotters::prelude::*;
+
+use crate::chain::KerRow;
+use crate::run::{Run, Series};
+
+/// The font every bitmap figure is drawn with (DejaVu Sans, bundled so that figures look the
+/// same on every machine and need no system font library). SVG files name `sans-serif`.
+const FONT: &[u8] = include_bytes!("../../assets/fonts/DejaVuSans.ttf");
+
+/// A figure could not be drawn or written.
+#[derive(Debug, thiserror::Error)]
+#[error("figure {path}: {reason}")]
+pub struct FigureError {
+    /// The file being written.
+    pub path: String,
+    /// What went wrong.
+    pub reason: String,
+}
+
+/// One curve of a figure.
+#[derive(Debug, Clone)]
+pub struct Curve {
+    /// Legend entry.
+    pub label: String,
+    /// Abscissae.
+    pub x: Vec<f64>,
+    /// Ordinates.
+    pub y: Vec<f64>,
+}
+
+/// One figure: axes, titles and curves.
+#[derive(Debug, Clone)]
+pub struct Figure {
+    /// File stem (`displacement` gives `displacement.png` and `displacement.svg`).
+    pub name: String,
+    /// Caption.
+    pub title: String,
+    /// Abscissa label.
+    pub x_desc: String,
+    /// Ordinate label.
+    pub y_desc: String,
+    /// Curves, drawn in order.
+    pub curves: Vec<Curve>,
+    /// Mark each point (for charts of few points).
+    pub points: bool,
+}
+
+fn register_font() {
+    static ONCE: Once = Once::new();
+    ONCE.call_once(|| {
+        for style in [FontStyle::Normal, FontStyle::Bold] {
+            let registered = plotters::style::register_font("sans-serif", style, FONT);
+            assert!(registered.is_ok(), "the bundled font is a valid TrueType font");
+        }
+    });
+}
+
+/// Writes `figure` as PNG and SVG of `size` (width, height) into `dir`; returns the paths.
+pub fn write(figure: &Figure, dir: &Path, size: (u32, u32)) -> Result<Vec<PathBuf>, FigureError> {
+    register_font();
+    std::fs::create_dir_all(dir)
+        .map_err(|e| FigureError { path: dir.display().to_string(), reason: e.to_string() })?;
+    let mut written = vec![];
+    for ext in ["png", "svg"] {
+        let path = dir.join(format!("{}.{ext}", figure.name));
+        // Drawn beside the target and renamed, so an interrupted run leaves no half figure.
+        let tmp = dir.join(format!(".{}.tmp.{ext}", figure.name));
+        let fail = |reason: String| FigureError { path: path.display().to_string(), reason };
+        let drawn = if ext == "png" {
+            draw(BitMapBackend::new(&tmp, size).into_drawing_area(), figure)
+        } else {
+            draw(SVGBackend::new(&tmp, size).into_drawing_area(), figure)
+        };
+        drawn.map_err(fail)?;
+        std::fs::rename(&tmp, &path).map_err(|e| fail(e.to_string()))?;
+        written.push(path);
+    }
+    Ok(written)
+}
+
+fn draw<DB: DrawingBackend>(root: DrawingArea<DB, Shift>, f: &Figure) -> Result<(), String> {
+    let err = |e: DrawingAreaErrorKind<DB::ErrorType>| e.to_string();
+    root.fill(&WHITE).map_err(err)?;
+    let finite = |v: &f64| v.is_finite();
+    let xs = f.curves.iter().flat_map(|c| c.x.iter().copied()).filter(finite);
+    let ys = f.curves.iter().flat_map(|c| c.y.iter().copied()).filter(finite);
+    let (x0, x1) = padded(xs, 0.0);
+    let (y0, y1) = padded(ys, 0.05);
+    let (w, h) = root.dim_in_pixel();
+    let text = (h / 40).clamp(10, 22);
+    let mut chart = ChartBuilder::on(&root)
+        .caption(&f.title, ("sans-serif", text + 4))
+        .margin(text)
+        .x_label_area_size(text * 3)
+        .y_label_area_size((w / 12).clamp(40, 90))
+        .build_cartesian_2d(x0..x1, y0..y1)
+        .map_err(err)?;
+    chart
+        .configure_mesh()
+        .x_desc(&f.x_desc)
+        .y_desc(&f.y_desc)
+        .label_style(("sans-serif", text))
+        .light_line_style(WHITE.mix(0.0))
+        .draw()
+        .map_err(err)?;
+    for (k, c) in f.curves.iter().enumerate() {
+        let color = Palette99::pick(k).to_rgba();
+        let pts: Vec<(f64, f64)> = c.x.iter().copied().zip(c.y.iter().copied()).filter(|p| p.0.is_finite() && p.1.is_finite()).collect();
+        chart
+            .draw_series(LineSeries::new(pts.clone(), color.stroke_width(2)))
+            .map_err(err)?
+            .label(c.label.clone())
+            .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 18, y)], color.stroke_width(2)));
+        if f.points {
+            chart.draw_series(pts.iter().map(|&p| Circle::new(p, 4, color.filled()))).map_err(err)?;
+        }
+    }
+    chart
+        .configure_series_labels()
+        .position(SeriesLabelPosition::UpperRight)
+        .label_font(("sans-serif", text))
+        .background_style(WHITE.mix(0.85))
+        .border_style(BLACK)
+        .draw()
+        .map_err(err)?;
+    root.present().map_err(|e| e.to_string())
+}
+
+/// The range of `values`, widened by `pad` of its span (and never empty).
+fn padded(values: impl Iterator<Item = f64>, pad: f64) -> (f64, f64) {
+    let (lo, hi) = values.fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), v| (a.min(v), b.max(v)));
+    if !lo.is_finite() {
+        return (0.0, 1.0);
+    }
+    let span = hi - lo;
+    if span <= 1e-12 * lo.abs().max(1e-300) {
+        let d = if lo == 0.0 { 1.0 } else { 0.1 * lo.abs() };
+        return (lo - d, hi + d);
+    }
+    (lo - pad * span, hi + pad * span)
+}
+
+fn scaled(v: &[f64], k: f64) -> Vec<f64> {
+    v.iter().map(|x| x * k).collect()
+}
+
+/// Figs. 8-11: frame displacement and acceleration against time, with the damper (`with`) and,
+/// when given, without it (the bare frame).
+pub fn time_histories(with: &Run, without: Option<&Run>) -> Vec<Figure> {
+    let label = |r: &Run, what: &str| format!("{what} ({})", r.model);
+    let mut disp = vec![Curve { label: label(with, "with damper"), x: with.series.t.clone(), y: scaled(&with.series.xs, 1e3) }];
+    let mut acc = vec![Curve { label: label(with, "with damper"), x: with.series.t.clone(), y: with.series.a.clone() }];
+    if let Some(w) = without {
+        disp.insert(0, Curve { label: "without damper".into(), x: w.series.t.clone(), y: scaled(&w.series.xs, 1e3) });
+        acc.insert(0, Curve { label: "without damper".into(), x: w.series.t.clone(), y: w.series.a.clone() });
+    }
+    vec![
+        Figure {
+            name: "displacement".into(),
+            title: format!("{}: frame displacement", with.scene),
+            x_desc: "t (s)".into(),
+            y_desc: "xs (mm)".into(),
+            curves: disp,
+            points: false,
+        },
+        Figure {
+            name: "acceleration".into(),
+            title: format!("{}: frame acceleration", with.scene),
+            x_desc: "t (s)".into(),
+            y_desc: "a (m/s^2)".into(),
+            curves: acc,
+            points: false,
+        },
+    ]
+}
+
+/// Fig. 12: each ball's centre relative to the container's left wall, with the walls' inner
+/// faces when the container length is known.
+pub fn ball_positions(run: &Run, container_length: Option<f64>) -> Figure {
+    let s = &run.series;
+    let mut curves: Vec<Curve> = (0..s.x.len())
+        .map(|i| Curve {
+            label: format!("ball{}", i + 1),
+            x: s.t.clone(),
+            y: s.x[i].iter().zip(&s.xs).map(|(x, xs)| (x - xs) * 1e3).collect(),
+        })
+        .collect();
+    if let Some(l) = container_length {
+        let ends = vec![s.t.first().copied().unwrap_or(0.0), s.t.last().copied().unwrap_or(0.0)];
+        curves.push(Curve { label: "left wall".into(), x: ends.clone(), y: vec![0.0, 0.0] });
+        curves.push(Curve { label: "right wall".into(), x: ends, y: vec![l * 1e3, l * 1e3] });
+    }
+    Figure {
+        name: "positions".into(),
+        title: format!("{}: ball centres in the container ({})", run.scene, run.model),
+        x_desc: "t (s)".into(),
+        y_desc: "x - xs (mm)".into(),
+        curves,
+        points: false,
+    }
+}
+
+/// Figs. 13-16: the frame displacement for each value of a swept parameter.
+pub fn sweep_curves(parameter: &str, runs: &[(String, Run)]) -> Figure {
+    let scene = runs.first().map_or(String::new(), |r| r.1.scene.clone());
+    Figure {
+        name: "sweep".into(),
+        title: format!("{scene}: frame displacement for each {parameter}"),
+        x_desc: "t (s)".into(),
+        y_desc: "xs (mm)".into(),
+        curves: runs
+            .iter()
+            .map(|(value, r)| Curve { label: format!("{parameter} = {value}"), x: r.series.t.clone(), y: scaled(&r.series.xs, 1e3) })
+            .collect(),
+        points: false,
+    }
+}
+
+/// Fig. 5: kinetic energy ratio against the number of large balls, with and without small
+/// balls between them.
+pub fn ker_chart(rows: &[KerRow], model: &str) -> Figure {
+    let curve = |with_small: bool, label: &str| {
+        let sel: Vec<&KerRow> = rows.iter().filter(|r| (r.small > 0) == with_small).collect();
+        Curve { label: label.into(), x: sel.iter().map(|r| r.large as f64).collect(), y: sel.iter().map(|r| r.ker).collect() }
+    };
+    Figure {
+        name: "ker".into(),
+        title: format!("Chain experiment: kinetic energy ratio ({model})"),
+        x_desc: "large balls N_L".into(),
+        y_desc: "KER".into(),
+        curves: [curve(false, "large balls only"), curve(true, "small ball between each two")]
+            .into_iter()
+            .filter(|c| !c.x.is_empty())
+            .collect(),
+        points: true,
+    }
+}
+
+/// The models' frame displacements over each other (from `lpc compare --out`).
+pub fn overlay(runs: &[(String, Series)], scene: &str) -> Figure {
+    Figure {
+        name: "overlay".into(),
+        title: format!("{scene}: frame displacement, every model"),
+        x_desc: "t (s)".into(),
+        y_desc: "xs (mm)".into(),
+        curves: runs.iter().map(|(m, s)| Curve { label: m.clone(), x: s.t.clone(), y: scaled(&s.xs, 1e3) }).collect(),
+        points: false,
+    }
+}
+
+/// Reads a `series.csv` written by [`super::files::series_csv`].
+pub fn read_series_csv(path: &Path) -> Result<Series, FigureError> {
+    let fail = |reason: String| FigureError { path: path.display().to_string(), reason };
+    let mut r = csv::Reader::from_path(path).map_err(|e| fail(e.to_string()))?;
+    let header = r.headers().map_err(|e| fail(e.to_string()))?.clone();
+    let cols = header.len();
+    if cols < 4 || &header[0] != "t" || &header[1] != "xs" || (cols - 4) % 2 != 0 {
+        return Err(fail("is not a series.csv (expected columns t, xs, vs, a, x1, v1, ...)".into()));
+    }
+    let balls = (cols - 4) / 2;
+    let mut s = Series::with_capacity(balls, 0);
+    s.x = vec![vec![]; balls];
+    s.v = vec![vec![]; balls];
+    for (line, rec) in r.records().enumerate() {
+        let rec = rec.map_err(|e| fail(e.to_string()))?;
+        let num = |k: usize| -> Result<f64, FigureError> {
+            rec.get(k)
+                .and_then(|v| v.parse::<f64>().ok())
+                .ok_or_else(|| fail(format!("row {}: column `{}` is not a number", line + 2, &header[k])))
+        };
+        s.t.push(num(0)?);
+        s.xs.push(num(1)?);
+        s.vs.push(num(2)?);
+        s.a.push(num(3)?);
+        for i in 0..balls {
+            s.x[i].push(num(4 + 2 * i)?);
+            s.v[i].push(num(5 + 2 * i)?);
+        }
+    }
+    Ok(s)
+}
