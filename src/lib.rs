@@ -26,6 +26,8 @@ pub mod model;
 pub mod oscillator;
 pub mod output;
 pub mod rapier;
+#[cfg(feature = "render")]
+pub mod render;
 pub mod reference;
 pub mod run;
 pub mod scene;

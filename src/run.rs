@@ -118,6 +118,14 @@ pub struct Run {
     pub wall_time_s: f64,
 }
 
+/// A sampling step for a run to be shown at `fps` frames per second, and the samples per
+/// frame: the largest step no longer than `sample_dt` that divides `1 / fps`, so that every
+/// frame falls on a sample.
+pub fn frame_sampling(fps: f64, sample_dt: f64) -> (f64, usize) {
+    let per_frame = (1.0 / (fps * sample_dt)).ceil().max(1.0) as usize;
+    (1.0 / (fps * per_frame as f64), per_frame)
+}
+
 impl Run {
     /// A run of nothing: no samples, no impacts, no energy (a stand-in for a refused scene,
     /// or a shell to hold a series read back from a file).

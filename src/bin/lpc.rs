@@ -45,6 +45,47 @@ enum Command {
     Stability(StabilityArgs),
     /// The paper's figures (PNG and SVG) from a scene, a run directory or a compare directory.
     Plot(PlotArgs),
+    /// Numbered PNG frames of a run in 3D, off-screen (needs `--features render`).
+    Render(RenderArgs),
+    /// A run in an interactive 3D window (needs `--features render` and a display).
+    View(ViewArgs),
+}
+
+#[derive(clap::Args)]
+struct ViewArgs {
+    /// Scene file.
+    scene: PathBuf,
+    /// Model that runs the scene (the window replays its trajectory).
+    #[arg(long, default_value = "rapier")]
+    model: Model,
+    /// Simulated time, s (overrides the scene's).
+    #[arg(long)]
+    horizon: Option<f64>,
+    #[command(flatten)]
+    rapier: RapierArgs,
+}
+
+#[derive(clap::Args)]
+struct RenderArgs {
+    /// Scene file.
+    scene: PathBuf,
+    /// Directory for frame_00000.png, ... and the run's series.csv, impacts.csv, summary.json.
+    #[arg(long)]
+    out: PathBuf,
+    /// Frames per simulated second.
+    #[arg(long, default_value_t = 30.0)]
+    fps: f64,
+    /// Frame size in pixels, WIDTHxHEIGHT.
+    #[arg(long, default_value = "640x360", value_parser = parse_size)]
+    size: (u32, u32),
+    /// Simulated time to render, s (overrides the scene's).
+    #[arg(long)]
+    horizon: Option<f64>,
+    /// Model that runs the scene.
+    #[arg(long, default_value = "reference")]
+    model: Model,
+    #[command(flatten)]
+    rapier: RapierArgs,
 }
 
 #[derive(clap::Args)]
@@ -296,6 +337,8 @@ fn main() -> ExitCode {
         Command::Stress(a) => cmd_stress(a),
         Command::Stability(a) => cmd_stability(a),
         Command::Plot(a) => cmd_plot(a),
+        Command::Render(a) => cmd_render(a),
+        Command::View(a) => cmd_view(a),
         Command::Check(a) => return cmd_check(a),
     };
     match result {
@@ -659,6 +702,53 @@ fn cmd_stress(a: StressArgs) -> Result<()> {
     } else {
         Err(anyhow::anyhow!("{} of {} stressed runs failed", failures.len(), outcomes.len()))
     }
+}
+
+fn cmd_view(a: ViewArgs) -> Result<()> {
+    if !cfg!(feature = "render") {
+        return Err(anyhow::anyhow!("this lpc was built without a renderer: build it with `cargo run --release --features render -- view ...`"));
+    }
+    let mut s = scene::load_scene(&a.scene)?;
+    a.rapier.apply(&mut s, &a.scene)?;
+    override_run(&mut s, &a.scene, a.horizon, None)?;
+    let run = a.model.simulate(&s)?;
+    #[cfg(feature = "render")]
+    lpc_damper::render::window::view(&s, run);
+    #[cfg(not(feature = "render"))]
+    drop(run);
+    Ok(())
+}
+
+fn cmd_render(a: RenderArgs) -> Result<()> {
+    if !cfg!(feature = "render") {
+        return Err(anyhow::anyhow!(
+            "this lpc was built without a renderer: build it with `cargo run --release --features render -- render ...`"
+        ));
+    }
+    if !(a.fps.is_finite() && a.fps > 0.0 && a.fps <= 10_000.0) {
+        return Err(SceneError::Invalid { file: a.scene.display().to_string(), field: "--fps".into(), rule: format!("must lie in (0, 10000] (got {})", a.fps) }.into());
+    }
+    let mut s = scene::load_scene(&a.scene)?;
+    a.rapier.apply(&mut s, &a.scene)?;
+    // Frames fall on samples: the run is sampled at a step dividing the frame interval.
+    let (sample_dt, per_frame) = lpc_damper::run::frame_sampling(a.fps, s.sample_dt);
+    override_run(&mut s, &a.scene, a.horizon, Some(sample_dt))?;
+    let run = a.model.simulate(&s)?;
+    write_run_dir(&run, &a.out).with_context(|| format!("writing outputs to {}", a.out.display()))?;
+    render_run(&s, &run, &a, per_frame)
+}
+
+#[cfg(feature = "render")]
+fn render_run(s: &Scene, run: &lpc_damper::run::Run, a: &RenderArgs, per_frame: usize) -> Result<()> {
+    let options = lpc_damper::render::RenderOptions { out: a.out.clone(), size: a.size, samples_per_frame: per_frame };
+    let frames = lpc_damper::render::render_frames(s, run, &options)?;
+    println!("{} frames ({}x{}, {} fps, sample step {:e} s) in {}", frames.len(), a.size.0, a.size.1, a.fps, run.sample_dt, a.out.display());
+    Ok(())
+}
+
+#[cfg(not(feature = "render"))]
+fn render_run(_: &Scene, _: &lpc_damper::run::Run, _: &RenderArgs, _: usize) -> Result<()> {
+    unreachable!("cmd_render refuses before running when the renderer is not built")
 }
 
 fn cmd_plot(a: PlotArgs) -> Result<()> {

@@ -1,0 +1,115 @@
+//! Off-screen rendering (`--features render`; on CPU-only machines through Mesa's lavapipe):
+//! frames of the requested size in which each ball is drawn where the physics puts it, with
+//! background between balls, and a rendered run whose physics equals the headless run's to
+//! the byte.
+#![cfg(feature = "render")]
+
+use std::path::Path;
+use std::process::Command;
+
+use lpc_damper::output::figures::read_series_csv;
+use lpc_damper::render::stage::{Layout, BACKGROUND};
+use lpc_damper::scene::{load_scene, BallKind};
+
+fn lpc(args: &[&str]) -> std::process::Output {
+    Command::new(env!("CARGO_BIN_EXE_lpc")).args(args).current_dir(env!("CARGO_MANIFEST_DIR")).output().unwrap()
+}
+
+fn decode(path: &Path) -> (u32, u32, Vec<u8>, usize) {
+    let mut reader = png::Decoder::new(std::io::BufReader::new(std::fs::File::open(path).unwrap())).read_info().unwrap();
+    let mut buf = vec![0; reader.output_buffer_size()];
+    let info = reader.next_frame(&mut buf).unwrap();
+    buf.truncate(info.buffer_size());
+    (info.width, info.height, buf, info.color_type.samples())
+}
+
+/// Large balls are drawn red, small ones blue (see `render::stage`); lighting changes the
+/// shade, not which channel leads.
+fn is_large(p: [u8; 3]) -> bool {
+    p[0] > 90 && p[0] as i32 > p[1] as i32 + 50 && p[0] as i32 > p[2] as i32 + 50
+}
+fn is_small(p: [u8; 3]) -> bool {
+    p[2] > 90 && p[2] as i32 > p[0] as i32 + 50 && p[2] as i32 > p[1] as i32 + 20
+}
+
+const FPS: f64 = 20.0;
+const SIZE: (u32, u32) = (480, 270);
+
+#[test]
+fn balls_are_drawn_where_the_physics_puts_them() {
+    let out = tempfile::tempdir().unwrap();
+    let dir = out.path().to_str().unwrap();
+    let o = lpc(&["render", "scenes/lpc-lsl.toml", "--out", dir, "--horizon", "0.4", "--fps", "20", "--size", "480x270"]);
+    assert!(o.status.success(), "{}\n{}", String::from_utf8_lossy(&o.stdout), String::from_utf8_lossy(&o.stderr));
+    let scene = load_scene("scenes/lpc-lsl.toml").unwrap();
+    let layout = Layout::of(&scene);
+    let series = read_series_csv(&out.path().join("series.csv")).unwrap();
+    let (_, per_frame) = lpc_damper::run::frame_sampling(FPS, scene.sample_dt);
+    let frames = (0.4 * FPS).round() as usize + 1;
+    for k in 0..frames {
+        let path = out.path().join(format!("frame_{k:05}.png"));
+        let (w, h, px, channels) = decode(&path);
+        assert_eq!((w, h), SIZE, "{}", path.display());
+        let at = |p: bevy::math::Vec2| {
+            let i = (p.y.round() as usize * w as usize + p.x.round() as usize) * channels;
+            [px[i], px[i + 1], px[i + 2]]
+        };
+        let sample = k * per_frame;
+        assert!((series.t[sample] - k as f64 / FPS).abs() < 1e-9, "frame {k} falls on a sample");
+        let mut centres = vec![];
+        for (i, ball) in scene.balls.iter().enumerate() {
+            let centre = layout.ball(series.x[i][sample]);
+            let p = layout.project(SIZE, centre);
+            let r_px = layout.projected_radius(SIZE, centre, ball.radius as f32);
+            assert!(r_px > 3.0, "ball{} is {r_px} px across: too small to check", i + 1);
+            let colour = at(p);
+            let ok = if ball.kind == BallKind::Small { is_small(colour) } else { is_large(colour) };
+            assert!(ok, "frame {k}: ball{} ({:?}) at pixel {p} shows {colour:?}", i + 1, ball.kind);
+            centres.push((p, r_px));
+        }
+        for i in 1..centres.len() {
+            // Midway between two balls' facing surfaces, when there is room for a pixel.
+            let ((a, ra), (b, rb)) = (centres[i - 1], centres[i]);
+            if (b.x - rb) - (a.x + ra) >= 3.0 {
+                let mid = bevy::math::Vec2::new(0.5 * ((a.x + ra) + (b.x - rb)), 0.5 * (a.y + b.y));
+                let c = at(mid);
+                assert!(!is_large(c) && !is_small(c), "frame {k}: ball colour {c:?} between ball{i} and ball{}", i + 1);
+            }
+        }
+        // The top-left corner is sky: the clear colour.
+        let corner = at(bevy::math::Vec2::new(2.0, 2.0));
+        for ch in 0..3 {
+            assert!((corner[ch] as i32 - BACKGROUND[ch] as i32).abs() <= 12, "frame {k}: background {corner:?}");
+        }
+    }
+    assert!(!out.path().join(format!("frame_{frames:05}.png")).exists(), "one frame per 1/fps of simulated time");
+}
+
+#[test]
+fn rendering_never_changes_the_physics() {
+    for model in ["reference", "rapier"] {
+        let out = tempfile::tempdir().unwrap();
+        let (rendered, headless) = (out.path().join("rendered"), out.path().join("headless"));
+        let o = lpc(&[
+            "render", "scenes/lpc-lsl.toml", "--model", model, "--out", rendered.to_str().unwrap(),
+            "--horizon", "0.3", "--fps", "20", "--size", "160x100",
+        ]);
+        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+        let (sample_dt, _) = lpc_damper::run::frame_sampling(FPS, 0.001);
+        let o = lpc(&[
+            "run", "scenes/lpc-lsl.toml", "--model", model, "--out", headless.to_str().unwrap(),
+            "--horizon", "0.3", "--sample-dt", &format!("{sample_dt}"),
+        ]);
+        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+        for file in ["series.csv", "impacts.csv"] {
+            assert!(
+                std::fs::read(rendered.join(file)).unwrap() == std::fs::read(headless.join(file)).unwrap(),
+                "{model}: {file} differs between rendered and headless runs"
+            );
+        }
+        let strip = |p: &Path| -> String {
+            std::fs::read_to_string(p.join("summary.json")).unwrap().lines().filter(|l| !l.contains("wall_time_s")).collect()
+        };
+        assert_eq!(strip(&rendered), strip(&headless), "{model}: summary.json");
+    }
+}
