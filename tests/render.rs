@@ -65,6 +65,10 @@ fn balls_are_drawn_where_the_physics_puts_them() {
             let colour = at(p);
             let ok = if ball.kind == BallKind::Small { is_small(colour) } else { is_large(colour) };
             assert!(ok, "frame {k}: ball{} ({:?}) at pixel {p} shows {colour:?}", i + 1, ball.kind);
+            // Just above the ball (inside the see-through box) the ball's colour has ended: the
+            // ball is drawn at its size, not larger.
+            let above = at(p - bevy::math::Vec2::new(0.0, 1.3 * r_px + 1.0));
+            assert!(!is_large(above) && !is_small(above), "frame {k}: ball{} colour {above:?} above it", i + 1);
             centres.push((p, r_px));
         }
         for i in 1..centres.len() {
@@ -83,6 +87,20 @@ fn balls_are_drawn_where_the_physics_puts_them() {
         }
     }
     assert!(!out.path().join(format!("frame_{frames:05}.png")).exists(), "one frame per 1/fps of simulated time");
+}
+
+#[test]
+fn a_missing_graphics_driver_is_an_error_not_a_panic() {
+    let out = tempfile::tempdir().unwrap();
+    let o = Command::new(env!("CARGO_BIN_EXE_lpc"))
+        .args(["render", "scenes/conventional.toml", "--out", out.path().to_str().unwrap(), "--horizon", "0.1"])
+        .current_dir(env!("CARGO_MANIFEST_DIR"))
+        .env("VK_ICD_FILENAMES", "/nonexistent/icd.json")
+        .output()
+        .unwrap();
+    let stderr = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(1), "{stderr}");
+    assert!(stderr.contains("no graphics adapter") && !stderr.contains("panicked"), "{stderr}");
 }
 
 #[test]

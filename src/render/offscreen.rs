@@ -56,21 +56,29 @@ fn update_and_wait(app: &mut App) {
 
 /// A windowless app that renders `scene` posed by `run` into an image of `size`.
 fn app_for(scene: &Scene, run: Run, size: (u32, u32)) -> Result<(App, Handle<Image>), RenderError> {
-    let mut app = App::new();
-    app.add_plugins(
-        DefaultPlugins
-            .set(WindowPlugin { primary_window: None, exit_condition: bevy::window::ExitCondition::DontExit, ..default() })
-            .set(RenderPlugin { synchronous_pipeline_compilation: true, ..default() })
-            .disable::<bevy::log::LogPlugin>()
-            // No event loop: it would need a display.
-            .disable::<bevy::winit::WinitPlugin>(),
-    );
-    // Not `app.run()`: the frames are driven one by one, as the default runner would.
-    while app.plugins_state() == bevy::app::PluginsState::Adding {
-        bevy::tasks::tick_global_task_pools_on_main_thread();
-    }
-    app.finish();
-    app.cleanup();
+    // Bevy panics when it finds no adapter; that is a missing driver, reported as an error.
+    let quiet = std::panic::take_hook();
+    std::panic::set_hook(Box::new(|_| {}));
+    let started = std::panic::catch_unwind(|| {
+        let mut app = App::new();
+        app.add_plugins(
+            DefaultPlugins
+                .set(WindowPlugin { primary_window: None, exit_condition: bevy::window::ExitCondition::DontExit, ..default() })
+                .set(RenderPlugin { synchronous_pipeline_compilation: true, ..default() })
+                .disable::<bevy::log::LogPlugin>()
+                // No event loop: it would need a display.
+                .disable::<bevy::winit::WinitPlugin>(),
+        );
+        // Not `app.run()`: the frames are driven one by one, as the default runner would.
+        while app.plugins_state() == bevy::app::PluginsState::Adding {
+            bevy::tasks::tick_global_task_pools_on_main_thread();
+        }
+        app.finish();
+        app.cleanup();
+        app
+    });
+    std::panic::set_hook(quiet);
+    let mut app = started.map_err(|_| RenderError::NoAdapter)?;
     if app.world().get_resource::<RenderDevice>().is_none() {
         return Err(RenderError::NoAdapter);
     }
