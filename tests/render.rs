@@ -131,3 +131,17 @@ fn rendering_never_changes_the_physics() {
         assert_eq!(strip(&rendered), strip(&headless), "{model}: summary.json");
     }
 }
+
+#[test]
+fn view_without_a_display_is_an_error_not_a_panic() {
+    let o = Command::new(env!("CARGO_BIN_EXE_lpc"))
+        .args(["view", "scenes/conventional.toml", "--horizon", "0.1"])
+        .current_dir(env!("CARGO_MANIFEST_DIR"))
+        .env_remove("DISPLAY")
+        .env_remove("WAYLAND_DISPLAY")
+        .output()
+        .unwrap();
+    let stderr = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(1), "{stderr}");
+    assert!(stderr.contains("no display") && !stderr.contains("panicked"), "{stderr}");
+}

@@ -708,6 +708,10 @@ fn cmd_view(a: ViewArgs) -> Result<()> {
     if !cfg!(feature = "render") {
         return Err(anyhow::anyhow!("this lpc was built without a renderer: build it with `cargo run --release --features render -- view ...`"));
     }
+    // The window is an X11 one; without a display winit cannot start (and would panic).
+    if std::env::var_os("DISPLAY").is_none_or(|d| d.is_empty()) {
+        return Err(anyhow::anyhow!("no display: `lpc view` needs an X11 display (DISPLAY is not set); `lpc render` draws frames off-screen"));
+    }
     let mut s = scene::load_scene(&a.scene)?;
     a.rapier.apply(&mut s, &a.scene)?;
     override_run(&mut s, &a.scene, a.horizon, None)?;
