@@ -68,10 +68,15 @@ impl Layout {
         Vec3::new(x as f32, self.ball_y, 0.0)
     }
 
+    /// The point the camera looks at: mid-container, a little below the balls.
+    pub fn camera_target(&self) -> Vec3 {
+        Vec3::new(0.5 * self.length, 0.6 * self.ball_y, 0.0)
+    }
+
     /// The camera: in front of the structure, a little above and to the right, framing it
     /// from the ground to the container's top.
     pub fn camera(&self) -> Transform {
-        let target = Vec3::new(0.5 * self.length, 0.6 * self.ball_y, 0.0);
+        let target = self.camera_target();
         let span = (self.length + 2.0 * self.overhang).max(self.ball_y);
         let eye = target + Vec3::new(0.1 * span, 0.3 * span, 1.1 * span);
         Transform::from_translation(eye).looking_at(target, Vec3::Y)
@@ -231,10 +236,12 @@ pub fn pose(
 ) {
     let (xs, x) = super::state_at_sample(&playback.run, playback.sample);
     let mut glow = |m: &MeshMaterial3d<StandardMaterial>, on: bool| {
-        if let Some(mut mat) = materials.get_mut(&m.0) {
-            let base = mat.base_color.to_linear();
-            let want = if on { LinearRgba::rgb(base.red * 1.5, base.green * 1.5, base.blue * 1.5) } else { LinearRgba::BLACK };
-            if mat.emissive != want {
+        // `get_mut` marks the material modified (re-uploaded), so only when the flash changes.
+        let Some(mat) = materials.get(&m.0) else { return };
+        let base = mat.base_color.to_linear();
+        let want = if on { LinearRgba::rgb(base.red * 1.5, base.green * 1.5, base.blue * 1.5) } else { LinearRgba::BLACK };
+        if mat.emissive != want {
+            if let Some(mut mat) = materials.get_mut(&m.0) {
                 mat.emissive = want;
             }
         }

@@ -63,7 +63,7 @@ fn setup(
 ) {
     spawn_stage(&mut commands, &mut meshes, &mut materials, &scene.0, &layout);
     let cam = layout.camera();
-    let target = Vec3::new(0.5 * layout.length, 0.6 * layout.ball_y, 0.0);
+    let target = layout.camera_target();
     let offset = cam.translation - target;
     let distance = offset.length();
     commands.spawn((
