@@ -19,6 +19,9 @@ pub struct Metrics {
     pub settling_time: Option<f64>,
     /// Mechanical energy at the horizon / initial energy (`None` when the initial energy is 0).
     pub energy_remaining: Option<f64>,
+    /// Largest contact force over all impacts, N (`None` for impulse models).
+    #[serde(default)]
+    pub peak_contact_force: Option<f64>,
 }
 
 /// Computes the metrics of `run`.
@@ -33,6 +36,7 @@ pub fn metrics(run: &Run) -> Metrics {
         rms_displacement: rms,
         settling_time: settling_time(&s.t, &s.xs, run.initial_displacement),
         energy_remaining: (run.energy.initial != 0.0).then(|| run.energy.final_ / run.energy.initial),
+        peak_contact_force: run.impacts.iter().filter_map(|i| i.peak_force).reduce(f64::max),
     }
 }
 

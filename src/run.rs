@@ -12,7 +12,8 @@ pub struct Series {
     pub xs: Vec<f64>,
     /// Frame velocity, m/s.
     pub vs: Vec<f64>,
-    /// Frame acceleration without impulses and contact forces, `(Fe - cs vs - ks xs)/ms`, m/s^2.
+    /// Frame acceleration without impulses and contact forces, `(Fe - cs vs - ks xs)/ms`
+    /// ([`crate::scene::Scene::frame_acceleration`]), m/s^2.
     pub a: Vec<f64>,
     /// Ball centres, `[ball][sample]`, m.
     pub x: Vec<Vec<f64>>,
@@ -58,9 +59,15 @@ pub struct Impact {
     /// Momentum exchanges this impact stands for (sequential impulses at one instant, or the
     /// bodies of a merged run): each rounds momentum once, which bounds round-off.
     pub impulses: u32,
+    /// Largest contact force during the impact, N (compliant contact only; impulse models
+    /// have none).
+    pub peak_force: Option<f64>,
+    /// Time the bodies stay in contact, s (compliant contact only).
+    pub contact_duration: Option<f64>,
 }
 
-/// Where the energy went. `balance_error = (initial - final - damping_loss - impact_loss) / initial`.
+/// Where the energy went.
+/// `balance_error = (initial + forcing_work - final - damping_loss - impact_loss) / (|initial| + |forcing_work|)`.
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
 pub struct EnergyAccount {
     /// Mechanical energy at t = 0, J.
@@ -71,6 +78,8 @@ pub struct EnergyAccount {
     pub damping_loss: f64,
     /// Lost in impacts, J.
     pub impact_loss: f64,
+    /// Work done by the excitation, J (0 in free vibration).
+    pub forcing_work: f64,
     /// Relative balance error.
     pub balance_error: f64,
 }
@@ -78,13 +87,19 @@ pub struct EnergyAccount {
 impl EnergyAccount {
     /// An account with its balance error computed.
     pub fn new(initial: f64, final_: f64, damping_loss: f64, impact_loss: f64) -> Self {
-        let scale = if initial != 0.0 { initial.abs() } else { 1.0 };
+        Self::forced(initial, final_, damping_loss, impact_loss, 0.0)
+    }
+    /// An account of a forced run, the excitation having done `forcing_work`.
+    pub fn forced(initial: f64, final_: f64, damping_loss: f64, impact_loss: f64, forcing_work: f64) -> Self {
+        let scale = initial.abs() + forcing_work.abs();
+        let scale = if scale != 0.0 { scale } else { 1.0 };
         EnergyAccount {
             initial,
             final_,
             damping_loss,
             impact_loss,
-            balance_error: (initial - final_ - damping_loss - impact_loss) / scale,
+            forcing_work,
+            balance_error: (initial + forcing_work - final_ - damping_loss - impact_loss) / scale,
         }
     }
 }

@@ -51,6 +51,8 @@ fn free_chain(masses: &[f64], gaps: &[f64], speeds: &[f64], e: f64) -> Scene {
         horizon: 1.0,
         sample_dt: 1e-2,
         rapier: RapierSettings::default(),
+        compliant: Default::default(),
+        forcing: None,
         reference_radius: 0.01,
     }
 }

@@ -49,6 +49,8 @@ fn two_balls(v0: f64, gap: f64) -> Scene {
         horizon: 0.02,
         sample_dt: 1e-3,
         rapier: RapierSettings::default(),
+        compliant: Default::default(),
+        forcing: None,
         reference_radius: 0.0149,
     }
 }

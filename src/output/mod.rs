@@ -24,6 +24,12 @@ pub struct ImpactSummary {
     pub approach_speed: f64,
     /// J.
     pub energy_lost: f64,
+    /// Largest contact force, N (compliant model only).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub peak_force: Option<f64>,
+    /// Contact duration, s (compliant model only).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub contact_duration: Option<f64>,
 }
 
 /// The energy account as in the JSON contract.
@@ -38,6 +44,9 @@ pub struct EnergySummary {
     pub damping_loss: f64,
     /// J.
     pub impact_loss: f64,
+    /// Work done by the excitation, J (0 in free vibration).
+    #[serde(default)]
+    pub forcing_work: f64,
     /// Relative.
     pub balance_error: f64,
 }
@@ -79,6 +88,8 @@ impl RunSummary {
                     bodies: [Scene::body_name(i.a), Scene::body_name(i.b)],
                     approach_speed: i.approach_speed,
                     energy_lost: i.energy_lost,
+                    peak_force: i.peak_force,
+                    contact_duration: i.contact_duration,
                 })
                 .collect(),
             metrics: metrics(run),
@@ -87,6 +98,7 @@ impl RunSummary {
                 final_: run.energy.final_,
                 damping_loss: run.energy.damping_loss,
                 impact_loss: run.energy.impact_loss,
+                forcing_work: run.energy.forcing_work,
                 balance_error: run.energy.balance_error,
             },
             wall_time_s: run.wall_time_s,

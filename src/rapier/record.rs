@@ -269,6 +269,8 @@ pub fn feedback(
                 approach_speed: u,
                 energy_lost: lost,
                 impulses: 1,
+                peak_force: None,
+                contact_duration: None,
             });
         } else if let Some(k) = rec.last_impact[p] {
             rec.impacts[k].energy_lost += lost;

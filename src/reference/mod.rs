@@ -539,7 +539,7 @@ impl<'a> Solver<'a> {
             }
         }
         self.last_impact[p] = Some(self.impacts.len());
-        self.impacts.push(Impact { t: self.t, a, b, approach_speed, energy_lost, impulses });
+        self.impacts.push(Impact { t: self.t, a, b, approach_speed, energy_lost, impulses, peak_force: None, contact_duration: None });
     }
 
     /// An impact with restitution `e` across pair `p`.

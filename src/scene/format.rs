@@ -21,6 +21,11 @@ pub struct SceneFile {
     /// Settings of the Rapier model.
     #[serde(default)]
     pub rapier: RapierFile,
+    /// Settings of the compliant (Hertz + Hunt-Crossley) model.
+    #[serde(default)]
+    pub compliant: CompliantFile,
+    /// Harmonic forcing of the frame (free vibration without it).
+    pub forcing: Option<ForcingFile>,
     /// A parameter sweep over this scene.
     pub sweep: Option<SweepFile>,
     /// The chain experiment (KER), instead of a damper.
@@ -108,6 +113,38 @@ pub struct RapierFile {
     /// Rapier's swept continuous collision detection on the balls (off by default: the
     /// plug-in's speculative margin already finds every contact, see docs/BENCHMARKS.md).
     pub ccd: Option<bool>,
+}
+
+/// `[compliant]`: material of the balls and walls for the compliant contact model.
+#[derive(Debug, Clone, Deserialize, Serialize, Default)]
+#[serde(deny_unknown_fields)]
+pub struct CompliantFile {
+    /// Young's modulus `E`, Pa (default 200 GPa, steel).
+    pub youngs_modulus: Option<f64>,
+    /// Poisson's ratio `nu` (default 0.3).
+    pub poisson_ratio: Option<f64>,
+}
+
+/// What the harmonic forcing acts on.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize, Serialize)]
+#[serde(rename_all = "lowercase")]
+pub enum ForcingKind {
+    /// A force `Fe(t) = F0 sin(w t)` on the frame; `amplitude` is `F0` in N.
+    Force,
+    /// The ground under the spring and damper moves as `y(t) = Y sin(w t)`; `amplitude` is `Y` in m.
+    Base,
+}
+
+/// `[forcing]`: harmonic excitation of the frame.
+#[derive(Debug, Clone, Deserialize, Serialize)]
+#[serde(deny_unknown_fields)]
+pub struct ForcingFile {
+    /// `"force"` or `"base"`.
+    pub kind: ForcingKind,
+    /// `F0` in N (force) or `Y` in m (base).
+    pub amplitude: f64,
+    /// Forcing frequency, Hz.
+    pub frequency: f64,
 }
 
 /// `[sweep]`: one parameter and its values.

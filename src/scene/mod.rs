@@ -6,7 +6,7 @@ pub mod format;
 use std::f64::consts::PI;
 use std::path::{Path, PathBuf};
 
-pub use format::{Arrangement, Length, SceneFile};
+pub use format::{Arrangement, ForcingKind, Length, SceneFile};
 
 /// Default simulated time, s (MODEL.md §5).
 pub const DEFAULT_HORIZON: f64 = 5.0;
@@ -128,6 +128,67 @@ pub struct RapierSettings {
     pub ccd: Option<bool>,
 }
 
+/// Material of balls and walls for the compliant contact model (MODEL.md's steel by default).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct CompliantSettings {
+    /// Young's modulus `E`, Pa.
+    pub youngs_modulus: f64,
+    /// Poisson's ratio `nu`.
+    pub poisson_ratio: f64,
+}
+
+impl Default for CompliantSettings {
+    fn default() -> Self {
+        CompliantSettings { youngs_modulus: 200e9, poisson_ratio: 0.3 }
+    }
+}
+
+/// Harmonic excitation of the frame. Either way the frame obeys
+/// `ms xs'' + cs xs' + ks xs = P sin(w t) + Q cos(w t)` ([`Forcing::harmonic_load`]), and its
+/// smooth force is [`Scene::frame_force`].
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Forcing {
+    /// Force on the frame, or motion of the ground.
+    pub kind: ForcingKind,
+    /// `F0`, N (force) or `Y`, m (base).
+    pub amplitude: f64,
+    /// Hz.
+    pub frequency: f64,
+}
+
+impl Forcing {
+    /// `w = 2 pi f`, rad/s.
+    pub fn omega(&self) -> f64 {
+        2.0 * PI * self.frequency
+    }
+    /// The external force `Fe(t)` on the frame (0 for base excitation), N.
+    pub fn force(&self, t: f64) -> f64 {
+        match self.kind {
+            ForcingKind::Force => self.amplitude * (self.omega() * t).sin(),
+            ForcingKind::Base => 0.0,
+        }
+    }
+    /// The ground's displacement and velocity `(y, y')` (zero for a force), m and m/s.
+    pub fn ground(&self, t: f64) -> (f64, f64) {
+        match self.kind {
+            ForcingKind::Force => (0.0, 0.0),
+            ForcingKind::Base => {
+                let w = self.omega();
+                let (s, c) = (w * t).sin_cos();
+                (self.amplitude * s, self.amplitude * w * c)
+            }
+        }
+    }
+    /// `(P, Q)` of the load `P sin(w t) + Q cos(w t)` on a frame with damping `c` and
+    /// stiffness `k`: `(F0, 0)` for a force, `(k Y, c w Y)` for base motion.
+    pub fn harmonic_load(&self, damping: f64, stiffness: f64) -> (f64, f64) {
+        match self.kind {
+            ForcingKind::Force => (self.amplitude, 0.0),
+            ForcingKind::Base => (stiffness * self.amplitude, damping * self.omega() * self.amplitude),
+        }
+    }
+}
+
 /// A validated system: what every model simulates.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Scene {
@@ -153,6 +214,10 @@ pub struct Scene {
     pub sample_dt: f64,
     /// Rapier model settings from the file.
     pub rapier: RapierSettings,
+    /// Compliant model material.
+    pub compliant: CompliantSettings,
+    /// Harmonic forcing; `None` for free vibration.
+    pub forcing: Option<Forcing>,
     /// Reference radius `Rr`, m (radius of a large ball).
     pub reference_radius: f64,
 }
@@ -173,6 +238,58 @@ impl Scene {
                 .zip(&self.initial_velocities)
                 .map(|(b, v)| 0.5 * b.mass * v * v)
                 .sum::<f64>()
+    }
+
+    /// The smooth force on the frame at time `t` (spring, damper and excitation; impulses and
+    /// contact forces excluded): `Fe(t) - cs (xs' - y') - ks (xs - y)`, N. 0 without a frame.
+    pub fn frame_force(&self, t: f64, xs: f64, vs: f64) -> f64 {
+        let Some(f) = self.frame else { return 0.0 };
+        match self.forcing {
+            None => -(f.damping * vs + f.stiffness * xs),
+            Some(g) => {
+                let (y, yd) = g.ground(t);
+                g.force(t) - f.damping * (vs - yd) - f.stiffness * (xs - y)
+            }
+        }
+    }
+    /// The frame's reported acceleration `frame_force / ms` (MODEL.md §4), m/s^2.
+    pub fn frame_acceleration(&self, t: f64, xs: f64, vs: f64) -> f64 {
+        match (self.frame, self.forcing) {
+            (None, _) => 0.0,
+            (Some(f), None) => f.acceleration(xs, vs),
+            (Some(f), Some(_)) => self.frame_force(t, xs, vs) / f.mass,
+        }
+    }
+    /// The frame's kinetic energy plus the energy in its spring, `ks (xs - y)^2 / 2`, J.
+    pub fn frame_energy(&self, t: f64, xs: f64, vs: f64) -> f64 {
+        let Some(f) = self.frame else { return 0.0 };
+        match self.forcing {
+            None => f.energy(xs, vs),
+            Some(g) => {
+                let (y, _) = g.ground(t);
+                0.5 * f.mass * vs * vs + 0.5 * f.stiffness * (xs - y).powi(2)
+            }
+        }
+    }
+    /// Power dissipated in the frame's damper, `cs (xs' - y')^2`, W.
+    pub fn damping_power(&self, t: f64, vs: f64) -> f64 {
+        let Some(f) = self.frame else { return 0.0 };
+        let yd = self.forcing.map_or(0.0, |g| g.ground(t).1);
+        f.damping * (vs - yd).powi(2)
+    }
+    /// Power the excitation puts into the frame and its spring: `Fe xs'` for a force,
+    /// `-y' (cs (xs' - y') + ks (xs - y))` for base motion (the ground pushing the spring's
+    /// and damper's far ends), W. With [`Scene::frame_energy`] and [`Scene::damping_power`]
+    /// this closes the energy balance.
+    pub fn forcing_power(&self, t: f64, xs: f64, vs: f64) -> f64 {
+        let (Some(f), Some(g)) = (self.frame, self.forcing) else { return 0.0 };
+        match g.kind {
+            ForcingKind::Force => g.force(t) * vs,
+            ForcingKind::Base => {
+                let (y, yd) = g.ground(t);
+                -yd * (f.damping * (vs - yd) + f.stiffness * (xs - y))
+            }
+        }
     }
 
     /// The same frame without its damper: no container, no balls (the paper's "without
@@ -300,6 +417,8 @@ pub const SWEEP_PARAMETERS: &[&str] = &[
     "stiffness",
     "damping",
     "initial_displacement",
+    "forcing_amplitude",
+    "forcing_frequency",
 ];
 
 /// The scene file with one parameter set to `value`.
@@ -316,6 +435,15 @@ pub fn apply_sweep_value(file: &SceneFile, parameter: &str, value: Length) -> Re
         "stiffness" => frame.stiffness = number()?,
         "damping" => frame.damping = number()?,
         "initial_displacement" => frame.initial_displacement = value,
+        "forcing_amplitude" | "forcing_frequency" => {
+            let x = number()?;
+            let g = f.forcing.as_mut().ok_or("needs a [forcing] table")?;
+            if parameter == "forcing_amplitude" {
+                g.amplitude = x;
+            } else {
+                g.frequency = x;
+            }
+        }
         _ => {
             let balls = f.balls.as_mut().ok_or("needs a [balls] table")?;
             match parameter {
@@ -413,6 +541,11 @@ fn build_damper(f: &SceneFile, name: &str, v: &Validator) -> Result<Scene, Scene
     };
     let (horizon, sample_dt) = v.run(&f.run, DEFAULT_HORIZON)?;
     let rapier = rapier_settings(&f.rapier, v)?;
+    let compliant = compliant_settings(&f.compliant, v)?;
+    let forcing = match &f.forcing {
+        None => None,
+        Some(g) => Some(forcing(g, &frame, v)?),
+    };
     let Some(b) = &f.balls else {
         let xs0 = v.finite("frame.initial_displacement", fr.initial_displacement.metres(0.0))?;
         if matches!(fr.initial_displacement, Length::Rr(_)) {
@@ -430,6 +563,8 @@ fn build_damper(f: &SceneFile, name: &str, v: &Validator) -> Result<Scene, Scene
             horizon,
             sample_dt,
             rapier,
+            compliant,
+            forcing,
             reference_radius: 0.0,
         });
     };
@@ -488,8 +623,36 @@ fn build_damper(f: &SceneFile, name: &str, v: &Validator) -> Result<Scene, Scene
         horizon,
         sample_dt,
         rapier,
+        compliant,
+        forcing,
         reference_radius: rr,
     })
+}
+
+fn compliant_settings(c: &format::CompliantFile, v: &Validator) -> Result<CompliantSettings, SceneError> {
+    let d = CompliantSettings::default();
+    let youngs_modulus = v.positive("compliant.youngs_modulus", c.youngs_modulus.unwrap_or(d.youngs_modulus))?;
+    let poisson_ratio = v.finite("compliant.poisson_ratio", c.poisson_ratio.unwrap_or(d.poisson_ratio))?;
+    if !(poisson_ratio > -1.0 && poisson_ratio < 0.5) {
+        return Err(v.err("compliant.poisson_ratio", &format!("must lie in (-1, 0.5) for a stable solid (got {poisson_ratio})")));
+    }
+    Ok(CompliantSettings { youngs_modulus, poisson_ratio })
+}
+
+fn forcing(g: &format::ForcingFile, frame: &Frame, v: &Validator) -> Result<Forcing, SceneError> {
+    let amplitude = v.non_negative("forcing.amplitude", g.amplitude)?;
+    let frequency = v.positive("forcing.frequency", g.frequency)?;
+    let forcing = Forcing { kind: g.kind, amplitude, frequency };
+    // An undamped frame driven exactly at resonance has no bounded particular solution.
+    let w = forcing.omega();
+    let detuning = frame.stiffness - frame.mass * w * w;
+    if frame.damping == 0.0 && detuning.abs() <= 1e-12 * frame.stiffness {
+        return Err(v.err(
+            "forcing.frequency",
+            &format!("({frequency} Hz) drives an undamped frame exactly at resonance: its amplitude grows without bound"),
+        ));
+    }
+    Ok(forcing)
 }
 
 fn rapier_settings(r: &format::RapierFile, v: &Validator) -> Result<RapierSettings, SceneError> {
@@ -593,6 +756,8 @@ fn build_chain(c: &format::ChainFile, run: &format::RunFile, name: &str, v: &Val
                     horizon,
                     sample_dt,
                     rapier: RapierSettings::default(),
+                    compliant: CompliantSettings::default(),
+                    forcing: None,
                     reference_radius: rr,
                 },
             });

@@ -34,6 +34,8 @@ pub fn damper(frame: Frame, xs0: f64, masses: &[f64], e: f64, gap: f64, clearanc
         horizon,
         sample_dt: 1e-3,
         rapier: RapierSettings::default(),
+        compliant: Default::default(),
+        forcing: None,
     }
 }
 
