@@ -7,6 +7,9 @@
 //! `(1, t)` or `(cosh bt, sinh(bt)/b)`. `S` is written so that it stays accurate as `w` or `b`
 //! tends to zero, so near-critical damping loses no precision. The same basis gives the
 //! acceleration (itself a solution of the ODE), its sign changes, and the energy dissipated.
+//!
+//! Under harmonic forcing `P sin(wt) + Q cos(wt)` the motion is that closed form applied to the
+//! departure from the steady response [`Harmonic`] (the particular solution), plus it.
 
 use std::f64::consts::PI;
 
@@ -181,6 +184,111 @@ impl Oscillator {
     }
 }
 
+/// The steady response `xp(t) = X sin(w t) + Z cos(w t)` of an oscillator to the load
+/// `P sin(w t) + Q cos(w t)`: the particular solution added to the closed form under forcing.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Harmonic {
+    /// `X`, m.
+    pub sin: f64,
+    /// `Z`, m.
+    pub cos: f64,
+    /// `w`, rad/s.
+    pub omega: f64,
+}
+
+impl Harmonic {
+    /// The `n`-th time derivative of `xp` at `t`.
+    #[inline]
+    pub fn derivative(&self, t: f64, n: u32) -> f64 {
+        let (s, c) = (self.omega * t).sin_cos();
+        let scale = self.omega.powi(n as i32);
+        // Each derivative turns (sin, cos) a quarter turn: d/dt (X s + Z c) = w (X c - Z s).
+        scale
+            * match n % 4 {
+                0 => self.sin * s + self.cos * c,
+                1 => self.sin * c - self.cos * s,
+                2 => -(self.sin * s + self.cos * c),
+                _ => -(self.sin * c - self.cos * s),
+            }
+    }
+    /// `(xp, xp')` at `t`.
+    #[inline]
+    pub fn state(&self, t: f64) -> (f64, f64) {
+        let (s, c) = (self.omega * t).sin_cos();
+        (self.sin * s + self.cos * c, self.omega * (self.sin * c - self.cos * s))
+    }
+    /// Amplitude `sqrt(X^2 + Z^2)`, m.
+    pub fn amplitude(&self) -> f64 {
+        self.sin.hypot(self.cos)
+    }
+}
+
+impl Oscillator {
+    /// The steady response to `p sin(omega t) + q cos(omega t)`. An undamped oscillator driven
+    /// exactly at resonance has none (scene validation refuses that case); the result is then
+    /// infinite.
+    pub fn harmonic_response(&self, p: f64, q: f64, omega: f64) -> Harmonic {
+        let d = self.stiffness - self.mass * omega * omega;
+        let cw = self.damping * omega;
+        let det = d * d + cw * cw;
+        Harmonic { sin: (d * p + cw * q) / det, cos: (d * q - cw * p) / det, omega }
+    }
+}
+
+/// An oscillator with its optional harmonic load: the exact motion between any two times.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Driven {
+    /// The free oscillator.
+    pub osc: Oscillator,
+    /// Its steady response to the load, when loaded.
+    pub xp: Option<Harmonic>,
+}
+
+impl Driven {
+    /// `osc` under the load `p sin(w t) + q cos(w t)` given as `(p, q, w)`, or free.
+    pub fn new(osc: Oscillator, load: Option<(f64, f64, f64)>) -> Self {
+        Driven { osc, xp: load.map(|(p, q, w)| osc.harmonic_response(p, q, w)) }
+    }
+    /// State at `t1` of the motion that has state `(x0, v0)` at `t0`.
+    #[inline]
+    pub fn state(&self, x0: f64, v0: f64, t0: f64, t1: f64) -> (f64, f64) {
+        match &self.xp {
+            None => self.osc.state(x0, v0, t1 - t0),
+            Some(xp) => {
+                let (p0, q0) = xp.state(t0);
+                let (xh, vh) = self.osc.state(x0 - p0, v0 - q0, t1 - t0);
+                let (p1, q1) = xp.state(t1);
+                (xh + p1, vh + q1)
+            }
+        }
+    }
+}
+
+/// Two integrals over `[a, b]` at once by 8-point Gauss-Legendre on pieces no longer than
+/// `piece`: exact to round-off for integrands built from sines and decaying exponentials of
+/// rate `w` when `w piece <= pi / 4` (error about `(w piece)^16 / 16!`).
+pub fn gauss_legendre(a: f64, b: f64, piece: f64, mut f: impl FnMut(f64) -> [f64; 2]) -> [f64; 2] {
+    const NODES: [f64; 4] = [0.183_434_642_495_649_8, 0.525_532_409_916_329, 0.796_666_477_413_626_7, 0.960_289_856_497_536_3];
+    const WEIGHTS: [f64; 4] = [0.362_683_783_378_362, 0.313_706_645_877_887_3, 0.222_381_034_453_374_5, 0.101_228_536_290_376_3];
+    if b <= a {
+        return [0.0, 0.0];
+    }
+    let pieces = ((b - a) / piece).ceil().max(1.0);
+    let h = (b - a) / pieces;
+    let mut sum = [0.0, 0.0];
+    for k in 0..pieces as usize {
+        let mid = a + (k as f64 + 0.5) * h;
+        for (node, weight) in NODES.iter().zip(WEIGHTS) {
+            for t in [mid - 0.5 * h * node, mid + 0.5 * h * node] {
+                let [y0, y1] = f(t);
+                sum[0] += weight * y0;
+                sum[1] += weight * y1;
+            }
+        }
+    }
+    [0.5 * h * sum[0], 0.5 * h * sum[1]]
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -244,5 +352,55 @@ mod tests {
                 assert!(o.accel(xa, va) * o.accel(xb, vb) < 0.0);
             }
         }
+    }
+
+    #[test]
+    fn harmonic_response_solves_the_forced_equation() {
+        for (m, c, k, w) in [(1.35, 1.092, 865.0, 20.0), (2.0, 0.0, 50.0, 3.0), (1.0, 40.0, 100.0, 0.5), (1.0, 0.3, 0.0, 7.0)] {
+            let o = Oscillator::new(m, c, k);
+            let (p, q) = (3.0, -1.5);
+            let h = o.harmonic_response(p, q, w);
+            for t in [0.0, 0.1, 0.77, 3.0] {
+                let lhs = m * h.derivative(t, 2) + c * h.derivative(t, 1) + k * h.derivative(t, 0);
+                let rhs = p * (w * t).sin() + q * (w * t).cos();
+                assert!((lhs - rhs).abs() <= 1e-12 * (p.abs() + q.abs()), "{lhs} vs {rhs}");
+                let (x, v) = h.state(t);
+                assert_eq!((x, v), (h.derivative(t, 0), h.derivative(t, 1)));
+            }
+        }
+    }
+
+    #[test]
+    fn gauss_legendre_is_exact_for_smooth_periodic_integrands() {
+        let w = 7.0;
+        let piece = std::f64::consts::PI / (4.0 * w);
+        let [a, b] = gauss_legendre(0.3, 2.9, piece, |t| [(w * t).sin().powi(2), (-0.5 * t).exp() * (w * t).cos()]);
+        let exact_a = 0.5 * (2.9 - 0.3) - ((2.0 * w * 2.9).sin() - (2.0 * w * 0.3).sin()) / (4.0 * w);
+        // ∫ e^{-t/2} cos(wt) = e^{-t/2} (w sin wt - cos(wt)/2) / (w^2 + 1/4).
+        let prim = |t: f64| (-0.5 * t).exp() * (w * (w * t).sin() - 0.5 * (w * t).cos()) / (w * w + 0.25);
+        assert!((a - exact_a).abs() < 1e-14, "{a} vs {exact_a}");
+        assert!((b - (prim(2.9) - prim(0.3))).abs() < 1e-14);
+    }
+
+    #[test]
+    fn driven_motion_is_the_forced_solution() {
+        let osc = Oscillator::new(1.35, 1.092, 865.0);
+        let d = Driven::new(osc, Some((2.0, 0.5, 30.0)));
+        // Against RK4 on the forced equation with a fine step.
+        let (mut x, mut v, t0) = (0.01, -0.2, 0.4);
+        let (xe, ve) = d.state(x, v, t0, t0 + 0.5);
+        let f = |t: f64, x: f64, v: f64| (2.0 * (30.0 * t).sin() + 0.5 * (30.0 * t).cos() - 1.092 * v - 865.0 * x) / 1.35;
+        let n = 50_000;
+        let h = 0.5 / n as f64;
+        for k in 0..n {
+            let t = t0 + k as f64 * h;
+            let (k1x, k1v) = (v, f(t, x, v));
+            let (k2x, k2v) = (v + 0.5 * h * k1v, f(t + 0.5 * h, x + 0.5 * h * k1x, v + 0.5 * h * k1v));
+            let (k3x, k3v) = (v + 0.5 * h * k2v, f(t + 0.5 * h, x + 0.5 * h * k2x, v + 0.5 * h * k2v));
+            let (k4x, k4v) = (v + h * k3v, f(t + h, x + h * k3x, v + h * k3v));
+            x += h / 6.0 * (k1x + 2.0 * k2x + 2.0 * k3x + k4x);
+            v += h / 6.0 * (k1v + 2.0 * k2v + 2.0 * k3v + k4v);
+        }
+        assert!((x - xe).abs() < 1e-12 && (v - ve).abs() < 1e-10, "{x} {xe} {v} {ve}");
     }
 }

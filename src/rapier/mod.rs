@@ -40,13 +40,15 @@ pub const DEFAULT_SOLVER_ITERATIONS: usize = 4;
 pub const STEPS_PER_FRAME_PERIOD: f64 = 40.0;
 
 /// The stepping a scene asks for, with the defaults filled in and the step kept inside the
-/// stable region: at most a 40th of the frame's natural period.
+/// stable region: at most a 40th of the frame's natural period, and of the forcing period.
 pub fn settings(scene: &Scene) -> StepSettings {
     let dt = scene.rapier.dt.unwrap_or(DEFAULT_DT);
+    let forcing_bound = scene.forcing.map_or(f64::INFINITY, |g| 1.0 / (g.frequency * STEPS_PER_FRAME_PERIOD));
     let period_bound = scene
         .frame
         .filter(|f| f.stiffness > 0.0)
-        .map_or(f64::INFINITY, |f| 2.0 * std::f64::consts::PI * (f.mass / f.stiffness).sqrt() / STEPS_PER_FRAME_PERIOD);
+        .map_or(f64::INFINITY, |f| 2.0 * std::f64::consts::PI * (f.mass / f.stiffness).sqrt() / STEPS_PER_FRAME_PERIOD)
+        .min(forcing_bound);
     StepSettings {
         stepping: scene.rapier.stepping.unwrap_or(DEFAULT_STEPPING),
         dt: dt.min(period_bound),
@@ -116,13 +118,14 @@ pub fn collect(world: &mut World, scene: &Scene, steps: u64) -> Run {
     let frame = world.get_resource::<plugin::FrameState>().copied();
     let (xs, vs) = frame.map_or((0.0, 0.0), |f| f.now);
     let f = scene.frame;
-    let final_ = f.map_or(0.0, |f| f.energy(xs, vs))
+    let final_ = scene.frame_energy(scene.horizon, xs, vs)
         + scene.balls.iter().zip(&rec.v).map(|(b, v)| 0.5 * b.mass * v * v).sum::<f64>();
-    let energy = EnergyAccount::new(
+    let energy = EnergyAccount::forced(
         scene.initial_energy(),
         final_,
         frame.map_or(0.0, |f| f.damping_loss),
         rec.impact_loss,
+        frame.map_or(0.0, |f| f.forcing_work),
     );
     Run {
         scene: scene.name.clone(),

@@ -10,7 +10,7 @@ use bevy_rapier3d::rapier::dynamics::IntegrationParameters;
 use super::hooks::{ContactRole, RestitutionConfig, RestitutionHooks};
 use super::record::{feedback, record_samples, Recording};
 use super::stepping::{plan_step, StepPlan, Stepping};
-use crate::oscillator::Oscillator;
+use crate::oscillator::{gauss_legendre, Driven, Oscillator};
 use crate::scene::Scene;
 
 /// Rapier's length unit: the balls are centimetres, so are the tolerances.
@@ -62,8 +62,10 @@ pub struct FrameBody;
 /// The frame's exact state (f64), advanced in closed form; impacts arrive as velocity jumps.
 #[derive(Resource, Debug, Clone, Copy)]
 pub struct FrameState {
-    /// The bare frame's oscillator.
-    pub osc: Oscillator,
+    /// The bare frame's oscillator, with the scene's harmonic load.
+    pub motion: Driven,
+    /// Time at the start of the current step, s.
+    pub t_start: f64,
     /// Displacement and velocity at the start of the current step.
     pub start: (f64, f64),
     /// Displacement and velocity at the end of the step, before the impact impulses.
@@ -72,6 +74,8 @@ pub struct FrameState {
     pub now: (f64, f64),
     /// Energy dissipated by `cs` so far, J.
     pub damping_loss: f64,
+    /// Work done by the excitation so far, J.
+    pub forcing_work: f64,
 }
 
 /// Steps taken so far and the simulated time they cover.
@@ -275,11 +279,13 @@ fn init_frame(mut commands: Commands, scene: Res<DamperScene>) {
     if let Some(f) = scene.0.frame {
         let x0 = (scene.0.initial_displacement, 0.0);
         commands.insert_resource(FrameState {
-            osc: Oscillator::new(f.mass, f.damping, f.stiffness),
+            motion: Driven::new(Oscillator::new(f.mass, f.damping, f.stiffness), scene.0.harmonic_load()),
+            t_start: 0.0,
             start: x0,
             before_impulses: x0,
             now: x0,
             damping_loss: 0.0,
+            forcing_work: 0.0,
         });
     }
 }
@@ -289,15 +295,31 @@ fn init_frame(mut commands: Commands, scene: Res<DamperScene>) {
 /// created the body yet; the walls are far from every ball then.)
 pub fn drive_frame(
     plan: Res<StepPlan>,
+    clock: Res<StepClock>,
+    scene: Res<DamperScene>,
     frame: Option<ResMut<FrameState>>,
     bodies: Option<Res<Bodies>>,
     mut sets: Query<&mut RapierRigidBodySet>,
 ) {
     let (Some(mut frame), Some(bodies)) = (frame, bodies) else { return };
     let (x, v) = frame.now;
+    let (t0, t1) = (clock.t, clock.t + plan.h);
     frame.start = (x, v);
-    frame.before_impulses = frame.osc.state(x, v, plan.h);
-    frame.damping_loss += frame.osc.dissipated(x, v, plan.h);
+    frame.t_start = t0;
+    let motion = frame.motion;
+    frame.before_impulses = motion.state(x, v, t0, t1);
+    if motion.xp.is_none() {
+        frame.damping_loss += motion.osc.dissipated(x, v, plan.h);
+    } else {
+        // A step is a small fraction of both periods: one Gauss-Legendre piece is exact.
+        let scene = &scene.0;
+        let [damping, work] = gauss_legendre(t0, t1, plan.h, |t| {
+            let (xs, vs) = motion.state(x, v, t0, t);
+            [scene.damping_power(t, vs), scene.forcing_power(t, xs, vs)]
+        });
+        frame.damping_loss += damping;
+        frame.forcing_work += work;
+    }
     let (Some(entity), Ok(mut set)) = (bodies.frame, sets.single_mut()) else { return };
     if let Some(&h) = set.entity2body().get(&entity) {
         set.bodies[h].set_next_kinematic_translation(Vec3::new(frame.before_impulses.0 as f32, 0.0, 0.0));

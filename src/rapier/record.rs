@@ -311,8 +311,6 @@ pub fn record_samples(
     let t1 = clock.t;
     let t0 = t1 - dt;
     let rec: &mut Recording = &mut rec;
-    let f = scene.frame;
-    let accel = |x: f64, v: f64| f.map_or(0.0, |f| f.acceleration(x, v));
     while rec.next_sample < rec.sample_count {
         let k = rec.next_sample;
         let ts = k as f64 * scene.sample_dt;
@@ -324,14 +322,14 @@ pub fn record_samples(
         let (xs, vs) = match &frame {
             Some(_) if k == 0 => (scene.initial_displacement, 0.0),
             Some(fr) if at_end => fr.now,
-            Some(fr) => fr.osc.state(fr.start.0, fr.start.1, (ts - t0).max(0.0)),
+            Some(fr) => fr.motion.state(fr.start.0, fr.start.1, fr.t_start, ts.max(fr.t_start)),
             None => (0.0, 0.0),
         };
         let s = &mut rec.series;
         s.t.push(ts);
         s.xs.push(xs);
         s.vs.push(vs);
-        s.a.push(accel(xs, vs));
+        s.a.push(scene.frame_acceleration(ts, xs, vs));
         for i in 0..n {
             let (x, v) = if k == 0 {
                 (scene.initial_positions[i], scene.initial_velocities[i])

@@ -26,6 +26,7 @@ use crate::run::{EnergyAccount, Impact, Run, Series};
 use crate::scene::{Body, Scene};
 pub use impact_law::impact_law;
 pub use crate::oscillator::Oscillator;
+use crate::oscillator::{gauss_legendre, Harmonic};
 
 /// Why the reference could not finish a scene.
 #[derive(Debug, thiserror::Error)]
@@ -74,6 +75,11 @@ pub fn simulate(scene: &Scene) -> Result<Run, ReferenceError> {
     Ok(run)
 }
 
+/// Speed scale of base motion (`w Y`), 0 otherwise.
+fn g_amplitude_speed(scene: &Scene) -> f64 {
+    scene.forcing.filter(|g| g.kind == crate::scene::ForcingKind::Base).map_or(0.0, |g| g.omega() * g.amplitude)
+}
+
 /// Samples stepped by the transition matrix between two closed-form evaluations.
 const REANCHOR: u32 = 32;
 
@@ -103,23 +109,69 @@ struct Segment {
     t0: f64,
     x0: f64,
     v0: f64,
-    /// Acceleration and jerk at `t0`, for the sign-change search.
+    /// Acceleration and jerk at `t0`, for the sign-change search (of the departure from the
+    /// steady response, when forced).
     a0: f64,
     j0: f64,
     osc: Oscillator,
+    forced: Option<Forced>,
+}
+
+/// A forced segment: the motion is `xp(t)` plus the free motion of the departure from it.
+#[derive(Debug, Clone, Copy)]
+struct Forced {
+    xp: Harmonic,
+    /// Departure `(x - xp, v - xp')` at `t0`.
+    h0: (f64, f64),
+    /// Longest scan step of the sign-change search: a sixteenth of the shorter period.
+    scan: f64,
 }
 
 impl Segment {
-    fn new(t0: f64, x0: f64, v0: f64, osc: Oscillator) -> Self {
-        let a0 = osc.accel(x0, v0);
-        Segment { t0, x0, v0, a0, j0: -2.0 * osc.sigma * a0 - osc.w0sq * v0, osc }
+    fn new(t0: f64, x0: f64, v0: f64, osc: Oscillator, load: Option<(f64, f64, f64)>) -> Self {
+        let forced = load.map(|(p, q, omega)| {
+            let xp = osc.harmonic_response(p, q, omega);
+            let (xp0, vp0) = xp.state(t0);
+            let forcing_period = 2.0 * std::f64::consts::PI / omega;
+            let frame_period = if osc.w0sq > 0.0 { 2.0 * std::f64::consts::PI / osc.w0sq.sqrt() } else { f64::INFINITY };
+            Forced { xp, h0: (x0 - xp0, v0 - vp0), scan: forcing_period.min(frame_period) / 16.0 }
+        });
+        let (hx, hv) = forced.map_or((x0, v0), |f| f.h0);
+        let a0 = osc.accel(hx, hv);
+        Segment { t0, x0, v0, a0, j0: -2.0 * osc.sigma * a0 - osc.w0sq * hv, osc, forced }
     }
     #[inline]
     fn state(&self, t: f64) -> (f64, f64) {
-        self.osc.state(self.x0, self.v0, t - self.t0)
+        match &self.forced {
+            None => self.osc.state(self.x0, self.v0, t - self.t0),
+            Some(f) => {
+                let (xh, vh) = self.osc.state(f.h0.0, f.h0.1, t - self.t0);
+                let (xp, vp) = f.xp.state(t);
+                (xh + xp, vh + vp)
+            }
+        }
     }
-    /// Next time after `t` at which the frame's acceleration changes sign.
-    fn next_sign_change(&self, t: f64) -> f64 {
+    /// Acceleration, jerk and snap of a forced frame at `t`, with the size of each (the sum of
+    /// its parts' magnitudes) to judge round-off against.
+    fn forced_derivatives(&self, f: &Forced, t: f64) -> [(f64, f64); 3] {
+        let o = &self.osc;
+        let (ah, jh) = o.state(self.a0, self.j0, t - self.t0);
+        let sh = -2.0 * o.sigma * jh - o.w0sq * ah;
+        let parts = [(ah, f.xp.derivative(t, 2)), (jh, f.xp.derivative(t, 3)), (sh, f.xp.derivative(t, 4))];
+        let amp = f.xp.amplitude();
+        let w = f.xp.omega;
+        let mut out = [(0.0, 0.0); 3];
+        for (n, (h, p)) in parts.into_iter().enumerate() {
+            out[n] = (h + p, h.abs() + amp * w.powi(n as i32 + 2));
+        }
+        out
+    }
+    /// Next time after `t` at which the frame's acceleration changes sign, or `limit` if none
+    /// comes first (unforced segments ignore `limit`: their sign changes are closed form).
+    fn next_sign_change(&self, t: f64, limit: f64) -> f64 {
+        if let Some(f) = &self.forced {
+            return self.forced_sign_change(f, t, limit);
+        }
         // A root just after `t` in segment time can round onto `t` in absolute time: take the
         // next one then, so that time always moves on.
         let mut after = t - self.t0;
@@ -130,6 +182,53 @@ impl Segment {
             after = tau;
         }
         f64::INFINITY
+    }
+    /// The forced acceleration `a = a_h + a_p` has no closed-form roots; it is scanned with a
+    /// bound on its slope, so no sign change is stepped over. For `s' >= s`, the free part's
+    /// jerk `j_h` (a free solution itself) keeps `j_h'^2 + w0^2 j_h^2` from growing, so
+    /// `|a'| <= |j_h(s)| + h sqrt(j_h'(s)^2 + w0^2 j_h(s)^2) + w^3 |xp|` over `[s, s + h]`, and
+    /// `a` cannot change sign there while `|a(s)|` exceeds that times `h`. Pieces that cannot be
+    /// cleared are halved down to a few ulps.
+    fn forced_sign_change(&self, f: &Forced, t: f64, limit: f64) -> f64 {
+        if !(limit > t) {
+            return limit;
+        }
+        let o = &self.osc;
+        let amp3 = f.xp.amplitude() * f.xp.omega.powi(3);
+        let accel = |s: f64| self.forced_derivatives(f, s)[0].0;
+        let slope_bound = |s: f64, h: f64| {
+            let (ah, jh) = o.state(self.a0, self.j0, s - self.t0);
+            let sh = -2.0 * o.sigma * jh - o.w0sq * ah;
+            jh.abs() + h * (sh * sh + o.w0sq * jh * jh).sqrt() + amp3
+        };
+        let tiny = |s: f64| 8.0 * f64::EPSILON * s.abs().max(f.scan);
+        // Depth-first over halves, left first: the first sign change in [a, b], if any.
+        fn first(seg: &dyn Fn(f64) -> f64, bound: &dyn Fn(f64, f64) -> f64, tiny: &dyn Fn(f64) -> f64, a: f64, b: f64, fa: f64) -> Option<f64> {
+            let h = b - a;
+            if fa.abs() > bound(a, h) * h {
+                return None;
+            }
+            let fb = seg(b);
+            if h <= tiny(b) {
+                return ((fa > 0.0) != (fb > 0.0) || fb == 0.0).then_some(b);
+            }
+            let m = 0.5 * (a + b);
+            let fm = seg(m);
+            first(seg, bound, tiny, a, m, fa).or_else(|| first(seg, bound, tiny, m, b, fm))
+        }
+        let mut a = t;
+        let mut fa = accel(a);
+        while a < limit {
+            let b = (a + f.scan).min(limit);
+            if let Some(root) = first(&accel, &slope_bound, &tiny, a, b, fa) {
+                if root > t {
+                    return root;
+                }
+            }
+            a = b;
+            fa = accel(a);
+        }
+        limit
     }
 }
 
@@ -182,6 +281,9 @@ struct Solver<'a> {
     span: f64,
     horizon: f64,
     damping_loss: f64,
+    forcing_work: f64,
+    /// The harmonic load `(P, Q, w)` on the frame, when forced.
+    load: Option<(f64, f64, f64)>,
     impact_loss: f64,
     impacts: Vec<Impact>,
     last_impact: Vec<Option<usize>>,
@@ -219,7 +321,10 @@ impl<'a> Solver<'a> {
                 scene.horizon
             }
         });
-        let speed_scale = (bare_omega * xs0.abs())
+        let load = scene.harmonic_load();
+        let forced_speed =
+            load.map_or(0.0, |(p, q, w)| osc.harmonic_response(p, q, w).amplitude() * w + g_amplitude_speed(scene));
+        let speed_scale = (bare_omega * xs0.abs()).max(forced_speed)
             .max(scene.initial_velocities.iter().fold(0.0, |m: f64, v| m.max(v.abs())))
             .max(length_scale / scene.horizon);
         let samples = (scene.horizon / scene.sample_dt * (1.0 + 1e-12)).floor() as usize + 1;
@@ -234,7 +339,7 @@ impl<'a> Solver<'a> {
             damping,
             stiffness,
             length,
-            seg: Segment::new(0.0, xs0, 0.0, osc),
+            seg: Segment::new(0.0, xs0, 0.0, osc, load),
             t: 0.0,
             x: scene.initial_positions.clone(),
             v: scene.initial_velocities.clone(),
@@ -252,6 +357,8 @@ impl<'a> Solver<'a> {
             span: f64::INFINITY,
             horizon: scene.horizon,
             damping_loss: 0.0,
+            forcing_work: 0.0,
+            load,
             impact_loss: 0.0,
             impacts: Vec::new(),
             last_impact: vec![None; n + 1],
@@ -329,6 +436,20 @@ impl<'a> Solver<'a> {
     /// Every sign involved is that of `-(c v + k x)` and its derivatives, whatever the mass
     /// the frame carries, so holding and releasing a ball always agree.
     fn accel_ahead(&self, t: f64) -> f64 {
+        if let Some(f) = &self.seg.forced {
+            let [(a, sa), (jerk, sj), (snap, _)] = self.seg.forced_derivatives(f, t);
+            if a.abs() > 1e-9 * sa {
+                return a;
+            }
+            let sign = if jerk.abs() > 1e-9 * sj {
+                jerk.signum()
+            } else if snap == 0.0 {
+                return 0.0;
+            } else {
+                snap.signum()
+            };
+            return sign * a.abs().max(f64::MIN_POSITIVE);
+        }
         let (x, v) = self.seg.state(t);
         let o = &self.seg.osc;
         let a = o.accel(x, v);
@@ -375,7 +496,7 @@ impl<'a> Solver<'a> {
         let limit = (from + self.span).min(self.horizon);
         let mut a = from;
         loop {
-            let b = self.seg.next_sign_change(a).min(limit);
+            let b = self.seg.next_sign_change(a, limit).min(limit);
             // The sign just after `a` holds over the whole piece; judged as `resolve` judges it,
             // so that the two agree even where the acceleration is round-off (a frame at rest).
             let curvature = -s * self.accel_ahead(a);
@@ -479,7 +600,9 @@ impl<'a> Solver<'a> {
                 }
             }
             self.release_at = if self.held_mass > 0.0 && !self.packed {
-                self.seg.next_sign_change(self.t)
+                // Forced: at most one span ahead; if nothing changed sign by then, `release`
+                // finds nothing to let go and the search goes on from there.
+                self.seg.next_sign_change(self.t, (self.t + self.span).min(self.horizon))
             } else {
                 f64::INFINITY
             };
@@ -507,17 +630,35 @@ impl<'a> Solver<'a> {
 
     /// Starts a new frame segment at the current time with velocity `v` and the current load.
     fn set_frame(&mut self, v: f64) {
-        let tau = self.t - self.seg.t0;
-        self.damping_loss += self.seg.osc.dissipated(self.seg.x0, self.seg.v0, tau);
+        self.book_segment_energy();
         let (xs, _) = self.seg.state(self.t);
         let osc = if self.seg.osc.mass == self.frame_mass + self.held_mass {
             self.seg.osc
         } else {
             Oscillator::new(self.frame_mass + self.held_mass, self.damping, self.stiffness)
         };
-        self.seg = Segment::new(self.t, xs, v, osc);
+        self.seg = Segment::new(self.t, xs, v, osc, self.load);
         self.span = self.group_span();
         self.frame_dirty = true;
+    }
+
+    /// Books what the frame's damper dissipated, and the excitation put in, over the current
+    /// segment up to now: closed form when free; when forced, Gauss-Legendre on pieces of a
+    /// sixteenth of the shorter period (exact to round-off, see [`gauss_legendre`]).
+    fn book_segment_energy(&mut self) {
+        let tau = self.t - self.seg.t0;
+        let Some(f) = self.seg.forced else {
+            self.damping_loss += self.seg.osc.dissipated(self.seg.x0, self.seg.v0, tau);
+            return;
+        };
+        let seg = self.seg;
+        let scene = self.scene;
+        let [damping, work] = gauss_legendre(seg.t0, self.t, f.scan, |t| {
+            let (xs, vs) = seg.state(t);
+            [scene.damping_power(t, vs), scene.forcing_power(t, xs, vs)]
+        });
+        self.damping_loss += damping;
+        self.forcing_work += work;
     }
 
     fn touch_ball(&mut self, i: usize) {
@@ -749,7 +890,7 @@ impl<'a> Solver<'a> {
             s.t.push(ts);
             s.xs.push(xs);
             s.vs.push(vs);
-            s.a.push(self.scene.frame.map_or(0.0, |f| f.acceleration(xs, vs)));
+            s.a.push(self.scene.frame_acceleration(ts, xs, vs));
             for i in 0..self.n {
                 let (x, v) = match self.hold[i] {
                     Hold::Free => (self.x[i] + self.v[i] * (ts - self.t), self.v[i]),
@@ -766,6 +907,9 @@ impl<'a> Solver<'a> {
     /// transition matrix from the previous sample when it lies in the same segment, the closed
     /// form every [`REANCHOR`] samples so that round-off cannot drift.
     fn frame_sample(&mut self, ts: f64) -> (f64, f64) {
+        if self.seg.forced.is_some() {
+            return self.seg.state(ts);
+        }
         let c = &mut self.cursor;
         let k = self.next_sample;
         if c.seg_t0 == self.seg.t0 && c.k + 1 == k && c.steps < REANCHOR && k > 0 {
@@ -835,7 +979,7 @@ impl<'a> Solver<'a> {
 
     fn mechanical_energy(&self) -> f64 {
         let (xs, vs) = if self.has_frame() { self.seg.state(self.t) } else { (0.0, 0.0) };
-        let frame = self.scene.frame.map_or(0.0, |f| f.energy(xs, vs));
+        let frame = self.scene.frame_energy(self.t, xs, vs);
         frame
             + (0..self.n)
                 .map(|i| {
@@ -847,13 +991,18 @@ impl<'a> Solver<'a> {
 
     fn finish(mut self) -> Run {
         if self.has_frame() {
-            self.damping_loss += self.seg.osc.dissipated(self.seg.x0, self.seg.v0, self.t - self.seg.t0);
+            self.book_segment_energy();
         }
         let (_, vs) = if self.has_frame() { self.seg.state(self.t) } else { (0.0, 0.0) };
         let final_velocities =
             (0..self.n).map(|i| if self.hold[i] == Hold::Free { self.v[i] } else { vs }).collect();
-        let energy =
-            EnergyAccount::new(self.scene.initial_energy(), self.mechanical_energy(), self.damping_loss, self.impact_loss);
+        let energy = EnergyAccount::forced(
+            self.scene.initial_energy(),
+            self.mechanical_energy(),
+            self.damping_loss,
+            self.impact_loss,
+            self.forcing_work,
+        );
         Run {
             scene: self.scene.name.clone(),
             model: "reference".into(),

@@ -240,6 +240,13 @@ impl Scene {
                 .sum::<f64>()
     }
 
+    /// The frame's harmonic load `(P, Q, w)` (see [`Forcing::harmonic_load`]), when forced.
+    pub fn harmonic_load(&self) -> Option<(f64, f64, f64)> {
+        let (f, g) = (self.frame?, self.forcing?);
+        let (p, q) = g.harmonic_load(f.damping, f.stiffness);
+        Some((p, q, g.omega()))
+    }
+
     /// The smooth force on the frame at time `t` (spring, damper and excitation; impulses and
     /// contact forces excluded): `Fe(t) - cs (xs' - y') - ks (xs - y)`, N. 0 without a frame.
     pub fn frame_force(&self, t: f64, xs: f64, vs: f64) -> f64 {
