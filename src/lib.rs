@@ -21,6 +21,7 @@ pub mod bench;
 pub mod chain;
 pub mod check;
 pub mod compare;
+pub mod frf;
 pub mod metrics;
 pub mod model;
 pub mod oscillator;

@@ -1,11 +1,13 @@
-//! Parameter sweeps: one scene file, one `[sweep]` parameter, every value run in parallel.
+//! Parameter sweeps: one scene file, one `[sweep]` parameter or a grid of two (a design map),
+//! every point run in parallel. Axes come from the file's `[sweep]` or from the command line
+//! ([`parse_axis`]: `clearance=0.5 Rr,1 Rr` or `mass_ratio=1..20:5`).
 
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
 use crate::model::{Model, ModelError};
 use crate::output::RunSummary;
-use crate::scene::{self, Loaded, Scene, SceneError};
+use crate::scene::{self, Length, Loaded, Scene, SceneError};
 
 /// One value of a sweep (the JSON contract of `lpc sweep`).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -14,30 +16,143 @@ pub struct SweepPoint {
     pub parameter: String,
     /// Its value as written in the file (metres or Rr multiples for lengths).
     pub value: f64,
+    /// The second parameter of a grid.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub parameter_y: Option<String>,
+    /// Its value.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub value_y: Option<f64>,
     /// The run.
     pub summary: RunSummary,
 }
 
-/// The scenes of a sweep, one per value, each validated.
-pub fn sweep_scenes(loaded: &Loaded) -> Result<Vec<(f64, Scene)>, SceneError> {
+/// One swept parameter and its values.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Axis {
+    /// One of [`scene::SWEEP_PARAMETERS`].
+    pub parameter: String,
+    /// Values (lengths may be Rr multiples).
+    pub values: Vec<Length>,
+}
+
+/// The axes of the file's `[sweep]`: one, or two for a grid.
+pub fn file_axes(loaded: &Loaded) -> Result<Vec<Axis>, SceneError> {
     let sweep = loaded.file.sweep.as_ref().ok_or_else(|| SceneError::Invalid {
         file: loaded.path.clone(),
         field: "sweep".into(),
-        rule: "is missing: this command needs a scene file with a [sweep] table".into(),
+        rule: "is missing: this command needs a scene file with a [sweep] table (or axes on the command line)".into(),
     })?;
+    let mut axes = vec![Axis { parameter: sweep.parameter.clone(), values: sweep.values.clone() }];
+    match (&sweep.parameter_y, &sweep.values_y) {
+        (Some(p), Some(v)) => axes.push(Axis { parameter: p.clone(), values: v.clone() }),
+        (None, None) => {}
+        (Some(_), None) => return Err(invalid(loaded, "sweep.values_y", "is missing: `parameter_y` needs its values")),
+        (None, Some(_)) => return Err(invalid(loaded, "sweep.parameter_y", "is missing: `values_y` needs its parameter")),
+    }
+    Ok(axes)
+}
+
+fn invalid(loaded: &Loaded, field: &str, rule: &str) -> SceneError {
+    SceneError::Invalid { file: loaded.path.clone(), field: field.into(), rule: rule.into() }
+}
+
+/// Parses `PARAM=V1,V2,...` or `PARAM=A..B:N` (N values evenly spaced; lengths may carry
+/// `Rr`, as `0.5Rr..3Rr:6`).
+pub fn parse_axis(text: &str) -> Result<Axis, String> {
+    let (parameter, values) =
+        text.split_once('=').ok_or_else(|| format!("`{text}`: write `PARAM=V1,V2,...` or `PARAM=A..B:N`"))?;
+    let parameter = parameter.trim().to_string();
+    if !scene::SWEEP_PARAMETERS.contains(&parameter.as_str()) {
+        return Err(format!("`{parameter}` cannot be swept; choose one of {}", scene::SWEEP_PARAMETERS.join(", ")));
+    }
+    let value = |s: &str| -> Result<Length, String> {
+        let s = s.trim();
+        match s.parse::<f64>() {
+            Ok(x) if x.is_finite() => Ok(Length::Metres(x)),
+            _ => Length::try_from_text(s).ok_or_else(|| format!("`{s}` is not a number or `<k> Rr`")),
+        }
+    };
+    let values = if let Some((range, n)) = values.split_once(':') {
+        let (a, b) = range.split_once("..").ok_or_else(|| format!("`{values}`: a range is `A..B:N`"))?;
+        let n: usize = n.trim().parse().map_err(|_| format!("`{n}` is not a count"))?;
+        if !(2..=1000).contains(&n) {
+            return Err(format!("the count `{n}` must lie in 2..=1000"));
+        }
+        let (a, b) = (value(a)?, value(b)?);
+        if std::mem::discriminant(&a) != std::mem::discriminant(&b) {
+            return Err(format!("`{range}`: both ends must be in metres or both in Rr"));
+        }
+        (0..n)
+            .map(|k| {
+                let x = a.raw() + (b.raw() - a.raw()) * k as f64 / (n - 1) as f64;
+                match a {
+                    Length::Metres(_) => Length::Metres(x),
+                    Length::Rr(_) => Length::Rr(x),
+                }
+            })
+            .collect()
+    } else {
+        values.split(',').map(value).collect::<Result<Vec<_>, _>>()?
+    };
+    if values.is_empty() {
+        return Err("no values".into());
+    }
+    Ok(Axis { parameter, values })
+}
+
+/// A point of a sweep: its coordinates and its validated scene.
+#[derive(Debug, Clone)]
+pub struct GridScene {
+    /// Value on each axis, as written.
+    pub values: Vec<f64>,
+    /// The scene.
+    pub scene: Scene,
+}
+
+/// The scenes of a sweep over `axes` (the first varies fastest), each validated; an invalid
+/// point is an error naming its axis and value.
+pub fn grid_scenes(loaded: &Loaded, axes: &[Axis]) -> Result<Vec<GridScene>, SceneError> {
     let base = loaded.scene.as_ref().map(|s| s.name.clone()).unwrap_or_default();
-    sweep
-        .values
-        .iter()
-        .map(|value| {
-            let file = scene::apply_sweep_value(&loaded.file, &sweep.parameter, *value).map_err(|rule| {
-                SceneError::Invalid { file: loaded.path.clone(), field: "sweep.parameter".into(), rule }
-            })?;
-            let mut s = scene::from_file(file, &loaded.path, &base)?.scene.expect("damper scene");
-            s.name = format!("{base}[{}={}]", sweep.parameter, value.raw());
-            Ok((value.raw(), s))
+    let mut points: Vec<(Vec<(usize, Length)>, scene::SceneFile)> = vec![(vec![], loaded.file.clone())];
+    for (a, axis) in axes.iter().enumerate() {
+        let mut next = Vec::new();
+        for (coords, file) in &points {
+            for (i, value) in axis.values.iter().enumerate() {
+                let field = if a == 0 { format!("sweep.values[{i}]") } else { format!("sweep.values_y[{i}]") };
+                let varied = scene::apply_sweep_value(file, &axis.parameter, *value)
+                    .map_err(|rule| SceneError::Invalid { file: loaded.path.clone(), field: field.clone(), rule })?;
+                let mut c = coords.clone();
+                c.push((i, *value));
+                next.push((c, varied));
+            }
+        }
+        points = next;
+    }
+    // First axis fastest: order by the later axes' indices first.
+    points.sort_by(|a, b| a.0.iter().rev().map(|c| c.0).cmp(b.0.iter().rev().map(|c| c.0)));
+    points
+        .into_iter()
+        .map(|(coords, file)| {
+            let label = axes.iter().zip(&coords).map(|(ax, (_, v))| format!("{}={}", ax.parameter, v.raw())).collect::<Vec<_>>().join(",");
+            let mut s = scene::from_file(file, &loaded.path, &base)
+                .map_err(|e| match e {
+                    SceneError::Invalid { file, field, rule } => {
+                        SceneError::Invalid { file, field: format!("sweep point {label} (as {field})"), rule }
+                    }
+                    other => other,
+                })?
+                .scene
+                .expect("damper scene");
+            s.name = format!("{base}[{label}]");
+            Ok(GridScene { values: coords.iter().map(|(_, v)| v.raw()).collect(), scene: s })
         })
         .collect()
+}
+
+/// The scenes of the file's one-parameter sweep, one per value, each validated.
+pub fn sweep_scenes(loaded: &Loaded) -> Result<Vec<(f64, Scene)>, SceneError> {
+    let axes = file_axes(loaded)?;
+    Ok(grid_scenes(loaded, &axes[..1])?.into_iter().map(|g| (g.values[0], g.scene)).collect())
 }
 
 /// Runs every scene with `model` in parallel; `progress` is called after each run.
@@ -47,12 +162,48 @@ pub fn run_sweep(
     model: Model,
     progress: &(dyn Fn() + Sync),
 ) -> Result<Vec<SweepPoint>, ModelError> {
-    scenes
-        .par_iter()
-        .map(|(value, scene)| {
-            let run = model.simulate(scene)?;
+    let axes = [parameter.to_string()];
+    let grid: Vec<GridScene> = scenes.iter().map(|(v, s)| GridScene { values: vec![*v], scene: s.clone() }).collect();
+    run_grid(&axes, &grid, model, progress)
+}
+
+/// Runs every point of a grid with `model` in parallel.
+pub fn run_grid(
+    parameters: &[String],
+    grid: &[GridScene],
+    model: Model,
+    progress: &(dyn Fn() + Sync),
+) -> Result<Vec<SweepPoint>, ModelError> {
+    grid.par_iter()
+        .map(|g| {
+            let run = model.simulate(&g.scene)?;
             progress();
-            Ok(SweepPoint { parameter: parameter.to_string(), value: *value, summary: RunSummary::of(&run) })
+            Ok(SweepPoint {
+                parameter: parameters[0].clone(),
+                value: g.values[0],
+                parameter_y: parameters.get(1).cloned(),
+                value_y: g.values.get(1).copied(),
+                summary: RunSummary::of(&run),
+            })
         })
         .collect()
+}
+
+/// Metrics a design map can show.
+pub const MAP_METRICS: &[&str] =
+    &["settling_time", "energy_remaining", "peak_contact_force", "peak_displacement", "peak_acceleration", "rms_displacement", "impact_count"];
+
+/// The value of metric `name` in `summary` (`None` when the run has none, e.g. not settled).
+pub fn metric_value(summary: &RunSummary, name: &str) -> Option<f64> {
+    let m = &summary.metrics;
+    match name {
+        "settling_time" => m.settling_time,
+        "energy_remaining" => m.energy_remaining,
+        "peak_contact_force" => m.peak_contact_force,
+        "peak_displacement" => Some(m.peak_displacement),
+        "peak_acceleration" => Some(m.peak_acceleration),
+        "rms_displacement" => Some(m.rms_displacement),
+        "impact_count" => Some(summary.impact_count as f64),
+        _ => None,
+    }
 }

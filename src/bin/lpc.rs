@@ -15,7 +15,6 @@ use lpc_damper::chain::{run_chain, KerRow};
 use lpc_damper::compare::{errors, Errors};
 use lpc_damper::output::{text_summary, write_atomic, write_run_dir, RunSummary};
 use lpc_damper::scene::{self, Scene, SceneError};
-use lpc_damper::sweep::{run_sweep, sweep_scenes};
 use lpc_damper::Model;
 
 #[derive(Parser)]
@@ -31,6 +30,9 @@ enum Command {
     Run(RunArgs),
     /// Run every value of a scene's [sweep] table, in parallel.
     Sweep(SweepArgs),
+    /// Frequency response: steady amplitude of xs against forcing frequency, with and without
+    /// the damper (needs a [forcing] table, or --kind and --amplitude).
+    Frf(FrfArgs),
     /// The chain experiment (Fig. 5): kinetic energy ratio against the number of large balls.
     Chain(ChainArgs),
     /// Run several models on one scene and report each one's errors against the reference.
@@ -243,11 +245,59 @@ struct SweepArgs {
     /// Output format on standard output.
     #[arg(long, value_enum, default_value_t = Format::Text)]
     format: Format,
-    /// Also write sweep.json into this directory.
+    /// Also write sweep.json (and, for a grid, the design map sweep-map.png/.svg) into this
+    /// directory.
+    #[arg(long)]
+    out: Option<PathBuf>,
+    /// First axis instead of the file's [sweep]: `PARAM=V1,V2,...` or `PARAM=A..B:N`
+    /// (lengths may be `0.5Rr`).
+    #[arg(long)]
+    x: Option<String>,
+    /// Second axis (makes a grid): same syntax as --x.
+    #[arg(long)]
+    y: Option<String>,
+    /// Metric of the design map (one of settling_time, energy_remaining, peak_contact_force,
+    /// peak_displacement, peak_acceleration, rms_displacement, impact_count).
+    #[arg(long, default_value = "settling_time")]
+    metric: String,
+    #[command(flatten)]
+    rapier: RapierArgs,
+}
+
+#[derive(clap::Args)]
+struct FrfArgs {
+    /// Scene file.
+    scene: PathBuf,
+    /// Frequency range `A..B` in Hz.
+    #[arg(long)]
+    freq: String,
+    /// Number of frequencies, evenly spaced over the range.
+    #[arg(long, default_value_t = 21)]
+    steps: usize,
+    /// Model to run.
+    #[arg(long, default_value = "reference")]
+    model: Model,
+    /// Forcing kind, when the scene has no [forcing] table (or to override it).
+    #[arg(long, value_enum)]
+    kind: Option<ForcingKindArg>,
+    /// Forcing amplitude (N for a force, m for base motion), when the scene has no [forcing]
+    /// table (or to override it).
+    #[arg(long)]
+    amplitude: Option<f64>,
+    /// Output format on standard output.
+    #[arg(long, value_enum, default_value_t = Format::Text)]
+    format: Format,
+    /// Write frf.json, frf.csv and the plot (frf.png, frf.svg) into this directory.
     #[arg(long)]
     out: Option<PathBuf>,
     #[command(flatten)]
     rapier: RapierArgs,
+}
+
+#[derive(Clone, Copy, ValueEnum)]
+enum ForcingKindArg {
+    Force,
+    Base,
 }
 
 /// Settings of the Rapier model that every command accepts.
@@ -331,6 +381,7 @@ fn main() -> ExitCode {
     let result = match cli.command {
         Command::Run(a) => cmd_run(a),
         Command::Sweep(a) => cmd_sweep(a),
+        Command::Frf(a) => cmd_frf(a),
         Command::Chain(a) => cmd_chain(a),
         Command::Compare(a) => cmd_compare(a),
         Command::Bench(a) => cmd_bench(a),
@@ -406,20 +457,52 @@ fn progress_bar(len: usize, label: &str) -> ProgressBar {
 
 fn cmd_sweep(a: SweepArgs) -> Result<()> {
     let loaded = scene::load(&a.scene)?;
-    let mut scenes = sweep_scenes(&loaded)?;
-    for (_, s) in &mut scenes {
-        override_run(s, &a.scene, a.horizon, None)?;
-        a.rapier.apply(s, &a.scene)?;
+    let invalid = |field: &str, rule: String| SceneError::Invalid { file: a.scene.display().to_string(), field: field.into(), rule };
+    if !lpc_damper::sweep::MAP_METRICS.contains(&a.metric.as_str()) {
+        return Err(invalid("--metric", format!("`{}` is not one of {}", a.metric, lpc_damper::sweep::MAP_METRICS.join(", "))).into());
     }
-    let parameter = loaded.file.sweep.as_ref().map(|s| s.parameter.clone()).unwrap_or_default();
-    let bar = progress_bar(scenes.len(), "sweep");
+    let mut axes = match &a.x {
+        Some(x) => vec![lpc_damper::sweep::parse_axis(x).map_err(|rule| invalid("--x", rule))?],
+        None if a.y.is_some() => return Err(invalid("--y", "needs --x".into()).into()),
+        None => lpc_damper::sweep::file_axes(&loaded)?,
+    };
+    if let Some(y) = &a.y {
+        axes.truncate(1);
+        axes.push(lpc_damper::sweep::parse_axis(y).map_err(|rule| invalid("--y", rule))?);
+    }
+    if loaded.scene.is_none() {
+        return Err(invalid("frame", "is missing: a sweep needs a damper scene".into()).into());
+    }
+    let mut grid = lpc_damper::sweep::grid_scenes(&loaded, &axes)?;
+    for g in &mut grid {
+        override_run(&mut g.scene, &a.scene, a.horizon, None)?;
+        a.rapier.apply(&mut g.scene, &a.scene)?;
+    }
+    let parameters: Vec<String> = axes.iter().map(|x| x.parameter.clone()).collect();
+    let parameter = parameters.join(" x ");
+    let bar = progress_bar(grid.len(), "sweep");
     let start = std::time::Instant::now();
-    let points = run_sweep(&parameter, &scenes, a.model, &|| bar.inc(1))?;
+    let points = lpc_damper::sweep::run_grid(&parameters, &grid, a.model, &|| bar.inc(1))?;
     bar.finish_and_clear();
     let elapsed = start.elapsed().as_secs_f64();
     if let Some(dir) = &a.out {
         write_atomic(&dir.join("sweep.json"), &serde_json::to_vec_pretty(&points)?)
             .with_context(|| format!("writing {}", dir.display()))?;
+        if axes.len() == 2 {
+            let (nx, ny) = (axes[0].values.len(), axes[1].values.len());
+            let z = (0..ny)
+                .map(|r| (0..nx).map(|c| lpc_damper::sweep::metric_value(&points[r * nx + c].summary, &a.metric)).collect())
+                .collect();
+            let map = lpc_damper::output::figures::HeatMap {
+                name: "sweep-map".into(),
+                title: format!("{}: {} ({})", loaded.scene.as_ref().map_or("", |s| s.name.as_str()), a.metric, a.model.name()),
+                x: (axis_title(&axes[0]), axes[0].values.iter().map(|v| v.raw()).collect()),
+                y: (axis_title(&axes[1]), axes[1].values.iter().map(|v| v.raw()).collect()),
+                z,
+                z_desc: a.metric.clone(),
+            };
+            lpc_damper::output::figures::write_heat_map(&map, dir, (900, 640))?;
+        }
     }
     match a.format {
         Format::Json => print_json(&points)?,
@@ -431,14 +514,16 @@ fn cmd_sweep(a: SweepArgs) -> Result<()> {
                 elapsed,
                 points.len() as f64 / elapsed
             );
+            let y_head = parameters.get(1).map_or(String::new(), |p| format!("{p:>12} "));
             println!(
-                "{:>10} {:>8} {:>12} {:>12} {:>10} {:>10} {:>9}",
-                parameter, "impacts", "peak xs mm", "peak a m/s2", "rms xs mm", "settle s", "E left %"
+                "{:>12} {y_head}{:>8} {:>12} {:>12} {:>10} {:>10} {:>9}",
+                parameters[0], "impacts", "peak xs mm", "peak a m/s2", "rms xs mm", "settle s", "E left %"
             );
             for p in &points {
                 let m = &p.summary.metrics;
+                let y = p.value_y.map_or(String::new(), |v| format!("{v:>12} "));
                 println!(
-                    "{:>10} {:>8} {:>12.4} {:>12.4} {:>10.4} {:>10} {:>9.3}",
+                    "{:>12} {y}{:>8} {:>12.4} {:>12.4} {:>10.4} {:>10} {:>9.3}",
                     p.value,
                     p.summary.impact_count,
                     m.peak_displacement * 1e3,
@@ -447,6 +532,114 @@ fn cmd_sweep(a: SweepArgs) -> Result<()> {
                     m.settling_time.map_or("-".into(), |t| format!("{t:.3}")),
                     m.energy_remaining.unwrap_or(f64::NAN) * 100.0
                 );
+            }
+            if let (Some(dir), 2) = (&a.out, axes.len()) {
+                println!("wrote sweep.json, sweep-map.png, sweep-map.svg to {}", dir.display());
+            }
+        }
+    }
+    Ok(())
+}
+
+/// An axis's parameter, with `(Rr)` when its values are multiples of the reference radius.
+fn axis_title(axis: &lpc_damper::sweep::Axis) -> String {
+    let rr = axis.values.iter().any(|v| matches!(v, scene::Length::Rr(_)));
+    if rr {
+        format!("{} (Rr)", axis.parameter)
+    } else {
+        axis.parameter.clone()
+    }
+}
+
+fn parse_range(text: &str, path: &Path, field: &str) -> Result<(f64, f64), SceneError> {
+    let invalid = |rule: String| SceneError::Invalid { file: path.display().to_string(), field: field.into(), rule };
+    let (a, b) = text.split_once("..").ok_or_else(|| invalid(format!("`{text}` is not a range: write `A..B`")))?;
+    let num = |s: &str| s.trim().parse::<f64>().map_err(|_| invalid(format!("`{s}` in `{text}` is not a number")));
+    let (a, b) = (num(a)?, num(b)?);
+    if !(a.is_finite() && b.is_finite() && a > 0.0 && b >= a) {
+        return Err(invalid(format!("`{text}` must be positive and increasing")));
+    }
+    Ok((a, b))
+}
+
+fn cmd_frf(a: FrfArgs) -> Result<()> {
+    let mut scene = scene::load_scene(&a.scene)?;
+    a.rapier.apply(&mut scene, &a.scene)?;
+    let (from, to) = parse_range(&a.freq, &a.scene, "--freq")?;
+    let invalid = |field: &str, rule: String| SceneError::Invalid { file: a.scene.display().to_string(), field: field.into(), rule };
+    if a.steps == 0 || a.steps > 10_000 {
+        return Err(invalid("--steps", format!("must lie in 1..=10000 (got {})", a.steps)).into());
+    }
+    if a.kind.is_some() || a.amplitude.is_some() {
+        let g = scene.forcing.get_or_insert(scene::Forcing { kind: scene::ForcingKind::Force, amplitude: 0.0, frequency: from });
+        if let Some(k) = a.kind {
+            g.kind = match k {
+                ForcingKindArg::Force => scene::ForcingKind::Force,
+                ForcingKindArg::Base => scene::ForcingKind::Base,
+            };
+        }
+        if let Some(x) = a.amplitude {
+            if !(x.is_finite() && x > 0.0) {
+                return Err(invalid("--amplitude", format!("must be a positive number (got {x})")).into());
+            }
+            g.amplitude = x;
+        }
+    }
+    let Some(g) = scene.forcing else {
+        return Err(invalid("forcing", "is missing: give the scene a [forcing] table, or --kind and --amplitude".into()).into());
+    };
+    if g.amplitude == 0.0 {
+        return Err(invalid("forcing.amplitude", "is 0: give --amplitude".into()).into());
+    }
+    if let Some(f) = scene.frame {
+        // An undamped frame driven at resonance has no steady state (scene validation's rule).
+        let w0 = (f.stiffness / f.mass).sqrt() / (2.0 * std::f64::consts::PI);
+        if f.damping == 0.0 && from <= w0 && w0 <= to {
+            return Err(invalid("--freq", format!("{from}..{to} Hz contains the undamped frame's resonance {w0:.6} Hz, where no steady state exists")).into());
+        }
+    }
+    let freqs = lpc_damper::frf::frequencies(from, to, a.steps);
+    let bar = progress_bar(2 * freqs.len(), "frf");
+    let start = std::time::Instant::now();
+    let points = lpc_damper::frf::frf(&scene, &freqs, a.model, &|| bar.inc(1))?;
+    bar.finish_and_clear();
+    let elapsed = start.elapsed().as_secs_f64();
+    if let Some(dir) = &a.out {
+        write_atomic(&dir.join("frf.json"), &serde_json::to_vec_pretty(&points)?)
+            .with_context(|| format!("writing {}", dir.display()))?;
+        let mut w = csv::Writer::from_writer(Vec::new());
+        for p in &points {
+            w.serialize(p)?;
+        }
+        write_atomic(&dir.join("frf.csv"), &w.into_inner()?).with_context(|| format!("writing {}", dir.display()))?;
+        let fig = lpc_damper::output::figures::frf_chart(&points, &scene.name, a.model.name());
+        lpc_damper::output::figures::write(&fig, dir, (900, 560))?;
+    }
+    match a.format {
+        Format::Json => print_json(&points)?,
+        Format::Text => {
+            println!(
+                "frequency response of {} ({}, {:?} forcing, amplitude {}; {} runs in {:.2} s)",
+                scene.name,
+                a.model.name(),
+                g.kind,
+                g.amplitude,
+                2 * points.len(),
+                elapsed
+            );
+            println!("{:>10} {:>14} {:>14} {:>8} {:>7}", "f Hz", "amp mm", "no damper mm", "ratio", "steady (with/without)");
+            for p in &points {
+                println!(
+                    "{:>10.4} {:>14.4} {:>14.4} {:>8.3} {:>7}",
+                    p.frequency,
+                    p.amplitude * 1e3,
+                    p.amplitude_no_damper * 1e3,
+                    p.amplitude / p.amplitude_no_damper,
+                    format!("{}/{}", if p.steady { "yes" } else { "no" }, if p.steady_no_damper { "yes" } else { "no" })
+                );
+            }
+            if let Some(dir) = &a.out {
+                println!("wrote frf.json, frf.csv, frf.png, frf.svg to {}", dir.display());
             }
         }
     }

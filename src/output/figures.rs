@@ -66,25 +66,131 @@ fn register_font() {
 
 /// Writes `figure` as PNG and SVG of `size` (width, height) into `dir`; returns the paths.
 pub fn write(figure: &Figure, dir: &Path, size: (u32, u32)) -> Result<Vec<PathBuf>, FigureError> {
+    write_both(&figure.name, dir, size, |root| draw(root, figure), |root| draw(root, figure))
+}
+
+/// Writes `map` as PNG and SVG of `size` into `dir`; returns the paths.
+pub fn write_heat_map(map: &HeatMap, dir: &Path, size: (u32, u32)) -> Result<Vec<PathBuf>, FigureError> {
+    write_both(&map.name, dir, size, |root| draw_heat_map(root, map), |root| draw_heat_map(root, map))
+}
+
+type Png<'a> = DrawingArea<BitMapBackend<'a>, Shift>;
+type Svg<'a> = DrawingArea<SVGBackend<'a>, Shift>;
+
+fn write_both(
+    name: &str,
+    dir: &Path,
+    size: (u32, u32),
+    png: impl FnOnce(Png) -> Result<(), String>,
+    svg: impl FnOnce(Svg) -> Result<(), String>,
+) -> Result<Vec<PathBuf>, FigureError> {
     register_font();
     std::fs::create_dir_all(dir)
         .map_err(|e| FigureError { path: dir.display().to_string(), reason: e.to_string() })?;
     let mut written = vec![];
+    let (mut png, mut svg) = (Some(png), Some(svg));
     for ext in ["png", "svg"] {
-        let path = dir.join(format!("{}.{ext}", figure.name));
+        let path = dir.join(format!("{name}.{ext}"));
         // Drawn beside the target and renamed, so an interrupted run leaves no half figure.
-        let tmp = dir.join(format!(".{}.tmp.{ext}", figure.name));
+        let tmp = dir.join(format!(".{name}.tmp.{ext}"));
         let fail = |reason: String| FigureError { path: path.display().to_string(), reason };
         let drawn = if ext == "png" {
-            draw(BitMapBackend::new(&tmp, size).into_drawing_area(), figure)
+            (png.take().expect("once"))(BitMapBackend::new(&tmp, size).into_drawing_area())
         } else {
-            draw(SVGBackend::new(&tmp, size).into_drawing_area(), figure)
+            (svg.take().expect("once"))(SVGBackend::new(&tmp, size).into_drawing_area())
         };
         drawn.map_err(fail)?;
         std::fs::rename(&tmp, &path).map_err(|e| fail(e.to_string()))?;
         written.push(path);
     }
     Ok(written)
+}
+
+/// A design map: one metric over a grid of two parameters.
+#[derive(Debug, Clone)]
+pub struct HeatMap {
+    /// File stem.
+    pub name: String,
+    /// Title.
+    pub title: String,
+    /// First parameter (columns) and its values.
+    pub x: (String, Vec<f64>),
+    /// Second parameter (rows) and its values.
+    pub y: (String, Vec<f64>),
+    /// `z[row][column]`; `None` where the metric has no value (e.g. not settled).
+    pub z: Vec<Vec<Option<f64>>>,
+    /// The metric's name and unit.
+    pub z_desc: String,
+}
+
+fn draw_heat_map<DB: DrawingBackend>(root: DrawingArea<DB, Shift>, m: &HeatMap) -> Result<(), String> {
+    use plotters::style::colors::colormaps::{ColorMap, ViridisRGB};
+    let err = |e: DrawingAreaErrorKind<DB::ErrorType>| e.to_string();
+    root.fill(&WHITE).map_err(err)?;
+    let (w, h) = root.dim_in_pixel();
+    let text = (h / 40).clamp(10, 22);
+    let (plot, bar) = root.split_horizontally(w.saturating_sub((w / 5).max(110)));
+    let (nx, ny) = (m.x.1.len(), m.y.1.len());
+    let values = m.z.iter().flatten().flatten().copied().filter(|v| v.is_finite());
+    let (lo, hi) = values.fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), v| (a.min(v), b.max(v)));
+    let (lo, hi) = if lo.is_finite() { (lo, if hi > lo { hi } else { lo + 1.0 }) } else { (0.0, 1.0) };
+    let colour = |v: f64| ViridisRGB.get_color_normalized(v as f32, lo as f32, hi as f32);
+    let label = |values: &[f64], i: f64| {
+        let k = i.round();
+        if (i - k).abs() < 1e-9 && k >= 0.0 && (k as usize) < values.len() {
+            format!("{}", values[k as usize])
+        } else {
+            String::new()
+        }
+    };
+    let mut chart = ChartBuilder::on(&plot)
+        .caption(&m.title, ("sans-serif", text + 4))
+        .margin(text)
+        .x_label_area_size(text * 3)
+        .y_label_area_size((w / 10).clamp(40, 90))
+        .build_cartesian_2d(-0.5..nx as f64 - 0.5, -0.5..ny as f64 - 0.5)
+        .map_err(err)?;
+    chart
+        .configure_mesh()
+        .disable_mesh()
+        .x_labels(nx.min(12))
+        .y_labels(ny.min(12))
+        .x_label_formatter(&|i| label(&m.x.1, *i))
+        .y_label_formatter(&|i| label(&m.y.1, *i))
+        .x_desc(&m.x.0)
+        .y_desc(&m.y.0)
+        .label_style(("sans-serif", text))
+        .draw()
+        .map_err(err)?;
+    let cells = (0..ny).flat_map(|r| (0..nx).map(move |c| (r, c)));
+    chart
+        .draw_series(cells.map(|(r, c)| {
+            let (x, y) = (c as f64, r as f64);
+            let style = match m.z[r][c] {
+                Some(v) if v.is_finite() => colour(v).filled(),
+                _ => RGBColor(200, 200, 200).filled(),
+            };
+            Rectangle::new([(x - 0.5, y - 0.5), (x + 0.5, y + 0.5)], style)
+        }))
+        .map_err(err)?;
+    // Colour bar: the metric's range, bottom to top; grey means no value.
+    let mut scale = ChartBuilder::on(&bar)
+        .margin(text)
+        .margin_top(text * 3)
+        .y_label_area_size((w / 14).clamp(40, 70))
+        .caption(&m.z_desc, ("sans-serif", text))
+        .build_cartesian_2d(0.0..1.0, lo..hi)
+        .map_err(err)?;
+    scale.configure_mesh().disable_mesh().disable_x_axis().label_style(("sans-serif", text)).draw().map_err(err)?;
+    let steps = 100;
+    scale
+        .draw_series((0..steps).map(|k| {
+            let a = lo + (hi - lo) * k as f64 / steps as f64;
+            let b = lo + (hi - lo) * (k + 1) as f64 / steps as f64;
+            Rectangle::new([(0.0, a), (1.0, b)], colour(0.5 * (a + b)).filled())
+        }))
+        .map_err(err)?;
+    root.present().map_err(|e| e.to_string())
 }
 
 fn draw<DB: DrawingBackend>(root: DrawingArea<DB, Shift>, f: &Figure) -> Result<(), String> {
@@ -222,6 +328,23 @@ pub fn sweep_curves(parameter: &str, runs: &[(String, Run)]) -> Figure {
             .map(|(value, r)| Curve { label: format!("{parameter} = {value}"), x: r.series.t.clone(), y: scaled(&r.series.xs, 1e3) })
             .collect(),
         points: false,
+    }
+}
+
+/// Frequency response: steady amplitude of `xs` against forcing frequency, with and without
+/// the damper.
+pub fn frf_chart(points: &[crate::frf::FrfPoint], scene: &str, model: &str) -> Figure {
+    let f: Vec<f64> = points.iter().map(|p| p.frequency).collect();
+    Figure {
+        name: "frf".into(),
+        title: format!("{scene}: steady amplitude ({model})"),
+        x_desc: "forcing frequency (Hz)".into(),
+        y_desc: "amplitude of xs (mm)".into(),
+        curves: vec![
+            Curve { label: "with damper".into(), x: f.clone(), y: points.iter().map(|p| p.amplitude * 1e3).collect() },
+            Curve { label: "without damper".into(), x: f, y: points.iter().map(|p| p.amplitude_no_damper * 1e3).collect() },
+        ],
+        points: true,
     }
 }
 

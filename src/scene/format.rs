@@ -156,6 +156,10 @@ pub struct SweepFile {
     pub parameter: String,
     /// The values, in the parameter's unit (lengths may be `"1 Rr"`).
     pub values: Vec<Length>,
+    /// A second parameter: the sweep becomes a grid (a design map).
+    pub parameter_y: Option<String>,
+    /// The second parameter's values.
+    pub values_y: Option<Vec<Length>>,
 }
 
 /// `[chain]`: the KER experiment of MODEL.md §6.
@@ -244,6 +248,10 @@ impl std::fmt::Display for Length {
 }
 
 impl Length {
+    /// Parses `"<k> Rr"` (or `"<k>Rr"`).
+    pub fn try_from_text(s: &str) -> Option<Length> {
+        parse_rr(s)
+    }
     /// The length in metres for reference radius `rr`.
     pub fn metres(self, rr: f64) -> f64 {
         match self {

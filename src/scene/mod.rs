@@ -394,17 +394,29 @@ pub fn from_file(parsed: SceneFile, file: &str, default_name: &str) -> Result<Lo
         if sweep.values.is_empty() {
             return Err(v.err("sweep.values", "is empty: give at least one value"));
         }
-        for (i, value) in sweep.values.iter().enumerate() {
-            let varied = apply_sweep_value(&parsed, &sweep.parameter, *value)
-                .map_err(|rule| v.err("sweep.parameter", &rule))?;
-            build_damper(&varied, &name, &v).map_err(|e| match e {
-                SceneError::Invalid { file, field, rule } => SceneError::Invalid {
-                    file,
-                    field: format!("sweep.values[{i}] (as {field})"),
-                    rule,
-                },
-                other => other,
-            })?;
+        let second = match (&sweep.parameter_y, &sweep.values_y) {
+            (Some(p), Some(values)) if !values.is_empty() => Some((p, values)),
+            (Some(_), Some(_)) => return Err(v.err("sweep.values_y", "is empty: give at least one value")),
+            (None, None) => None,
+            (Some(_), None) => return Err(v.err("sweep.values_y", "is missing: `parameter_y` needs its values")),
+            (None, Some(_)) => return Err(v.err("sweep.parameter_y", "is missing: `values_y` needs its parameter")),
+        };
+        // Each value alone must make a valid scene (a grid's combinations are checked when run).
+        let axes = std::iter::once(("sweep.parameter", "sweep.values", &sweep.parameter, &sweep.values))
+            .chain(second.map(|(p, values)| ("sweep.parameter_y", "sweep.values_y", p, values)));
+        for (parameter_field, values_field, parameter, values) in axes {
+            for (i, value) in values.iter().enumerate() {
+                let varied =
+                    apply_sweep_value(&parsed, parameter, *value).map_err(|rule| v.err(parameter_field, &rule))?;
+                build_damper(&varied, &name, &v).map_err(|e| match e {
+                    SceneError::Invalid { file, field, rule } => SceneError::Invalid {
+                        file,
+                        field: format!("{values_field}[{i}] (as {field})"),
+                        rule,
+                    },
+                    other => other,
+                })?;
+            }
         }
     } else if parsed.sweep.is_some() {
         return Err(v.err("sweep", "needs a damper scene ([frame] and [balls])"));

@@ -1,0 +1,148 @@
+//! Frequency response (`lpc frf`): the steady-state amplitude of `xs` against the forcing
+//! frequency, with and without the damper, every frequency run in parallel.
+//!
+//! Steady state is detected from the runs themselves: the peaks of `|xs|` in consecutive
+//! forcing periods are grouped in blocks of [`BLOCK_PERIODS`]; the response is steady when the
+//! last two blocks' mean peaks agree within [`STEADY_TOLERANCE`] and the last block's peaks
+//! spread by no more than twice that. Until then the horizon doubles (up to
+//! [`MAX_DOUBLINGS`] times). A response that never settles (impact dampers can respond
+//! chaotically near resonance) is reported with `steady = false`; its amplitude is then the
+//! largest peak of the last block, the worst case an engineer sizes for.
+
+use rayon::prelude::*;
+use serde::{Deserialize, Serialize};
+
+use crate::model::{Model, ModelError};
+use crate::run::Run;
+use crate::scene::Scene;
+
+/// Forcing periods per block of peaks.
+pub const BLOCK_PERIODS: usize = 10;
+/// Relative agreement of the last two blocks' mean peaks that counts as steady.
+pub const STEADY_TOLERANCE: f64 = 0.01;
+/// Times the horizon may double while the response is still transient.
+pub const MAX_DOUBLINGS: u32 = 3;
+/// Samples per forcing period (the peak of a sine sampled so is within 5e-4 of the true one).
+pub const SAMPLES_PER_PERIOD: f64 = 100.0;
+
+/// One frequency of the response (the JSON contract of `lpc frf`).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct FrfPoint {
+    /// Forcing frequency, Hz.
+    pub frequency: f64,
+    /// Steady amplitude of `xs` with the damper, m.
+    pub amplitude: f64,
+    /// Steady amplitude of `xs` of the bare frame, m.
+    pub amplitude_no_damper: f64,
+    /// Whether the response with the damper reached a steady state.
+    pub steady: bool,
+    /// Whether the bare frame's did.
+    pub steady_no_damper: bool,
+    /// Simulated time used with the damper, s.
+    pub horizon: f64,
+}
+
+/// The steady-state reading of one run.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct SteadyState {
+    /// Amplitude, m: the mean peak of the last block when steady, its largest peak otherwise.
+    pub amplitude: f64,
+    /// Whether the criterion holds.
+    pub steady: bool,
+}
+
+/// Reads the steady amplitude of `run`, forced with period `period`.
+pub fn steady_state(run: &Run, period: f64) -> SteadyState {
+    let s = &run.series;
+    let periods = (run.horizon / period).floor() as usize;
+    let mut peaks = vec![0.0f64; periods];
+    for (t, x) in s.t.iter().zip(&s.xs) {
+        let k = (t / period) as usize;
+        if k < periods {
+            peaks[k] = peaks[k].max(x.abs());
+        }
+    }
+    if periods < 2 * BLOCK_PERIODS {
+        let amplitude = peaks.iter().fold(0.0, |m: f64, p| m.max(*p));
+        return SteadyState { amplitude, steady: false };
+    }
+    let last = &peaks[periods - BLOCK_PERIODS..];
+    let before = &peaks[periods - 2 * BLOCK_PERIODS..periods - BLOCK_PERIODS];
+    let mean = |b: &[f64]| b.iter().sum::<f64>() / b.len() as f64;
+    let (m1, m0) = (mean(last), mean(before));
+    let max = last.iter().fold(0.0, |m: f64, p| m.max(*p));
+    let min = last.iter().fold(f64::INFINITY, |m: f64, p| m.min(*p));
+    let scale = m1.max(f64::MIN_POSITIVE);
+    let steady = (m1 - m0).abs() <= STEADY_TOLERANCE * scale && max - min <= 2.0 * STEADY_TOLERANCE * scale;
+    SteadyState { amplitude: if steady { m1 } else { max }, steady }
+}
+
+/// The scene forced at `frequency`, sampled finely enough to read peaks, over at least
+/// `2 BLOCK_PERIODS` periods plus three decay times of the bare frame.
+pub fn forced_at(scene: &Scene, frequency: f64) -> Scene {
+    let mut s = scene.clone();
+    let g = s.forcing.as_mut().expect("a forced scene");
+    g.frequency = frequency;
+    let period = 1.0 / frequency;
+    let decay = s.frame.map_or(0.0, |f| if f.damping > 0.0 { 3.0 * 2.0 * f.mass / f.damping } else { 0.0 });
+    s.horizon = s.horizon.max(4.0 * BLOCK_PERIODS as f64 * period).max(decay);
+    s.sample_dt = s.sample_dt.min(period / SAMPLES_PER_PERIOD);
+    s.name = format!("{}[f={frequency} Hz]", scene.name);
+    s
+}
+
+/// Runs `scene` with `model` until its response is steady (or the horizon has doubled
+/// [`MAX_DOUBLINGS`] times); returns the reading and the horizon used.
+pub fn steady_run(scene: &Scene, model: Model) -> Result<(SteadyState, f64), ModelError> {
+    let period = 1.0 / scene.forcing.expect("a forced scene").frequency;
+    let mut s = scene.clone();
+    for doubling in 0..=MAX_DOUBLINGS {
+        let run = model.simulate(&s)?;
+        let reading = steady_state(&run, period);
+        if reading.steady || doubling == MAX_DOUBLINGS {
+            return Ok((reading, s.horizon));
+        }
+        s.horizon *= 2.0;
+    }
+    unreachable!("the loop returns on its last pass")
+}
+
+/// `steps` frequencies evenly spaced from `from` to `to` (just `from` when `steps` is 1).
+pub fn frequencies(from: f64, to: f64, steps: usize) -> Vec<f64> {
+    if steps <= 1 {
+        return vec![from];
+    }
+    (0..steps).map(|k| from + (to - from) * k as f64 / (steps - 1) as f64).collect()
+}
+
+/// The frequency response of `scene` (which must be forced) at each frequency, with and
+/// without the damper, in parallel; `progress` is called after each run.
+pub fn frf(scene: &Scene, frequencies: &[f64], model: Model, progress: &(dyn Fn() + Sync)) -> Result<Vec<FrfPoint>, ModelError> {
+    let bare = scene.without_damper();
+    let jobs: Vec<(usize, bool)> = (0..frequencies.len()).flat_map(|k| [(k, true), (k, false)]).collect();
+    let results: Vec<(SteadyState, f64)> = jobs
+        .par_iter()
+        .map(|&(k, damper)| {
+            let base = if damper { scene } else { &bare };
+            let r = steady_run(&forced_at(base, frequencies[k]), model);
+            progress();
+            r
+        })
+        .collect::<Result<_, _>>()?;
+    Ok(frequencies
+        .iter()
+        .enumerate()
+        .map(|(k, &frequency)| {
+            let (with, horizon) = results[2 * k];
+            let (without, _) = results[2 * k + 1];
+            FrfPoint {
+                frequency,
+                amplitude: with.amplitude,
+                amplitude_no_damper: without.amplitude,
+                steady: with.steady,
+                steady_no_damper: without.steady,
+                horizon,
+            }
+        })
+        .collect())
+}
