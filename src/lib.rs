@@ -24,6 +24,7 @@ pub mod compare;
 pub mod frf;
 pub mod metrics;
 pub mod model;
+pub mod optimize;
 pub mod oscillator;
 pub mod output;
 pub mod rapier;

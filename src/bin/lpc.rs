@@ -33,6 +33,9 @@ enum Command {
     /// Frequency response: steady amplitude of xs against forcing frequency, with and without
     /// the damper (needs a [forcing] table, or --kind and --amplitude).
     Frf(FrfArgs),
+    /// Find the design (arrangement and parameters) with the shortest settling time or the
+    /// lowest resonant amplitude inside a given container length.
+    Optimize(OptimizeArgs),
     /// The chain experiment (Fig. 5): kinetic energy ratio against the number of large balls.
     Chain(ChainArgs),
     /// Run several models on one scene and report each one's errors against the reference.
@@ -294,6 +297,48 @@ struct FrfArgs {
     rapier: RapierArgs,
 }
 
+#[derive(clap::Args)]
+struct OptimizeArgs {
+    /// Scene file (its [balls] table is the starting design).
+    scene: PathBuf,
+    /// Inner container length (m, or `<k> Rr`); default: the scene's.
+    #[arg(long)]
+    container_length: Option<String>,
+    /// A design parameter and its range: `PARAM=A..B:N` or `PARAM=V1,V2,...` (repeatable).
+    #[arg(long = "vary")]
+    vary: Vec<String>,
+    /// Ball arrangements to try, comma-separated (default: the scene's).
+    #[arg(long)]
+    arrangements: Option<String>,
+    /// What to minimise.
+    #[arg(long, value_enum, default_value_t = ObjectiveArg::SettlingTime)]
+    objective: ObjectiveArg,
+    /// Frequency range `A..B` in Hz for the resonant amplitude.
+    #[arg(long)]
+    freq: Option<String>,
+    /// Frequencies over that range.
+    #[arg(long, default_value_t = 9)]
+    steps: usize,
+    /// Refinements around the best grid point.
+    #[arg(long, default_value_t = 2)]
+    refinements: u32,
+    /// Model to run.
+    #[arg(long, default_value = "reference")]
+    model: Model,
+    /// Designs listed in the text output.
+    #[arg(long, default_value_t = 10)]
+    top: usize,
+    /// Output format on standard output.
+    #[arg(long, value_enum, default_value_t = Format::Text)]
+    format: Format,
+}
+
+#[derive(Clone, Copy, ValueEnum)]
+enum ObjectiveArg {
+    SettlingTime,
+    ResonantAmplitude,
+}
+
 #[derive(Clone, Copy, ValueEnum)]
 enum ForcingKindArg {
     Force,
@@ -382,6 +427,7 @@ fn main() -> ExitCode {
         Command::Run(a) => cmd_run(a),
         Command::Sweep(a) => cmd_sweep(a),
         Command::Frf(a) => cmd_frf(a),
+        Command::Optimize(a) => cmd_optimize(a),
         Command::Chain(a) => cmd_chain(a),
         Command::Compare(a) => cmd_compare(a),
         Command::Bench(a) => cmd_bench(a),
@@ -640,6 +686,86 @@ fn cmd_frf(a: FrfArgs) -> Result<()> {
             }
             if let Some(dir) = &a.out {
                 println!("wrote frf.json, frf.csv, frf.png, frf.svg to {}", dir.display());
+            }
+        }
+    }
+    Ok(())
+}
+
+fn cmd_optimize(a: OptimizeArgs) -> Result<()> {
+    use lpc_damper::optimize::{optimize, Objective};
+    let loaded = scene::load(&a.scene)?;
+    let invalid = |field: &str, rule: String| SceneError::Invalid { file: a.scene.display().to_string(), field: field.into(), rule };
+    let Some(base) = loaded.scene.clone() else {
+        return Err(invalid("frame", "is missing: a design needs a damper scene".into()).into());
+    };
+    let length = match &a.container_length {
+        Some(text) => match text.trim().parse::<f64>() {
+            Ok(x) if x.is_finite() && x > 0.0 => scene::Length::Metres(x),
+            _ => scene::Length::try_from_text(text)
+                .ok_or_else(|| invalid("--container-length", format!("`{text}` is not a positive length (m or `<k> Rr`)")))?,
+        },
+        None => scene::Length::Metres(base.container.map_or(0.0, |c| c.length)),
+    };
+    let axes = a
+        .vary
+        .iter()
+        .map(|v| lpc_damper::sweep::parse_axis(v).map_err(|rule| invalid("--vary", rule)))
+        .collect::<Result<Vec<_>, _>>()?;
+    let arrangements: Vec<String> = match &a.arrangements {
+        Some(list) => list.split(',').map(|s| s.trim().to_string()).filter(|s| !s.is_empty()).collect(),
+        None => match &loaded.file.balls.as_ref().map(|b| b.arrangement.clone()) {
+            Some(scene::Arrangement::Letters(l)) => vec![l.clone()],
+            _ => return Err(invalid("--arrangements", "is needed: the scene lists its balls explicitly".into()).into()),
+        },
+    };
+    if arrangements.is_empty() {
+        return Err(invalid("--arrangements", "is empty".into()).into());
+    }
+    let objective = match a.objective {
+        ObjectiveArg::SettlingTime => Objective::SettlingTime,
+        ObjectiveArg::ResonantAmplitude => {
+            let text = a.freq.as_deref().ok_or_else(|| invalid("--freq", "is needed for the resonant amplitude".into()))?;
+            let (from, to) = parse_range(text, &a.scene, "--freq")?;
+            Objective::ResonantAmplitude { from, to, steps: a.steps.max(1) }
+        }
+    };
+    let bar = progress_bar(usize::MAX >> 1, "designs");
+    bar.set_style(ProgressStyle::with_template("{msg} {pos} ({elapsed})").expect("valid template"));
+    let start = std::time::Instant::now();
+    let search = optimize(&loaded, &axes, &arrangements, length, objective, a.model, a.refinements, &|| bar.inc(1))
+        .map_err(|e| match e {
+            lpc_damper::optimize::OptimizeError::Scene(s) => anyhow::Error::from(s),
+            lpc_damper::optimize::OptimizeError::Model(m) => anyhow::Error::from(m),
+        })?;
+    bar.finish_and_clear();
+    match a.format {
+        Format::Json => print_json(&search)?,
+        Format::Text => {
+            let unit = match objective {
+                Objective::SettlingTime => "settling time s",
+                Objective::ResonantAmplitude { .. } => "resonant amplitude mm",
+            };
+            let scale = if matches!(objective, Objective::SettlingTime) { 1.0 } else { 1e3 };
+            println!(
+                "{} designs evaluated in {:.2} s ({} infeasible: balls do not fit {length}); container length fixed",
+                search.ranking.len() + search.infeasible,
+                start.elapsed().as_secs_f64(),
+                search.infeasible
+            );
+            println!("{:>12} {:>12} {:>22}  parameters", "arrangement", "clearance mm", unit);
+            for d in search.ranking.iter().take(a.top) {
+                let params = d.values.iter().map(|(p, v)| format!("{p}={v}")).collect::<Vec<_>>().join(" ");
+                println!(
+                    "{:>12} {:>12.3} {:>22}  {params}",
+                    d.arrangement,
+                    d.clearance * 1e3,
+                    d.objective.map_or("not settled".into(), |x| format!("{:.4}", x * scale))
+                );
+            }
+            match &search.best {
+                Some(b) => println!("best: {} with {}", b.arrangement, b.values.iter().map(|(p, v)| format!("{p}={v}")).collect::<Vec<_>>().join(" ")),
+                None => println!("no feasible design settled"),
             }
         }
     }

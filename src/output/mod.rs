@@ -7,7 +7,7 @@ pub mod plot;
 
 use serde::{Deserialize, Serialize};
 
-use crate::metrics::{metrics, Metrics};
+use crate::metrics::{metrics, noise, Metrics, Noise};
 use crate::run::Run;
 use crate::scene::Scene;
 
@@ -68,6 +68,9 @@ pub struct RunSummary {
     pub metrics: Metrics,
     /// Energy account.
     pub energy: EnergySummary,
+    /// Noise proxy: impact rate, energy lost, approach speed and peak force per impact.
+    #[serde(default)]
+    pub noise: Noise,
     /// Computing time, s.
     pub wall_time_s: f64,
 }
@@ -101,9 +104,22 @@ impl RunSummary {
                 forcing_work: run.energy.forcing_work,
                 balance_error: run.energy.balance_error,
             },
+            noise: noise(run),
             wall_time_s: run.wall_time_s,
         }
     }
+}
+
+fn noise_line(n: &Noise) -> String {
+    let Some(e) = n.energy_lost else { return "no impacts".into() };
+    let mut line = format!(
+        "{:.1} impacts/s; energy lost per impact mean {:.3e} J, p95 {:.3e} J, max {:.3e} J",
+        n.impact_rate, e.mean, e.p95, e.max
+    );
+    if let Some(f) = n.peak_force {
+        line += &format!("; peak force mean {:.1} N, p95 {:.1} N, max {:.1} N", f.mean, f.p95, f.max);
+    }
+    line
 }
 
 /// A readable multi-line summary of a run.
@@ -119,7 +135,8 @@ pub fn text_summary(s: &RunSummary) -> String {
          rms displacement   {:.4} mm\n\
          settling time      {}\n\
          energy remaining   {}\n\
-         energy (J)         initial {:.6e} = final {:.6e} + damping {:.6e} + impacts {:.6e} (balance error {:.1e})\n",
+         energy (J)         initial {:.6e}{} = final {:.6e} + damping {:.6e} + impacts {:.6e} (balance error {:.1e})\n\
+         noise proxy        {}\n",
         s.scene,
         s.model,
         s.horizon,
@@ -131,9 +148,11 @@ pub fn text_summary(s: &RunSummary) -> String {
         opt(m.settling_time, "s", 1.0),
         opt(m.energy_remaining.map(|x| x * 100.0), "%", 1.0),
         e.initial,
+        if e.forcing_work != 0.0 { format!(" + forcing {:.6e}", e.forcing_work) } else { String::new() },
         e.final_,
         e.damping_loss,
         e.impact_loss,
         e.balance_error,
+        noise_line(&s.noise),
     )
 }
