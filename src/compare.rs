@@ -17,7 +17,8 @@ pub struct Errors {
     pub max_xs_early: f64,
     /// `settling_time - settling_time_ref`, s; `null` when either run has not settled.
     pub settling_time_diff: Option<f64>,
-    /// `(impact_loss - impact_loss_ref) / initial energy`.
+    /// `(impact_loss - impact_loss_ref) / energy put in` (the initial energy, plus the
+    /// reference's forcing work when forced).
     pub impact_loss_diff: f64,
     /// `impact_count - impact_count_ref`.
     pub impact_count_diff: i64,
@@ -41,7 +42,8 @@ pub fn errors(run: &Run, reference: &Run) -> Errors {
         }
     }
     let (ma, mr) = (metrics(run), metrics(reference));
-    let initial = if reference.energy.initial != 0.0 { reference.energy.initial } else { 1.0 };
+    let put_in = reference.energy.initial.abs() + reference.energy.forcing_work.abs();
+    let initial = if put_in != 0.0 { put_in } else { 1.0 };
     Errors {
         rms_xs: if len > 0 { (sq / len as f64).sqrt() } else { 0.0 },
         max_xs_early: early,

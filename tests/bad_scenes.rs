@@ -147,3 +147,19 @@ fn every_shipped_scene_is_valid() {
         lpc_damper::scene::load(&p).unwrap_or_else(|e| panic!("{}: {e}", p.display()));
     }
 }
+
+#[test]
+fn impossible_forcing_and_material() {
+    let forced = |body: &str| format!("{GOOD}\n[forcing]\n{body}\n");
+    expect_error(&forced("kind = \"force\"\namplitude = -1.0\nfrequency = 4.0"), &[], "forcing.amplitude", "negative");
+    expect_error(&forced("kind = \"force\"\namplitude = 1.0\nfrequency = 0.0"), &[], "forcing.frequency", "positive");
+    expect_error(&forced("kind = \"force\"\namplitude = nan\nfrequency = 4.0"), &[], "forcing.amplitude", "finite");
+    expect_error(&forced("kind = \"shake\"\namplitude = 1.0\nfrequency = 4.0"), &[], "kind", "unknown variant");
+    // An undamped frame driven exactly at its natural frequency sqrt(865/1.35)/2pi.
+    let undamped = with("damping", "0.0");
+    let f0 = (865.0f64 / 1.35).sqrt() / (2.0 * std::f64::consts::PI);
+    let resonant = format!("{undamped}\n[forcing]\nkind = \"force\"\namplitude = 1.0\nfrequency = {f0:?}\n");
+    expect_error(&resonant, &[], "forcing.frequency", "resonance");
+    expect_error(&format!("{GOOD}\n[compliant]\npoisson_ratio = 0.5\n"), &[], "compliant.poisson_ratio", "(-1, 0.5)");
+    expect_error(&format!("{GOOD}\n[compliant]\nyoungs_modulus = -2e11\n"), &[], "compliant.youngs_modulus", "positive");
+}
