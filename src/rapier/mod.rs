@@ -39,10 +39,30 @@ pub const DEFAULT_SOLVER_ITERATIONS: usize = 4;
 /// a step, which must stay close to the frame's true path.
 pub const STEPS_PER_FRAME_PERIOD: f64 = 40.0;
 
+/// Largest gap between the straight path Rapier gives the walls over a step and the frame's
+/// true path, m: a fifth of Rapier's allowed contact error (`0.005 length_unit`), so that the
+/// walls a ball meets are where the frame is.
+pub const WALL_CHORD_ERROR: f64 = 1e-5;
+
+/// The frame's largest acceleration to expect: its spring at the larger of the initial
+/// displacement and the steady forced amplitude, plus the excitation's load, m/s^2.
+pub fn peak_frame_acceleration(scene: &Scene) -> f64 {
+    let Some(f) = scene.frame else { return 0.0 };
+    let steady = scene.harmonic_load().map_or(0.0, |(p, q, w)| {
+        crate::oscillator::Oscillator::new(f.mass, f.damping, f.stiffness).harmonic_response(p, q, w).amplitude()
+    });
+    let load = scene.harmonic_load().map_or(0.0, |(p, q, _)| p.hypot(q));
+    (f.stiffness * scene.initial_displacement.abs().max(steady) + load) / f.mass
+}
+
 /// The stepping a scene asks for, with the defaults filled in and the step kept inside the
-/// stable region: at most a 40th of the frame's natural period, and of the forcing period.
+/// stable region: at most a 40th of the frame's natural period and of the forcing period, and
+/// short enough that the walls' straight path over a step stays within [`WALL_CHORD_ERROR`]
+/// of the frame's (`a h^2 / 8`).
 pub fn settings(scene: &Scene) -> StepSettings {
     let dt = scene.rapier.dt.unwrap_or(DEFAULT_DT);
+    let a = peak_frame_acceleration(scene);
+    let chord_bound = if a > 0.0 { (8.0 * WALL_CHORD_ERROR / a).sqrt() } else { f64::INFINITY };
     let forcing_bound = scene.forcing.map_or(f64::INFINITY, |g| 1.0 / (g.frequency * STEPS_PER_FRAME_PERIOD));
     let period_bound = scene
         .frame
@@ -51,7 +71,7 @@ pub fn settings(scene: &Scene) -> StepSettings {
         .min(forcing_bound);
     StepSettings {
         stepping: scene.rapier.stepping.unwrap_or(DEFAULT_STEPPING),
-        dt: dt.min(period_bound),
+        dt: dt.min(period_bound).min(chord_bound),
         solver_iterations: scene.rapier.solver_iterations.map_or(DEFAULT_SOLVER_ITERATIONS, |i| i as usize),
         ccd: scene.rapier.ccd.unwrap_or(false),
         speculative_margin: true,

@@ -141,6 +141,21 @@ pub fn feedback(
         x_new.push(body.translation().x as f64);
         v_new.push(body.linvel().x as f64);
     }
+    // Rapier's contacts are soft: a ball pressed by an accelerating wall or a loaded chain
+    // sinks past the allowed error. Project it back (positions only: no energy changes).
+    if let (Some(c), Some(f)) = (scene.container, frame.as_ref()) {
+        if project_inside(x_new, &scene.balls, f.before_impulses.0, c.length) {
+            for (i, &h) in handles.iter().enumerate() {
+                let body = &mut set.bodies[h];
+                let mut p = body.translation();
+                if p.x as f64 != x_new[i] {
+                    p.x = x_new[i] as f32;
+                    body.set_translation(p, false);
+                    x_new[i] = p.x as f64;
+                }
+            }
+        }
+    }
     let mass = |i: usize| scene.balls[i].mass;
     let impulses = |v_new: &[f64], v_old: &[f64], dp: &mut Vec<f64>, active: &[bool], j: &mut Vec<f64>| {
         dp.clear();
@@ -249,6 +264,20 @@ pub fn feedback(
             rec.x[body as usize] + if right { r } else { -r }
         }
     };
+    // Each pair's share of the step's loss, `j (u + u') / 2`; the shares sum to the step's
+    // loss. Rapier solves touching contacts together, and the split of one simultaneous solve
+    // among its pairs is not physical (a pair can appear to gain while the step loses): when
+    // the step loses energy, it is shared among the pairs that lost, in proportion.
+    let share = |p: usize| {
+        let (a, b) = (p as isize - 1, p as isize);
+        let u = vel(&rec.v, frame_pre, a) - vel(&rec.v, frame_pre, b);
+        let u_after = vel(v_new, frame_post, a) - vel(v_new, frame_post, b);
+        j[p] * 0.5 * (u + u_after)
+    };
+    let shares: Vec<f64> = (0..=n).map(share).collect();
+    let total: f64 = shares.iter().sum();
+    let gross: f64 = shares.iter().filter(|x| **x > 0.0).sum();
+    let split = total >= 0.0 && gross > 0.0 && shares.iter().any(|x| *x < 0.0);
     for p in 0..=n {
         let (a, b) = (p as isize - 1, p as isize);
         if !active[p] && j[p] == 0.0 {
@@ -256,8 +285,7 @@ pub fn feedback(
             continue;
         }
         let u = vel(&rec.v, frame_pre, a) - vel(&rec.v, frame_pre, b);
-        let u_after = vel(v_new, frame_post, a) - vel(v_new, frame_post, b);
-        let lost = j[p] * 0.5 * (u + u_after);
+        let lost = if split { shares[p].max(0.0) * total / gross } else { shares[p] };
         let starts = j[p] > rec.impulse_floor && rec.last_impulse[p] <= rec.impulse_floor && u > 0.0;
         if starts {
             let gap = edge(b, false) - edge(a, true);
@@ -284,6 +312,41 @@ pub fn feedback(
     std::mem::swap(&mut rec.prev_v, &mut rec.v);
     rec.x.clone_from(x_new);
     rec.v.clone_from(v_new);
+}
+
+/// Overlap a projected contact keeps: Rapier's allowed error (`0.005 length_unit`), less the
+/// walls' chord error within a step, so that samples inside a step stay within the allowed error.
+pub const PROJECTED_OVERLAP: f64 = 0.005 * super::plugin::LENGTH_UNIT as f64 - super::WALL_CHORD_ERROR;
+/// Deepest overlap projected back, as a fraction of the ball's radius: anything deeper is a
+/// failure of the contact model and is left for the checks to see.
+pub const MAX_PROJECTION: f64 = 0.25;
+
+/// Moves balls that overlap a wall (at `left` and `left + length`) or a neighbour by more than
+/// [`PROJECTED_OVERLAP`] (and at most [`MAX_PROJECTION`] of the radius) back to that overlap:
+/// a sweep from the left wall, then one from the right. Returns whether any ball moved.
+pub fn project_inside(x: &mut [f64], balls: &[crate::scene::Ball], left: f64, length: f64) -> bool {
+    let mut moved = false;
+    let mut edge = left;
+    for (i, b) in balls.iter().enumerate() {
+        let lowest = edge + b.radius - PROJECTED_OVERLAP;
+        let depth = lowest - x[i];
+        if depth > 0.0 && depth <= MAX_PROJECTION * b.radius {
+            x[i] = lowest;
+            moved = true;
+        }
+        edge = x[i] + b.radius;
+    }
+    let mut edge = left + length;
+    for (i, b) in balls.iter().enumerate().rev() {
+        let highest = edge - b.radius + PROJECTED_OVERLAP;
+        let depth = x[i] - highest;
+        if depth > 0.0 && depth <= MAX_PROJECTION * b.radius {
+            x[i] = highest;
+            moved = true;
+        }
+        edge = x[i] - b.radius;
+    }
+    moved
 }
 
 fn body_of(body: isize, n: usize) -> Body {
