@@ -394,6 +394,8 @@ struct Driver<'s, 'a> {
     contacts: Vec<Option<Contact>>,
     v_max: Vec<f64>,
     scale: Vec<f64>,
+    /// Scratch state for samples.
+    buf: Vec<f64>,
     impacts: Vec<Impact>,
     series: Series,
     next_sample: usize,
@@ -421,6 +423,7 @@ impl<'s, 'a> Driver<'s, 'a> {
             t: 0.0,
             dy: vec![0.0; y.len()],
             scale: vec![f64::INFINITY; y.len()],
+            buf: vec![0.0; y.len()],
             y,
             contacts: vec![None; sys.pairs.len()],
             v_max: vec![0.0; sys.pairs.len()],
@@ -433,20 +436,30 @@ impl<'s, 'a> Driver<'s, 'a> {
         }
     }
 
+    /// Attempts a step of length `h` from the current state.
+    fn attempt(&mut self, h: f64) {
+        let (sys, v_max) = (self.sys, &self.v_max);
+        let mut f = |t: f64, y: &[f64], dy: &mut [f64]| sys.rhs(t, y, dy, v_max);
+        self.rk.step(&mut f, self.t, &self.y, &self.dy, h);
+    }
+
     fn derivative(&mut self) {
         let (sys, v_max) = (self.sys, &self.v_max);
         sys.rhs(self.t, &self.y, &mut self.dy, v_max);
     }
 
     /// Opens contacts of pairs that overlap, or touch and approach, and closes those that no
-    /// longer overlap, at the current time. Returns whether anything changed.
-    fn update_contacts(&mut self) -> bool {
+    /// longer overlap, at the current time; pair `event` (whose crossing was just located, its
+    /// overlap now zero to round-off) changes state whatever the sign of that round-off.
+    /// Returns whether anything changed.
+    fn update_contacts(&mut self, event: Option<usize>) -> bool {
         let sys = self.sys;
         let mut changed = false;
         for (q, pair) in sys.pairs.iter().enumerate() {
             let (d, rate) = sys.overlap(pair, |i| self.y[i]);
+            let toggle = event == Some(q);
             match self.contacts[q] {
-                None if d > 0.0 || (d == 0.0 && rate > 0.0) => {
+                None if toggle || d > 0.0 || (d == 0.0 && rate > 0.0) => {
                     self.contacts[q] = Some(Contact {
                         onset: self.t,
                         v_max: rate.max(0.0),
@@ -456,7 +469,7 @@ impl<'s, 'a> Driver<'s, 'a> {
                     self.v_max[q] = rate.max(0.0);
                     changed = true;
                 }
-                Some(c) if d <= 0.0 => {
+                Some(c) if toggle || d <= 0.0 => {
                     self.close(q, c);
                     changed = true;
                 }
@@ -550,15 +563,15 @@ impl<'s, 'a> Driver<'s, 'a> {
     /// The earliest point of the last step where a pair's contact state changes: the first
     /// scan point where an open pair's overlap is no longer positive, or a closed pair's is,
     /// refined to the crossing.
-    fn first_event(&self) -> Option<f64> {
+    fn first_event(&self) -> Option<(f64, usize)> {
         let sys = self.sys;
         let rk = &self.rk;
-        let mut earliest: Option<f64> = None;
+        let mut earliest: Option<(f64, usize)> = None;
         for (q, pair) in sys.pairs.iter().enumerate() {
             let open = self.contacts[q].is_some();
             let overlap = |th: f64| sys.overlap(pair, |i| rk.dense_component(i, th)).0;
             let crossed = |d: f64| if open { d <= 0.0 } else { d > 0.0 };
-            let limit = earliest.unwrap_or(1.0);
+            let limit = earliest.map_or(1.0, |e| e.0);
             let mut prev = 0.0;
             for j in 1..=SCAN_POINTS {
                 let th = (j as f64 / SCAN_POINTS as f64).min(limit);
@@ -569,8 +582,8 @@ impl<'s, 'a> Driver<'s, 'a> {
                         // Sign of g follows "crossed": the root returned lies on the crossed side.
                         bracketed_root(|x| if crossed(overlap(x)) { 1.0 } else { -1.0 } * overlap(x).abs().max(f64::MIN_POSITIVE), prev, th, 1e-15)
                     };
-                    if earliest.is_none_or(|e| root < e) {
-                        earliest = Some(root);
+                    if earliest.is_none_or(|e| root < e.0) {
+                        earliest = Some((root, q));
                     }
                     break;
                 }
@@ -647,12 +660,12 @@ impl<'s, 'a> Driver<'s, 'a> {
         changed
     }
 
-    /// Writes every sample with time `<=` the current time; `theta_of(ts)` maps a sample time
-    /// to the last step's dense output.
+    /// Writes every sample with time `<=` the current time, between steps from the last
+    /// step's dense output (it started at `step_t0` and was `step_h` long).
     fn sample(&mut self, step_t0: f64, step_h: f64, dense: bool) {
         let sys = self.sys;
         let dt = sys.scene.sample_dt;
-        let mut buf = vec![0.0; self.y.len()];
+        let mut buf = std::mem::take(&mut self.buf);
         while self.next_sample < self.sample_count {
             let ts = self.next_sample as f64 * dt;
             if ts > self.t {
@@ -676,6 +689,7 @@ impl<'s, 'a> Driver<'s, 'a> {
             }
             self.next_sample += 1;
         }
+        self.buf = buf;
     }
 
     fn run(mut self) -> Result<Run, CompliantError> {
@@ -683,7 +697,7 @@ impl<'s, 'a> Driver<'s, 'a> {
         let scene = sys.scene;
         let horizon = scene.horizon;
         let initial = sys.energy(0.0, &self.y);
-        self.update_contacts();
+        self.update_contacts(None);
         self.derivative();
         self.sample(0.0, 1.0, false);
         let mut h = sys.h_floor.min(sys.h_max);
@@ -703,11 +717,7 @@ impl<'s, 'a> Driver<'s, 'a> {
                 return Err(CompliantError::StepUnderflow { scene: scene.name.clone(), t: self.t, h: h_try });
             }
             self.update_scales();
-            {
-                let (sys, v_max) = (self.sys, &self.v_max);
-                let mut f = |t: f64, y: &[f64], dy: &mut [f64]| sys.rhs(t, y, dy, v_max);
-                self.rk.step(&mut f, self.t, &self.y, &self.dy, h_try);
-            }
+            self.attempt(h_try);
             let err = self.rk.error_norm(&self.scale);
             if !err.is_finite() {
                 // A stage went far into an overlap: try a much shorter step.
@@ -719,29 +729,37 @@ impl<'s, 'a> Driver<'s, 'a> {
                 continue;
             }
             self.accepted += 1;
-            let event = self.first_event();
-            let theta = event.unwrap_or(1.0);
-            let faster = self.track_contacts(theta);
             let t0 = self.t;
-            match event {
-                Some(th) => {
-                    let mut y = std::mem::take(&mut self.y);
-                    self.rk.dense(th, &mut y);
-                    self.y = y;
-                    self.t = t0 + th * h_try;
-                }
-                None => {
-                    self.y.copy_from_slice(&self.rk.y1);
-                    self.dy.copy_from_slice(self.rk.last_derivative());
-                    self.t = if h_try == remaining { horizon } else { t0 + h_try };
+            let mut h_done = h_try;
+            let event = self.first_event();
+            if let Some((theta, _)) = event {
+                // Redo the step up to the event, so that no stage sees past it: the state there
+                // (an onset speed, an exit speed) is that of a step on one side of the kink.
+                h_done = theta * h_try;
+                if h_done > 0.0 {
+                    self.steps += 1;
+                    self.attempt(h_done);
+                    let err = self.rk.error_norm(&self.scale);
+                    if !(err <= 1.0) {
+                        h = if err.is_finite() { next_step(h_done, err) } else { 0.1 * h_done };
+                        continue;
+                    }
+                    self.accepted += 1;
                 }
             }
-            if !self.y.iter().all(|v| v.is_finite()) {
-                return Err(CompliantError::NonFinite { scene: scene.name.clone(), t: self.t });
+            let mut faster = false;
+            if h_done > 0.0 {
+                faster = self.track_contacts(1.0);
+                self.y.copy_from_slice(&self.rk.y1);
+                self.dy.copy_from_slice(self.rk.last_derivative());
+                self.t = if event.is_none() && h_try == remaining { horizon } else { t0 + h_done };
+                if !self.y.iter().all(|v| v.is_finite()) {
+                    return Err(CompliantError::NonFinite { scene: scene.name.clone(), t: self.t });
+                }
+                self.sample(t0, h_done, true);
             }
-            self.sample(t0, h_try, true);
-            let changed = self.update_contacts();
-            if event.is_some() || changed || faster {
+            let changed = self.update_contacts(event.map(|e| e.1));
+            if changed || faster {
                 self.derivative();
             }
         }
