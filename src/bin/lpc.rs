@@ -132,7 +132,7 @@ struct CheckArgs {
     #[arg(long, default_value = "tests/golden")]
     golden: PathBuf,
     /// Models, comma-separated.
-    #[arg(long, value_delimiter = ',', default_value = "reference,rapier")]
+    #[arg(long, value_delimiter = ',', default_value = "reference,rapier,compliant")]
     models: Vec<Model>,
     /// Rewrite the golden files from this run.
     #[arg(long)]
@@ -176,7 +176,7 @@ struct BenchArgs {
     /// Scene files (default: the paper's damper scenes).
     scenes: Vec<PathBuf>,
     /// Models, comma-separated.
-    #[arg(long, value_delimiter = ',', default_value = "reference,rapier")]
+    #[arg(long, value_delimiter = ',', default_value = "reference,rapier,compliant")]
     models: Vec<Model>,
     /// Rapier steppings, comma-separated.
     #[arg(long, value_delimiter = ',', default_value = "fixed,aligned")]
@@ -300,7 +300,7 @@ struct CompareArgs {
     /// Scene file.
     scene: PathBuf,
     /// Models to compare with the reference, comma-separated.
-    #[arg(long, value_delimiter = ',', default_value = "reference,rapier")]
+    #[arg(long, value_delimiter = ',', default_value = "reference,rapier,compliant")]
     models: Vec<Model>,
     /// Simulated time, s (overrides the scene's).
     #[arg(long)]
