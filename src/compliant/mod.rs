@@ -21,12 +21,18 @@
 //!   largest contact force, so the true acceleration during it reaches
 //!   `|a| + peak_force / ms`.
 //! - **Events.** A contact starts when a pair's overlap becomes positive and ends when it
-//!   returns to zero; both are located on the dense output to round-off, so the onset speed is
-//!   that of the trajectory. A step is never longer than 1.5 times the time any open pair
-//!   needs to close at its speed and a bound on its acceleration, and every step is scanned at
-//!   eight points for sign changes of every pair's overlap. An impact is recorded when its
+//!   returns to zero. Every accepted step is scanned at eight points for sign changes of every
+//!   pair's overlap; the first is located on the dense output to round-off and the step is
+//!   redone up to it, so no stage sees past it and the onset (or exit) speed is that of a
+//!   smooth step: exact for free flight. A step is never longer than 1.5 times the time any
+//!   open pair needs to close at its speed and a bound on its acceleration, so onsets are
+//!   found inside steps, not approached by ever shorter ones. (A graze that enters and leaves
+//!   between two scan points is not an event, but its force acts and its dissipation is
+//!   booked: only its line in the impact list is missing.) An impact is recorded when its
 //!   contact ends, at its onset time; a contact still open at the horizon is recorded with its
-//!   duration so far. Its energy lost is the Hunt-Crossley dissipation over the contact.
+//!   duration so far. Its energy lost is the Hunt-Crossley dissipation over the contact, and
+//!   its approach speed the contact's largest overlap rate (the onset speed of an isolated
+//!   impact). [`Run::events`] counts accepted steps.
 //! - **Energy.** Damper dissipation, forcing work and each pair's contact dissipation are
 //!   integrated with the state, and the final energy includes the elastic energy of open
 //!   contacts, so the balance closes to the integration tolerance.
@@ -164,13 +170,17 @@ struct System<'a> {
     pairs: Vec<Pair>,
     /// `c = alpha v0` giving the scene's restitution.
     c: f64,
+    /// Overlap rates below this set the damping as if they were this (resting contacts).
     v_floor: f64,
+    /// The scene's speed scale: frame swing, initial ball speeds, forcing.
     v_scale: f64,
-    /// Position error scale when no contact is open.
+    /// Position error scale when no contact is open: the smallest Hertz length at `v_scale`.
     length_scale: f64,
-    /// Bound on the frame's smooth acceleration per unit of its amplitude terms.
+    /// Longest step: a twentieth of the frame's natural period and of the forcing period, so
+    /// that the acceleration bound used to predict contacts holds over a step.
     h_max: f64,
-    /// Shortest step the closing bound may ask for.
+    /// Shortest step the closing bound may ask for (a tenth of the shortest contact time scale
+    /// at `v_scale`): pairs touching at rest would otherwise shrink steps to nothing.
     h_floor: f64,
 }
 
@@ -596,10 +606,10 @@ impl<'s, 'a> Driver<'s, 'a> {
         earliest
     }
 
-    /// Tracks each open contact's peak force and largest overlap rate over `[0, theta_end]` of
-    /// the last step (on the dense output, refined around a new peak). Returns whether a
-    /// contact's largest rate, and so its damping, changed.
-    fn track_contacts(&mut self, theta_end: f64) -> bool {
+    /// Tracks each open contact's peak force and largest overlap rate over the last step (on
+    /// the dense output, refined around a new peak). Returns whether a contact's largest rate,
+    /// and so its damping, changed.
+    fn track_contacts(&mut self) -> bool {
         let sys = self.sys;
         let mut changed = false;
         let rk = &self.rk;
@@ -613,7 +623,7 @@ impl<'s, 'a> Driver<'s, 'a> {
             let mut best = (f64::NEG_INFINITY, 0usize);
             let mut rates = 0.0f64;
             for j in 0..=SCAN_POINTS {
-                let (f, rate) = at(theta_end * j as f64 / SCAN_POINTS as f64);
+                let (f, rate) = at(j as f64 / SCAN_POINTS as f64);
                 rates = rates.max(rate);
                 if f > best.0 {
                     best = (f, j);
@@ -624,7 +634,7 @@ impl<'s, 'a> Driver<'s, 'a> {
                 let j = best.1;
                 if j > 0 && j < SCAN_POINTS {
                     // Golden-section search for the maximum between the neighbouring points.
-                    let step = theta_end / SCAN_POINTS as f64;
+                    let step = 1.0 / SCAN_POINTS as f64;
                     let (mut a, mut b) = ((j - 1) as f64 * step, (j + 1) as f64 * step);
                     let r = 0.5 * (5f64.sqrt() - 1.0);
                     let (mut x1, mut x2) = (b - r * (b - a), a + r * (b - a));
@@ -749,7 +759,7 @@ impl<'s, 'a> Driver<'s, 'a> {
             }
             let mut faster = false;
             if h_done > 0.0 {
-                faster = self.track_contacts(1.0);
+                faster = self.track_contacts();
                 self.y.copy_from_slice(&self.rk.y1);
                 self.dy.copy_from_slice(self.rk.last_derivative());
                 self.t = if event.is_none() && h_try == remaining { horizon } else { t0 + h_done };
