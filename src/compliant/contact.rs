@@ -117,8 +117,7 @@ pub fn damping_for(e: f64) -> f64 {
     while restitution(hi) > e {
         hi *= 2.0;
     }
-    let root = bracketed_root(|c| restitution(c) - e, 0.0, hi, 1e-13 * hi);
-    root
+    bracketed_root(|c| restitution(c) - e, 0.0, hi, 1e-13 * hi)
 }
 
 #[cfg(test)]
