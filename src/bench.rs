@@ -1,4 +1,5 @@
-//! Run time against error: every model and setting on every scene, the median computing time
+//! Run time against error: every model and setting (Rapier's stepping, step and iterations;
+//! the compliant model's error tolerance) on every scene, the median computing time
 //! per simulated second over repeated runs, `lpc compare`'s errors, and the Pareto front.
 
 use serde::{Deserialize, Serialize};
@@ -17,6 +18,9 @@ pub struct Settings {
     pub dt: Option<f64>,
     /// Solver iterations.
     pub solver_iterations: Option<u32>,
+    /// Error tolerance (compliant model).
+    #[serde(default)]
+    pub tolerance: Option<f64>,
 }
 
 /// One measured setting (the JSON contract of `lpc bench`).
@@ -49,6 +53,8 @@ pub struct Plan {
     pub dts: Vec<f64>,
     /// Rapier solver iterations.
     pub solver_iterations: Vec<u32>,
+    /// Compliant model tolerances.
+    pub compliant_tolerances: Vec<f64>,
     /// Runs per setting (the median is kept).
     pub repeat: usize,
 }
@@ -94,13 +100,36 @@ pub fn bench_scene(scene: &Scene, plan: &Plan, progress: &dyn Fn()) -> Result<Ve
                 rows.push(BenchRow {
                     scene: scene.name.clone(),
                     model: model.name(),
-                    settings: Settings { stepping: "event-driven", dt: None, solver_iterations: None },
+                    settings: Settings { stepping: "event-driven", dt: None, solver_iterations: None, tolerance: None },
                     wall_s_per_sim_s: cost,
                     errors: errors(&run, &reference),
                     steps_per_sim_s: run.events as f64 / scene.horizon,
                     pareto: false,
                 });
                 progress();
+            }
+            Model::Compliant => {
+                for &tolerance in &plan.compliant_tolerances {
+                    let opts = crate::compliant::Options { tolerance, ..Default::default() };
+                    let mut times = Vec::with_capacity(plan.repeat);
+                    let mut last = None;
+                    for _ in 0..plan.repeat.max(1) {
+                        let run = crate::compliant::simulate_with(scene, opts)?;
+                        times.push(run.wall_time_s);
+                        last = Some(run);
+                    }
+                    let run = last.expect("at least one run");
+                    rows.push(BenchRow {
+                        scene: scene.name.clone(),
+                        model: model.name(),
+                        settings: Settings { stepping: "adaptive", dt: None, solver_iterations: None, tolerance: Some(tolerance) },
+                        wall_s_per_sim_s: median(times) / scene.horizon,
+                        errors: errors(&run, &reference),
+                        steps_per_sim_s: run.events as f64 / scene.horizon,
+                        pareto: false,
+                    });
+                    progress();
+                }
             }
             Model::Rapier => {
                 for &stepping in &plan.steppings {
@@ -111,7 +140,7 @@ pub fn bench_scene(scene: &Scene, plan: &Plan, progress: &dyn Fn()) -> Result<Ve
                             rows.push(BenchRow {
                                 scene: scene.name.clone(),
                                 model: model.name(),
-                                settings: Settings { stepping: stepping.name(), dt: Some(dt), solver_iterations: Some(it) },
+                                settings: Settings { stepping: stepping.name(), dt: Some(dt), solver_iterations: Some(it), tolerance: None },
                                 wall_s_per_sim_s: cost,
                                 errors: errors(&run, &reference),
                                 steps_per_sim_s: run.events as f64 / scene.horizon,
@@ -155,7 +184,7 @@ mod tests {
         BenchRow {
             scene: "s".into(),
             model: "rapier",
-            settings: Settings { stepping: "fixed", dt: None, solver_iterations: None },
+            settings: Settings { stepping: "fixed", dt: None, solver_iterations: None, tolerance: None },
             wall_s_per_sim_s: cost,
             errors: Errors { rms_xs: 0.0, max_xs_early: err, settling_time_diff: None, impact_loss_diff: 0.0, impact_count_diff: 0 },
             steps_per_sim_s: 0.0,

@@ -8,6 +8,13 @@
 //! perturbation of the exact model moves the RMS displacement by up to 0.5 mm, the settling
 //! time by up to 0.8 s and the energy left by 0.13 % of E0. Its tolerances are those, with the
 //! peaks (set in the first periods, well-conditioned) at 2 %, and the impact count at 15 %.
+//!
+//! The compliant model is f64 and bitwise repeatable on one machine and build, so its metrics
+//! (and its peak contact force, which the impulse models do not have) must agree to 1e-6
+//! relative and its impact count exactly. That margin covers round-off, not a change of
+//! method: another libm can flip one accept/reject decision of its adaptive steps, a
+//! perturbation at its tolerance (1e-9 of the contact scales) that the paper scenes amplify
+//! as above; its goldens are then regenerated with `lpc check --update --models compliant`.
 
 use std::path::{Path, PathBuf};
 
@@ -132,6 +139,9 @@ fn tolerance(model: &str, metric: &str) -> (f64, f64) {
     if model == "reference" {
         return if metric == "impact_count" { (0.0, 0.0) } else { (1e-9, 1e-15) };
     }
+    if model == "compliant" {
+        return if metric == "impact_count" { (0.0, 0.0) } else { (1e-6, 1e-15) };
+    }
     match metric {
         "peak_displacement" | "peak_acceleration" => (0.02, 0.0),
         "rms_displacement" => (0.0, 0.5e-3),
@@ -152,6 +162,7 @@ pub fn compare(now: &Golden, golden: Option<&Golden>) -> Vec<Row> {
             v.push(("rms_displacement".into(), Some(m.rms_displacement)));
             v.push(("settling_time".into(), m.settling_time));
             v.push(("energy_remaining".into(), m.energy_remaining));
+            v.push(("peak_contact_force".into(), m.peak_contact_force));
         }
         for r in &g.ker {
             v.push((format!("ker {}L-{}S", r.large, r.small), Some(r.ker)));

@@ -6,7 +6,7 @@
 //! scene format and write one output type, so they can be checked against each other.
 //!
 //! Data flows one way: `scenes/*.toml` → [`scene`] (parse + validate) → a model
-//! ([`reference`]) → [`run::Run`] → [`metrics`], [`output`], [`chain`], [`sweep`].
+//! ([`reference`], [`rapier`], [`compliant`]) → [`run::Run`] → [`metrics`], [`output`], [`chain`], [`sweep`].
 //!
 //! ```
 //! let scene = lpc_damper::scene::load_scene(lpc_damper::scene::scenes_dir().join("lpc-lsl.toml")).unwrap();
@@ -21,6 +21,7 @@ pub mod bench;
 pub mod chain;
 pub mod check;
 pub mod compare;
+pub mod compliant;
 pub mod frf;
 pub mod metrics;
 pub mod model;

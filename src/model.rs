@@ -10,17 +10,20 @@ pub enum Model {
     Reference,
     /// Rapier colliders in a headless Bevy app.
     Rapier,
+    /// Hertz contacts with Hunt-Crossley damping, integrated through every contact.
+    Compliant,
 }
 
 impl Model {
     /// Every model, in report order.
-    pub const ALL: &'static [Model] = &[Model::Reference, Model::Rapier];
+    pub const ALL: &'static [Model] = &[Model::Reference, Model::Rapier, Model::Compliant];
 
     /// Name used on the command line and in outputs.
     pub fn name(self) -> &'static str {
         match self {
             Model::Reference => "reference",
             Model::Rapier => "rapier",
+            Model::Compliant => "compliant",
         }
     }
 
@@ -29,6 +32,7 @@ impl Model {
         match self {
             Model::Reference => Ok(crate::reference::simulate(scene)?),
             Model::Rapier => crate::rapier::simulate(scene),
+            Model::Compliant => Ok(crate::compliant::simulate(scene)?),
         }
     }
 }
@@ -50,6 +54,9 @@ pub enum ModelError {
     /// The reference stalled.
     #[error(transparent)]
     Reference(#[from] crate::reference::ReferenceError),
+    /// The compliant model stalled.
+    #[error(transparent)]
+    Compliant(#[from] crate::compliant::CompliantError),
     /// The model refuses this scene (with the reason).
     #[error("{0}")]
     Refused(String),

@@ -14,6 +14,7 @@ fn bench_errors_equal_compare_errors() {
         steppings: vec![Stepping::Fixed, Stepping::Aligned],
         dts: vec![5e-4],
         solver_iterations: vec![4],
+        compliant_tolerances: vec![],
         repeat: 1,
     };
     let rows = bench_scene(&scene, &plan, &|| {}).unwrap();

@@ -1,4 +1,4 @@
-//! The same scene and settings give identical results across runs and thread counts.
+//! The same scene and settings give identical results across runs and thread counts, for every model.
 
 use lpc_damper::output::RunSummary;
 use lpc_damper::scene::{load, scenes_dir};
@@ -18,7 +18,7 @@ fn sweep_on(threads: usize, model: Model) -> Vec<RunSummary> {
 
 #[test]
 fn sweeps_are_identical_on_one_and_two_threads() {
-    for model in [Model::Reference, Model::Rapier] {
+    for model in [Model::Reference, Model::Rapier, Model::Compliant] {
         let one = sweep_on(1, model);
         let two = sweep_on(2, model);
         assert_eq!(serde_json::to_string(&one).unwrap(), serde_json::to_string(&two).unwrap(), "{}", model.name());

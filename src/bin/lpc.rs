@@ -137,7 +137,7 @@ struct CheckArgs {
     #[arg(long, default_value = "tests/golden")]
     golden: PathBuf,
     /// Models, comma-separated.
-    #[arg(long, value_delimiter = ',', default_value = "reference,rapier")]
+    #[arg(long, value_delimiter = ',', default_value = "reference,rapier,compliant")]
     models: Vec<Model>,
     /// Rewrite the golden files from this run.
     #[arg(long)]
@@ -181,7 +181,7 @@ struct BenchArgs {
     /// Scene files (default: the paper's damper scenes).
     scenes: Vec<PathBuf>,
     /// Models, comma-separated.
-    #[arg(long, value_delimiter = ',', default_value = "reference,rapier")]
+    #[arg(long, value_delimiter = ',', default_value = "reference,rapier,compliant")]
     models: Vec<Model>,
     /// Rapier steppings, comma-separated.
     #[arg(long, value_delimiter = ',', default_value = "fixed,aligned")]
@@ -192,6 +192,9 @@ struct BenchArgs {
     /// Rapier solver iterations, comma-separated.
     #[arg(long, value_delimiter = ',', default_value = "4")]
     solver_iterations: Vec<u32>,
+    /// Compliant model error tolerances, comma-separated.
+    #[arg(long, value_delimiter = ',', default_value = "1e-9")]
+    tolerance: Vec<f64>,
     /// Runs per setting; the median time is reported.
     #[arg(long, default_value_t = 3)]
     repeat: usize,
@@ -392,7 +395,7 @@ struct CompareArgs {
     /// Scene file.
     scene: PathBuf,
     /// Models to compare with the reference, comma-separated.
-    #[arg(long, value_delimiter = ',', default_value = "reference,rapier")]
+    #[arg(long, value_delimiter = ',', default_value = "reference,rapier,compliant")]
     models: Vec<Model>,
     /// Simulated time, s (overrides the scene's).
     #[arg(long)]
@@ -900,11 +903,13 @@ fn cmd_bench(a: BenchArgs) -> Result<()> {
         steppings: a.stepping.clone(),
         dts: a.dt.clone(),
         solver_iterations: a.solver_iterations.clone(),
+        compliant_tolerances: a.tolerance.clone(),
         repeat: a.repeat,
     };
     let per_scene = a.models.iter().map(|m| match m {
         Model::Reference => 1,
         Model::Rapier => plan.steppings.len() * plan.dts.len() * plan.solver_iterations.len(),
+        Model::Compliant => plan.compliant_tolerances.len(),
     }).sum::<usize>();
     let bar = progress_bar(per_scene * paths.len(), "bench");
     let mut rows = Vec::new();
@@ -936,7 +941,8 @@ fn cmd_bench(a: BenchArgs) -> Result<()> {
                     r.scene,
                     r.model,
                     r.settings.stepping,
-                    r.settings.dt.map_or("-".into(), |d| format!("{d}")),
+                    // The compliant model has no step to set: its column shows the tolerance.
+                    r.settings.dt.map(|d| format!("{d}")).or(r.settings.tolerance.map(|t| format!("tol {t:e}"))).unwrap_or("-".into()),
                     r.settings.solver_iterations.map_or("-".into(), |i| i.to_string()),
                     r.wall_s_per_sim_s,
                     r.steps_per_sim_s,
@@ -959,7 +965,7 @@ fn bench_csv(rows: &[lpc_damper::bench::BenchRow]) -> Result<Vec<u8>> {
     let mut w = csv::Writer::from_writer(Vec::new());
     w.write_record([
         "scene", "model", "stepping", "dt", "solver_iterations", "wall_s_per_sim_s", "steps_per_sim_s", "rms_xs",
-        "max_xs_early", "settling_time_diff", "impact_loss_diff", "impact_count_diff", "pareto",
+        "max_xs_early", "settling_time_diff", "impact_loss_diff", "impact_count_diff", "pareto", "tolerance",
     ])?;
     let opt = |x: Option<f64>| x.map_or(String::new(), |v| v.to_string());
     for r in rows {
@@ -978,6 +984,7 @@ fn bench_csv(rows: &[lpc_damper::bench::BenchRow]) -> Result<Vec<u8>> {
             e.impact_loss_diff.to_string(),
             e.impact_count_diff.to_string(),
             r.pareto.to_string(),
+            opt(r.settings.tolerance),
         ])?;
     }
     Ok(w.into_inner()?)

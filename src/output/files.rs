@@ -45,10 +45,13 @@ pub fn series_csv(run: &Run) -> Vec<u8> {
     w.into_inner().expect("writing to memory")
 }
 
-/// `impacts.csv`: `t, body_a, body_b, approach_speed, energy_lost`.
+/// `impacts.csv`: `t, body_a, body_b, approach_speed, energy_lost, peak_force,
+/// contact_duration` (the last two empty for impulse models).
 pub fn impacts_csv(run: &Run) -> Vec<u8> {
     let mut w = csv::Writer::from_writer(Vec::new());
-    w.write_record(["t", "body_a", "body_b", "approach_speed", "energy_lost"]).expect("writing to memory");
+    w.write_record(["t", "body_a", "body_b", "approach_speed", "energy_lost", "peak_force", "contact_duration"])
+        .expect("writing to memory");
+    let optional = |x: Option<f64>| x.map_or(String::new(), |x| x.to_string());
     for i in &run.impacts {
         w.write_record([
             i.t.to_string(),
@@ -56,6 +59,8 @@ pub fn impacts_csv(run: &Run) -> Vec<u8> {
             Scene::body_name(i.b),
             i.approach_speed.to_string(),
             i.energy_lost.to_string(),
+            optional(i.peak_force),
+            optional(i.contact_duration),
         ])
         .expect("writing to memory");
     }

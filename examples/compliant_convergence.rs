@@ -1,0 +1,38 @@
+//! The compliant model against the reference as the balls stiffen (early xs error against
+//! Young's modulus: contact durations scale as E^(-2/5)), and its energy balance against the
+//! error tolerance. Figures of docs/BENCHMARKS.md, "Compliant model".
+//!
+//! `cargo run --release --example compliant_convergence`
+
+use lpc_damper::compare::errors;
+use lpc_damper::compliant::{simulate, simulate_with, Options};
+use lpc_damper::scene::{load_scene, scenes_dir};
+
+fn main() {
+    println!("early xs error (max |xs - xs_ref| over 0.5 s), mm");
+    println!("{:>12} {:>10} {:>10} {:>10}", "E factor", "lpc-lsl", "conventional", "chain-lll");
+    for factor in [1.0, 1e2, 1e4] {
+        let mut row = format!("{factor:>12.0e}");
+        for name in ["lpc-lsl", "conventional", "chain-lll"] {
+            let mut scene = load_scene(scenes_dir().join(format!("{name}.toml"))).unwrap();
+            scene.horizon = 0.5;
+            scene.compliant.youngs_modulus *= factor;
+            let reference = lpc_damper::reference::simulate(&scene).unwrap();
+            let e = errors(&simulate(&scene).unwrap(), &reference);
+            row += &format!(" {:>10.4}", e.max_xs_early * 1e3);
+        }
+        println!("{row}");
+    }
+    println!("\nlpc-lsl, 5 s: energy balance error against the tolerance");
+    let scene = load_scene(scenes_dir().join("lpc-lsl.toml")).unwrap();
+    for tolerance in [1e-6, 1e-7, 1e-8, 1e-9, 1e-10, 1e-11] {
+        let run = simulate_with(&scene, Options { tolerance, ..Default::default() }).unwrap();
+        println!(
+            "tolerance {tolerance:.0e}: balance error {:+.2e}, {} steps, {} impacts, {:.1} ms",
+            run.energy.balance_error,
+            run.events,
+            run.impacts.len(),
+            run.wall_time_s * 1e3
+        );
+    }
+}
