@@ -163,6 +163,7 @@ pub fn compare(now: &Golden, golden: Option<&Golden>) -> Vec<Row> {
             v.push(("settling_time".into(), m.settling_time));
             v.push(("energy_remaining".into(), m.energy_remaining));
             v.push(("peak_contact_force".into(), m.peak_contact_force));
+            v.push(("peak_true_acceleration".into(), m.peak_true_acceleration));
         }
         for r in &g.ker {
             v.push((format!("ker {}L-{}S", r.large, r.small), Some(r.ker)));

@@ -22,6 +22,9 @@ pub struct Metrics {
     /// Largest contact force over all impacts, N (`None` for impulse models).
     #[serde(default)]
     pub peak_contact_force: Option<f64>,
+    /// max |a| for t >= T with contact forces included, m/s^2 (`None` for impulse models).
+    #[serde(default)]
+    pub peak_true_acceleration: Option<f64>,
 }
 
 /// Mean, 95th percentile and largest of a set of per-impact values.
@@ -94,6 +97,7 @@ pub fn metrics(run: &Run) -> Metrics {
         settling_time: settling_time(&s.t, &s.xs, run.initial_displacement),
         energy_remaining: (run.energy.initial != 0.0).then(|| run.energy.final_ / run.energy.initial),
         peak_contact_force: run.impacts.iter().filter_map(|i| i.peak_force).reduce(f64::max),
+        peak_true_acceleration: run.peak_true_acceleration,
     }
 }
 

@@ -129,6 +129,9 @@ pub struct Run {
     pub events: u64,
     /// Final ball velocities (exact, not sampled), m/s.
     pub final_velocities: Vec<f64>,
+    /// Largest |acceleration| of the frame for t >= T with contact forces included, m/s^2
+    /// (compliant contact only: impulse models have infinite acceleration at impacts).
+    pub peak_true_acceleration: Option<f64>,
     /// Computing time, s.
     pub wall_time_s: f64,
 }
@@ -157,6 +160,7 @@ impl Run {
             energy: EnergyAccount::default(),
             events: 0,
             final_velocities: vec![],
+            peak_true_acceleration: None,
             wall_time_s: 0.0,
         }
     }

@@ -169,6 +169,13 @@ fn wall_of_a_free_frame_bounces_a_ball_as_eq_9_10() {
             assert!(imp.a == wall || imp.b == wall, "{imp:?}");
             // Momentum of ball and frame together, to round-off.
             assert!((m * r.final_velocities[0] + frame.mass * vs - m * v).abs() <= 1e-12 * m * v.abs());
+            // With no spring and no damper the frame's true acceleration is the wall force over
+            // its mass; sampled at step ends, about 40 a contact, so within (pi/40)^2/2 of the
+            // peak (and never above it).
+            let true_peak = r.peak_true_acceleration.unwrap();
+            let force_peak = imp.peak_force.unwrap() / frame.mass;
+            assert!(true_peak <= force_peak * (1.0 + 1e-9), "v {v} e {e}: {true_peak} > {force_peak}");
+            assert!(true_peak >= force_peak * (1.0 - 0.5 * (std::f64::consts::PI / 40.0).powi(2)), "v {v} e {e}: {true_peak} vs {force_peak}");
         }
     }
 }

@@ -412,6 +412,9 @@ struct Driver<'s, 'a> {
     sample_count: usize,
     steps: u64,
     accepted: u64,
+    /// Largest |frame acceleration| with contact forces, at accepted step ends after one bare
+    /// period (within about `(pi / 40)^2 / 2 = 0.3 %` of the true peak, at 40 steps a contact).
+    peak_true_acceleration: f64,
 }
 
 impl<'s, 'a> Driver<'s, 'a> {
@@ -443,6 +446,7 @@ impl<'s, 'a> Driver<'s, 'a> {
             sample_count: samples,
             steps: 0,
             accepted: 0,
+            peak_true_acceleration: 0.0,
         }
     }
 
@@ -707,6 +711,7 @@ impl<'s, 'a> Driver<'s, 'a> {
         let scene = sys.scene;
         let horizon = scene.horizon;
         let initial = sys.energy(0.0, &self.y);
+        let period = scene.frame.map_or(0.0, |f| f.damped_period());
         self.update_contacts(None);
         self.derivative();
         self.sample(0.0, 1.0, false);
@@ -763,6 +768,9 @@ impl<'s, 'a> Driver<'s, 'a> {
                 self.y.copy_from_slice(&self.rk.y1);
                 self.dy.copy_from_slice(self.rk.last_derivative());
                 self.t = if event.is_none() && h_try == remaining { horizon } else { t0 + h_done };
+                if sys.has_frame() && self.t >= period {
+                    self.peak_true_acceleration = self.peak_true_acceleration.max(self.dy[VS].abs());
+                }
                 if !self.y.iter().all(|v| v.is_finite()) {
                     return Err(CompliantError::NonFinite { scene: scene.name.clone(), t: self.t });
                 }
@@ -801,6 +809,7 @@ impl<'s, 'a> Driver<'s, 'a> {
             energy,
             events: self.accepted,
             final_velocities,
+            peak_true_acceleration: sys.has_frame().then_some(self.peak_true_acceleration),
             wall_time_s: 0.0,
         })
     }

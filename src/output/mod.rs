@@ -131,7 +131,7 @@ pub fn text_summary(s: &RunSummary) -> String {
         "scene {} | model {} | horizon {} s | computed in {:.3} ms\n\
          impacts            {}\n\
          peak displacement  {:.4} mm (t >= T)\n\
-         peak acceleration  {:.4} m/s^2 (t >= T)\n\
+         peak acceleration  {:.4} m/s^2 (t >= T){}\n\
          rms displacement   {:.4} mm\n\
          settling time      {}\n\
          energy remaining   {}\n\
@@ -144,6 +144,11 @@ pub fn text_summary(s: &RunSummary) -> String {
         s.impact_count,
         m.peak_displacement * 1e3,
         m.peak_acceleration,
+        match (m.peak_true_acceleration, m.peak_contact_force) {
+            (Some(a), Some(f)) => format!("; with contact forces {a:.4} m/s^2; peak contact force {f:.1} N"),
+            (Some(a), None) => format!("; with contact forces {a:.4} m/s^2"),
+            _ => String::new(),
+        },
         m.rms_displacement * 1e3,
         opt(m.settling_time, "s", 1.0),
         opt(m.energy_remaining.map(|x| x * 100.0), "%", 1.0),

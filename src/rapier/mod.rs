@@ -159,6 +159,7 @@ pub fn collect(world: &mut World, scene: &Scene, steps: u64) -> Run {
         energy,
         events: steps,
         final_velocities: rec.v,
+        peak_true_acceleration: None,
         wall_time_s: 0.0,
     }
 }

@@ -1015,6 +1015,7 @@ impl<'a> Solver<'a> {
             energy,
             events: self.events,
             final_velocities,
+            peak_true_acceleration: None,
             wall_time_s: 0.0,
         }
     }
