@@ -9,12 +9,11 @@
 //! time by up to 0.8 s and the energy left by 0.13 % of E0. Its tolerances are those, with the
 //! peaks (set in the first periods, well-conditioned) at 2 %, and the impact count at 15 %.
 //!
-//! The compliant model is f64 and bitwise repeatable on one machine and build, so its metrics
-//! (and its peak contact force, which the impulse models do not have) must agree to 1e-6
-//! relative and its impact count exactly. That margin covers round-off, not a change of
-//! method: another libm can flip one accept/reject decision of its adaptive steps, a
-//! perturbation at its tolerance (1e-9 of the contact scales) that the paper scenes amplify
-//! as above; its goldens are then regenerated with `lpc check --update --models compliant`.
+//! The compliant model is f64 and bitwise repeatable on one machine and build, but another
+//! libm can flip one accept/reject decision of its adaptive steps: a perturbation at its
+//! tolerance (1e-9 of the contact scales), which the paper scenes amplify as above. So it gets
+//! the contact model's tolerances, and its peak contact force and true acceleration peak (set
+//! by the fastest, earliest impacts) 2 %, like the peaks.
 
 use std::path::{Path, PathBuf};
 
@@ -139,11 +138,8 @@ fn tolerance(model: &str, metric: &str) -> (f64, f64) {
     if model == "reference" {
         return if metric == "impact_count" { (0.0, 0.0) } else { (1e-9, 1e-15) };
     }
-    if model == "compliant" {
-        return if metric == "impact_count" { (0.0, 0.0) } else { (1e-6, 1e-15) };
-    }
     match metric {
-        "peak_displacement" | "peak_acceleration" => (0.02, 0.0),
+        "peak_displacement" | "peak_acceleration" | "peak_contact_force" | "peak_true_acceleration" => (0.02, 0.0),
         "rms_displacement" => (0.0, 0.5e-3),
         "settling_time" => (0.0, 0.8),
         "energy_remaining" => (0.0, 1.3e-3),

@@ -29,3 +29,13 @@ fn generated_scenes_are_reproducible_from_their_seed() {
     assert_eq!(a, b);
     assert_ne!(a, c);
 }
+
+/// The contact model on the first 25 scenes of the default seed (horizons up to 1 s): a
+/// regression guard at the measured pass rate (`lpc stress --models rapier --count 1000`
+/// passes 936 of 1000, docs/BENCHMARKS.md "Stress runs"); a refused scene is a pass.
+#[test]
+fn contact_model_passes_the_first_seeded_scenes() {
+    let outcomes = stress(Model::Rapier, 1, 25, 1.0, &|| {});
+    let failed: Vec<_> = outcomes.iter().filter(|o| o.failure.is_some()).collect();
+    assert!(failed.is_empty(), "{} failures, first: seed {} {:?}", failed.len(), failed[0].seed, failed[0].failure);
+}

@@ -72,10 +72,23 @@ pub fn settings(scene: &Scene) -> StepSettings {
     StepSettings {
         stepping: scene.rapier.stepping.unwrap_or(DEFAULT_STEPPING),
         dt: dt.min(period_bound).min(chord_bound),
-        solver_iterations: scene.rapier.solver_iterations.map_or(DEFAULT_SOLVER_ITERATIONS, |i| i as usize),
+        solver_iterations: scene.rapier.solver_iterations.map_or_else(|| default_iterations(scene), |i| i as usize),
         ccd: scene.rapier.ccd.unwrap_or(false),
         speculative_margin: true,
     }
+}
+
+/// Solver iterations when the scene sets none: [`DEFAULT_SOLVER_ITERATIONS`] per decade of
+/// the largest mass ratio of neighbouring balls. Rapier's iterative solver converges more
+/// slowly the more unequal the masses it couples: a light ball squeezed between a heavy one
+/// and a wall sinks into the wall with too few iterations (docs/BENCHMARKS.md, "Stress runs").
+pub fn default_iterations(scene: &Scene) -> usize {
+    let ratio = scene
+        .balls
+        .windows(2)
+        .map(|w| (w[0].mass / w[1].mass).max(w[1].mass / w[0].mass))
+        .fold(1.0f64, f64::max);
+    DEFAULT_SOLVER_ITERATIONS * (ratio.log10().ceil().max(1.0) as usize)
 }
 
 /// Refuses scenes the kinematic-frame coupling cannot reproduce.
