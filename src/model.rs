@@ -60,4 +60,8 @@ pub enum ModelError {
     /// The model refuses this scene (with the reason).
     #[error("{0}")]
     Refused(String),
+    /// The model found during the run that it cannot resolve the scene (with the reason)
+    /// and stopped rather than return a wrong run.
+    #[error("{0}")]
+    Unstable(String),
 }

@@ -39,6 +39,8 @@ pub struct Outcome {
     pub failure: Option<Failure>,
     /// The shrunk scene that still fails, as TOML.
     pub minimal_scene: Option<String>,
+    /// The model's reason when it refused the scene (before or during the run): a pass.
+    pub refused: Option<String>,
 }
 
 /// A random valid scene file: 1 to 50 balls, mass ratios 1 to 1000, e in [0, 1], gaps from 0
@@ -89,7 +91,10 @@ pub fn check_run(model: Model, scene: &Scene) -> Result<Run, Failure> {
                 .unwrap_or_default();
             return Err(Failure { check: "panic", detail: msg });
         }
-        Ok(Err(crate::model::ModelError::Refused(_))) => return Ok(refused_run(scene)),
+        // Refusing with a reason, before or during the run, is a correct answer.
+        Ok(Err(crate::model::ModelError::Refused(reason) | crate::model::ModelError::Unstable(reason))) => {
+            return Ok(refused_run(scene, &reason))
+        }
         Ok(Err(e)) => {
             let check = if e.to_string().contains("stalled") { "stall" } else { "error" };
             return Err(Failure { check, detail: e.to_string() });
@@ -100,9 +105,17 @@ pub fn check_run(model: Model, scene: &Scene) -> Result<Run, Failure> {
     Ok(run)
 }
 
-/// A stand-in for a scene the model refuses with a reason (that is a correct answer).
-fn refused_run(scene: &Scene) -> Run {
-    Run { sample_dt: scene.sample_dt, initial_displacement: scene.initial_displacement, ..Run::empty(&scene.name, "refused") }
+/// Marks the model name of a stand-in run for a refused scene.
+pub const REFUSED: &str = "refused: ";
+
+/// A stand-in for a scene the model refuses with a reason (that is a correct answer); its
+/// model name is [`REFUSED`] followed by the reason.
+fn refused_run(scene: &Scene, reason: &str) -> Run {
+    Run {
+        sample_dt: scene.sample_dt,
+        initial_displacement: scene.initial_displacement,
+        ..Run::empty(&scene.name, &format!("{REFUSED}{reason}"))
+    }
 }
 
 /// The checks of a run of `model` on `scene` (see the module docs).
@@ -121,7 +134,7 @@ pub fn check(model: Model, scene: &Scene, run: &Run) -> Result<(), Failure> {
     // Reference: exact to round-off. Rapier: f32 velocities, one rounding per impulse.
     let (balance_tol, impact_tol) = match model {
         Model::Reference => (1e-9, 1e-9),
-        Model::Rapier => (1e-3, 1e-3),
+        Model::Rapier => (crate::rapier::ENERGY_GAIN_TOLERANCE, crate::rapier::ENERGY_GAIN_TOLERANCE),
         // Each step errs by at most the tolerance of the contact's scales; they add up at worst.
         Model::Compliant => ((run.events as f64 * crate::compliant::DEFAULT_TOLERANCE).max(1e-9), 1e-9),
     };
@@ -178,7 +191,7 @@ pub fn check(model: Model, scene: &Scene, run: &Run) -> Result<(), Failure> {
         // Reference: contact tolerance; Rapier: its allowed overlap (5e-5 m) before correction.
         let tol = match model {
             Model::Reference => 1e-9 * c.length.max(1e-3),
-            Model::Rapier => 5e-5 + 1e-6,
+            Model::Rapier => crate::rapier::ALLOWED_OVERLAP + 1e-6,
             Model::Compliant => compliant_overlap_bound(scene, run),
         };
         for k in 0..s.len() {
@@ -282,11 +295,14 @@ pub fn stress(model: Model, seed: u64, count: u64, max_horizon: f64, progress: &
         .map(|s| {
             let file = random_scene_file(s, max_horizon);
             let scene = validate(&file).expect("generated scenes are valid");
-            let failure = check_run(model, &scene).err();
+            let (failure, refused) = match check_run(model, &scene) {
+                Ok(run) => (None, run.model.strip_prefix(REFUSED).map(str::to_string)),
+                Err(f) => (Some(f), None),
+            };
             let minimal_scene =
                 failure.as_ref().map(|f| toml::to_string(&shrink(model, &file, f.check)).unwrap_or_default());
             progress();
-            Outcome { seed: s, model: model.name(), failure, minimal_scene }
+            Outcome { seed: s, model: model.name(), failure, minimal_scene, refused }
         })
         .collect()
 }

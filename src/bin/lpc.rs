@@ -1018,7 +1018,19 @@ fn cmd_stress(a: StressArgs) -> Result<()> {
             for &model in &a.models {
                 let total = outcomes.iter().filter(|o| o.model == model.name()).count();
                 let failed = failures.iter().filter(|o| o.model == model.name()).count();
-                println!("{}: {} passed, {} failed", model.name(), total - failed, failed);
+                let refused = outcomes.iter().filter(|o| o.model == model.name() && o.refused.is_some()).count();
+                let unstable = outcomes
+                    .iter()
+                    .filter(|o| o.model == model.name() && o.refused.as_deref().is_some_and(|r| r.contains("stopped")))
+                    .count();
+                println!(
+                    "{}: {} passed ({} of them refused with a reason, {} of those during the run), {} failed",
+                    model.name(),
+                    total - failed,
+                    refused,
+                    unstable,
+                    failed
+                );
             }
             println!("({:.1} s)", start.elapsed().as_secs_f64());
         }

@@ -39,6 +39,13 @@ pub const DEFAULT_SOLVER_ITERATIONS: usize = 4;
 /// a step, which must stay close to the frame's true path.
 pub const STEPS_PER_FRAME_PERIOD: f64 = 40.0;
 
+/// Rapier's allowed contact overlap (`0.005 length_unit`), m: what a contact may sink before
+/// Rapier corrects it.
+pub const ALLOWED_OVERLAP: f64 = 0.005 * plugin::LENGTH_UNIT as f64;
+/// Energy a step's contacts may gain, relative to the energy put in (f32 velocities, one
+/// rounding per impulse): beyond it the run stops as unstable.
+pub const ENERGY_GAIN_TOLERANCE: f64 = 1e-3;
+
 /// Largest gap between the straight path Rapier gives the walls over a step and the frame's
 /// true path, m: a fifth of Rapier's allowed contact error (`0.005 length_unit`), so that the
 /// walls a ball meets are where the frame is.
@@ -75,6 +82,7 @@ pub fn settings(scene: &Scene) -> StepSettings {
         solver_iterations: scene.rapier.solver_iterations.map_or_else(|| default_iterations(scene), |i| i as usize),
         ccd: scene.rapier.ccd.unwrap_or(false),
         speculative_margin: true,
+        self_check: true,
     }
 }
 
@@ -138,6 +146,12 @@ pub fn simulate_with(scene: &Scene, settings: StepSettings) -> Result<Run, Model
     let world = app.world_mut();
     while world.resource::<plugin::StepClock>().t < scene.horizon * (1.0 - 1e-12) {
         world.run_schedule(plugin::DamperStep);
+        if let Some(reason) = world.resource::<record::Recording>().failure.clone() {
+            return Err(ModelError::Unstable(format!(
+                "scene `{}`: the contact model stopped: {reason}; the reference and compliant models can run it",
+                scene.name
+            )));
+        }
     }
     let steps = app.world().resource::<plugin::StepClock>().steps;
     let mut run = collect(app.world_mut(), scene, steps);

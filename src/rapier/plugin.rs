@@ -31,12 +31,16 @@ pub struct StepSettings {
     /// steps (the plug-in's choice), rather than Rapier's fixed 0.02 length units (only the
     /// stability map turns this off, to show why it is needed).
     pub speculative_margin: bool,
+    /// Stop with [`crate::model::ModelError::Unstable`] when a ball is pushed through a wall or
+    /// contacts gain energy, rather than return a wrong run (only the stability map turns this
+    /// off, to measure the raw behaviour).
+    pub self_check: bool,
 }
 
 impl StepSettings {
     /// Fixed steps of `dt` with the plug-in's other defaults.
     pub fn fixed(dt: f64, solver_iterations: usize) -> Self {
-        StepSettings { stepping: Stepping::Fixed, dt, solver_iterations, ccd: false, speculative_margin: true }
+        StepSettings { stepping: Stepping::Fixed, dt, solver_iterations, ccd: false, speculative_margin: true, self_check: true }
     }
 }
 

@@ -1,0 +1,54 @@
+//! Issue 6: a light ball squeezed between a heavy one and a wall (mass ratio 660) was pushed
+//! through the wall by Rapier's iterative solver, and the run came back looking valid. The
+//! contact model now checks every step and stops with the reason instead; the reference runs
+//! the scene.
+
+use lpc_damper::model::ModelError;
+use lpc_damper::{scene, Model};
+
+const SCENE: &str = r#"
+name = "stress-174"
+[frame]
+mass = 1.35
+stiffness = 3366.652256466029
+damping = 0.0
+initial_displacement = "-0.4986277621334814 Rr"
+
+[balls]
+arrangement = "LS"
+large_mass = 0.11
+mass_ratio = 661.7318540906778
+density = 8000.0
+restitution = 0.9
+gap = "0.25 Rr"
+clearance = "0 Rr"
+
+[run]
+horizon = 0.061902355482029985
+sample_dt = 0.0001
+"#;
+
+#[test]
+fn the_contact_model_stops_with_the_reason_instead_of_a_wrong_run() {
+    let s = scene::parse(SCENE, "stress-174", "stress-174").unwrap().scene.unwrap();
+    match Model::Rapier.simulate(&s) {
+        Err(ModelError::Unstable(reason)) => {
+            assert!(reason.contains("stress-174") && reason.contains("right wall"), "{reason}");
+            assert!(reason.contains("mass ratio 662"), "{reason}");
+        }
+        other => panic!("expected the run to stop as unstable, got {:?}", other.map(|r| r.impacts.len())),
+    }
+    let reference = Model::Reference.simulate(&s).unwrap();
+    lpc_damper::stress::check(Model::Reference, &s, &reference).unwrap();
+}
+
+#[test]
+fn the_stability_map_still_sees_the_raw_behaviour() {
+    // With the self-check off the same scene runs to the end (and shows the ball outside).
+    let s = scene::parse(SCENE, "stress-174", "stress-174").unwrap().scene.unwrap();
+    let mut settings = lpc_damper::rapier::settings(&s);
+    settings.self_check = false;
+    let run = lpc_damper::rapier::simulate_with(&s, settings).unwrap();
+    let failure = lpc_damper::stress::check(Model::Rapier, &s, &run).unwrap_err();
+    assert_eq!(failure.check, "outside");
+}
