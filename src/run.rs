@@ -1,7 +1,7 @@
 //! The common output of every model: sampled series, impact list, energy account and wall
 //! time. Metrics, comparison and output read only this type, so models stay interchangeable.
 
-use crate::scene::Body;
+use crate::scene::{Body, Scene};
 
 /// Series sampled every `sample_dt` from `t = 0` to the horizon (inclusive where it falls on a sample).
 #[derive(Debug, Clone, Default, PartialEq)]
@@ -32,6 +32,14 @@ impl Series {
             x: (0..balls).map(|_| Vec::with_capacity(samples)).collect(),
             v: (0..balls).map(|_| Vec::with_capacity(samples)).collect(),
         }
+    }
+    /// Appends the frame's part of the sample at `t` (the acceleration as every model reports
+    /// it, [`Scene::frame_acceleration`]); the caller appends each ball's.
+    pub fn push_frame(&mut self, scene: &Scene, t: f64, xs: f64, vs: f64) {
+        self.t.push(t);
+        self.xs.push(xs);
+        self.vs.push(vs);
+        self.a.push(scene.frame_acceleration(t, xs, vs));
     }
     /// Number of samples.
     pub fn len(&self) -> usize {

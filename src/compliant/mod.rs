@@ -693,10 +693,7 @@ impl<'s, 'a> Driver<'s, 'a> {
             };
             let (xs, vs) = if sys.has_frame() { (state[XS], state[VS]) } else { (0.0, 0.0) };
             let s = &mut self.series;
-            s.t.push(ts);
-            s.xs.push(xs);
-            s.vs.push(vs);
-            s.a.push(sys.scene.frame_acceleration(ts, xs, vs));
+            s.push_frame(sys.scene, ts, xs, vs);
             for i in 0..sys.n {
                 s.x[i].push(state[sys.x(i)]);
                 s.v[i].push(state[sys.v(i)]);

@@ -456,10 +456,7 @@ pub fn record_samples(
             None => (0.0, 0.0),
         };
         let s = &mut rec.series;
-        s.t.push(ts);
-        s.xs.push(xs);
-        s.vs.push(vs);
-        s.a.push(scene.frame_acceleration(ts, xs, vs));
+        s.push_frame(scene, ts, xs, vs);
         for i in 0..n {
             let (x, v) = if k == 0 {
                 (scene.initial_positions[i], scene.initial_velocities[i])

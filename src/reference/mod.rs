@@ -887,10 +887,7 @@ impl<'a> Solver<'a> {
             let has_frame = self.has_frame();
             let (xs, vs) = if has_frame { self.frame_sample(ts) } else { (0.0, 0.0) };
             let s = &mut self.series;
-            s.t.push(ts);
-            s.xs.push(xs);
-            s.vs.push(vs);
-            s.a.push(self.scene.frame_acceleration(ts, xs, vs));
+            s.push_frame(self.scene, ts, xs, vs);
             for i in 0..self.n {
                 let (x, v) = match self.hold[i] {
                     Hold::Free => (self.x[i] + self.v[i] * (ts - self.t), self.v[i]),
