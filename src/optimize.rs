@@ -120,7 +120,7 @@ pub fn optimize(
                     let hi = values[(k + 1).min(values.len() - 1)];
                     (0..REFINE_POINTS)
                         .map(|i| {
-                            let x = lo.raw() + (hi.raw() - lo.raw()) * i as f64 / (REFINE_POINTS - 1) as f64;
+                            let x = crate::sweep::tidy(lo.raw() + (hi.raw() - lo.raw()) * i as f64 / (REFINE_POINTS - 1) as f64);
                             match lo {
                                 Length::Metres(_) => Length::Metres(x),
                                 Length::Rr(_) => Length::Rr(x),

@@ -56,6 +56,16 @@ fn invalid(loaded: &Loaded, field: &str, rule: &str) -> SceneError {
     SceneError::Invalid { file: loaded.path.clone(), field: field.into(), rule: rule.into() }
 }
 
+/// `x` rounded to 12 significant digits: evenly spaced values computed in binary read as
+/// written (`0.65`, not `0.6499999999999999`).
+pub fn tidy(x: f64) -> f64 {
+    if x == 0.0 || !x.is_finite() {
+        return x;
+    }
+    let scale = 10f64.powi(11 - x.abs().log10().floor() as i32);
+    (x * scale).round() / scale
+}
+
 /// Parses `PARAM=V1,V2,...` or `PARAM=A..B:N` (N values evenly spaced; lengths may carry
 /// `Rr`, as `0.5Rr..3Rr:6`).
 pub fn parse_axis(text: &str) -> Result<Axis, String> {
@@ -84,7 +94,7 @@ pub fn parse_axis(text: &str) -> Result<Axis, String> {
         }
         (0..n)
             .map(|k| {
-                let x = a.raw() + (b.raw() - a.raw()) * k as f64 / (n - 1) as f64;
+                let x = tidy(a.raw() + (b.raw() - a.raw()) * k as f64 / (n - 1) as f64);
                 match a {
                     Length::Metres(_) => Length::Metres(x),
                     Length::Rr(_) => Length::Rr(x),

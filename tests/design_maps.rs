@@ -40,6 +40,9 @@ fn axes_parse_lists_and_ranges_and_reject_the_rest() {
     assert_eq!(a.values.len(), 5);
     assert!(matches!(a.values[4], Length::Rr(x) if (x - 0.5).abs() < 1e-15));
     assert_eq!(parse_axis("restitution=0.5, 0.9").unwrap().values, vec![Length::Metres(0.5), Length::Metres(0.9)]);
+    // Evenly spaced values read as written.
+    let g = parse_axis("gap=0.1..0.7:5").unwrap();
+    assert_eq!(g.values.iter().map(|v| v.raw()).collect::<Vec<_>>(), vec![0.1, 0.25, 0.4, 0.55, 0.7]);
     for bad in ["colour=1,2", "gap", "gap=1..2", "gap=1Rr..2:3", "gap=a,b", "gap=1..2:1"] {
         assert!(parse_axis(bad).is_err(), "{bad}");
     }
