@@ -211,6 +211,14 @@ impl Harmonic {
                 _ => -(self.sin * c - self.cos * s),
             }
     }
+    /// `xp` and its first four derivatives at `t` (one `sin_cos` for all).
+    #[inline]
+    pub fn derivatives(&self, t: f64) -> [f64; 5] {
+        let (s, c) = (self.omega * t).sin_cos();
+        let (p, q) = (self.sin * s + self.cos * c, self.sin * c - self.cos * s);
+        let w = self.omega;
+        [p, w * q, -w * w * p, -w * w * w * q, w * w * w * w * p]
+    }
     /// `(xp, xp')` at `t`.
     #[inline]
     pub fn state(&self, t: f64) -> (f64, f64) {

@@ -47,7 +47,7 @@ pub const ALLOWED_OVERLAP: f64 = 0.005 * plugin::LENGTH_UNIT as f64;
 pub const ENERGY_GAIN_TOLERANCE: f64 = 1e-3;
 
 /// Largest gap between the straight path Rapier gives the walls over a step and the frame's
-/// true path, m: a fifth of Rapier's allowed contact error (`0.005 length_unit`), so that the
+/// true path, m: a fifth of [`ALLOWED_OVERLAP`], so that the
 /// walls a ball meets are where the frame is.
 pub const WALL_CHORD_ERROR: f64 = 1e-5;
 
@@ -55,10 +55,10 @@ pub const WALL_CHORD_ERROR: f64 = 1e-5;
 /// displacement and the steady forced amplitude, plus the excitation's load, m/s^2.
 pub fn peak_frame_acceleration(scene: &Scene) -> f64 {
     let Some(f) = scene.frame else { return 0.0 };
-    let steady = scene.harmonic_load().map_or(0.0, |(p, q, w)| {
-        crate::oscillator::Oscillator::new(f.mass, f.damping, f.stiffness).harmonic_response(p, q, w).amplitude()
+    let (steady, load) = scene.harmonic_load().map_or((0.0, 0.0), |(p, q, w)| {
+        let osc = crate::oscillator::Oscillator::new(f.mass, f.damping, f.stiffness);
+        (osc.harmonic_response(p, q, w).amplitude(), p.hypot(q))
     });
-    let load = scene.harmonic_load().map_or(0.0, |(p, q, _)| p.hypot(q));
     (f.stiffness * scene.initial_displacement.abs().max(steady) + load) / f.mass
 }
 
@@ -91,12 +91,12 @@ pub fn settings(scene: &Scene) -> StepSettings {
 /// slowly the more unequal the masses it couples: a light ball squeezed between a heavy one
 /// and a wall sinks into the wall with too few iterations (docs/BENCHMARKS.md, "Stress runs").
 pub fn default_iterations(scene: &Scene) -> usize {
-    let ratio = scene
-        .balls
-        .windows(2)
-        .map(|w| (w[0].mass / w[1].mass).max(w[1].mass / w[0].mass))
-        .fold(1.0f64, f64::max);
-    DEFAULT_SOLVER_ITERATIONS * (ratio.log10().ceil().max(1.0) as usize)
+    DEFAULT_SOLVER_ITERATIONS * (neighbour_mass_ratio(scene).log10().ceil().max(1.0) as usize)
+}
+
+/// The largest mass ratio of two neighbouring balls (1 for fewer than two balls).
+pub fn neighbour_mass_ratio(scene: &Scene) -> f64 {
+    scene.balls.windows(2).map(|w| (w[0].mass / w[1].mass).max(w[1].mass / w[0].mass)).fold(1.0, f64::max)
 }
 
 /// Refuses scenes the kinematic-frame coupling cannot reproduce.

@@ -42,6 +42,8 @@ pub struct Recording {
     /// Why the run cannot go on (a ball pushed through a wall, contacts that gained energy),
     /// when the self-check found it.
     pub failure: Option<String>,
+    /// The scene's mechanical energy at t = 0, J.
+    pub initial_energy: f64,
 }
 
 impl Recording {
@@ -64,6 +66,7 @@ impl Recording {
             sample_count: samples,
             impulse_floor: 1e-6 * m_min * super::plugin::speed_scale(scene).max(1e-6),
             failure: None,
+            initial_energy: scene.initial_energy(),
         }
     }
 }
@@ -109,6 +112,7 @@ pub struct Scratch {
     dp: Vec<f64>,
     active: Vec<bool>,
     j: Vec<f64>,
+    shares: Vec<f64>,
 }
 
 /// The after-step system: velocity jumps, the restitution Rapier skipped, frame feedback,
@@ -134,7 +138,7 @@ pub fn feedback(
     clock.steps += 1;
     clock.t += plan.h;
     let Ok((sim, colliders, mut set)) = context.single_mut() else { return };
-    let Scratch { x: x_new, v: v_new, dp, active, j, handles } = &mut *scratch;
+    let Scratch { x: x_new, v: v_new, dp, active, j, handles, shares } = &mut *scratch;
     if handles.len() != n {
         handles.clear();
         handles.extend(bodies.balls.iter().map(|e| set.entity2body()[e]));
@@ -280,7 +284,8 @@ pub fn feedback(
         let u_after = vel(v_new, frame_post, a) - vel(v_new, frame_post, b);
         j[p] * 0.5 * (u + u_after)
     };
-    let shares: Vec<f64> = (0..=n).map(share).collect();
+    shares.clear();
+    shares.extend((0..=n).map(share));
     let total: f64 = shares.iter().sum();
     let gross: f64 = shares.iter().filter(|x| **x > 0.0).sum();
     let split = total >= 0.0 && gross > 0.0 && shares.iter().any(|x| *x < 0.0);
@@ -343,7 +348,7 @@ fn self_check(
             let (left, right) = (x[i] - b.radius - xs, xs + c.length - x[i] - b.radius);
             let depth = -left.min(right);
             if depth > ALLOWED_OVERLAP + 1e-6 {
-                let ratio = scene.balls.windows(2).map(|w| (w[0].mass / w[1].mass).max(w[1].mass / w[0].mass)).fold(1.0, f64::max);
+                let ratio = super::neighbour_mass_ratio(scene);
                 return Some(format!(
                     "at t = {t:.6e} s {} is {depth:.3e} m into the {} wall, past Rapier's allowed overlap ({ALLOWED_OVERLAP:.1e} m): \
                      Rapier's iterative solver did not hold it (largest neighbouring mass ratio {ratio:.0})",
@@ -353,7 +358,7 @@ fn self_check(
             }
         }
     }
-    let energy_in = scene.initial_energy().abs() + forcing_work.abs();
+    let energy_in = rec.initial_energy.abs() + forcing_work.abs();
     let scale = energy_in.max(1e-12);
     // Free chains (the KER experiment, no frame) are judged on their total energy only: there
     // Rapier solves a touching chain at once and moves energy between the pairs of one step
@@ -383,7 +388,7 @@ fn self_check(
 
 /// Overlap a projected contact keeps: Rapier's allowed error (`0.005 length_unit`), less the
 /// walls' chord error within a step, so that samples inside a step stay within the allowed error.
-pub const PROJECTED_OVERLAP: f64 = 0.005 * super::plugin::LENGTH_UNIT as f64 - super::WALL_CHORD_ERROR;
+pub const PROJECTED_OVERLAP: f64 = super::ALLOWED_OVERLAP - super::WALL_CHORD_ERROR;
 /// Deepest overlap projected back, as a fraction of the ball's radius: anything deeper is a
 /// failure of the contact model and is left for the checks to see.
 pub const MAX_PROJECTION: f64 = 0.25;

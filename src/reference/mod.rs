@@ -76,7 +76,7 @@ pub fn simulate(scene: &Scene) -> Result<Run, ReferenceError> {
 }
 
 /// Speed scale of base motion (`w Y`), 0 otherwise.
-fn g_amplitude_speed(scene: &Scene) -> f64 {
+fn base_motion_speed(scene: &Scene) -> f64 {
     scene.forcing.filter(|g| g.kind == crate::scene::ForcingKind::Base).map_or(0.0, |g| g.omega() * g.amplitude)
 }
 
@@ -157,7 +157,8 @@ impl Segment {
         let o = &self.osc;
         let (ah, jh) = o.state(self.a0, self.j0, t - self.t0);
         let sh = -2.0 * o.sigma * jh - o.w0sq * ah;
-        let parts = [(ah, f.xp.derivative(t, 2)), (jh, f.xp.derivative(t, 3)), (sh, f.xp.derivative(t, 4))];
+        let d = f.xp.derivatives(t);
+        let parts = [(ah, d[2]), (jh, d[3]), (sh, d[4])];
         let amp = f.xp.amplitude();
         let w = f.xp.omega;
         let mut out = [(0.0, 0.0); 3];
@@ -195,7 +196,8 @@ impl Segment {
         }
         let o = &self.osc;
         let amp3 = f.xp.amplitude() * f.xp.omega.powi(3);
-        let accel = |s: f64| self.forced_derivatives(f, s)[0].0;
+        // The scan needs the acceleration alone.
+        let accel = |s: f64| o.state(self.a0, self.j0, s - self.t0).0 + f.xp.derivative(s, 2);
         let slope_bound = |s: f64, h: f64| {
             let (ah, jh) = o.state(self.a0, self.j0, s - self.t0);
             let sh = -2.0 * o.sigma * jh - o.w0sq * ah;
@@ -323,7 +325,7 @@ impl<'a> Solver<'a> {
         });
         let load = scene.harmonic_load();
         let forced_speed =
-            load.map_or(0.0, |(p, q, w)| osc.harmonic_response(p, q, w).amplitude() * w + g_amplitude_speed(scene));
+            load.map_or(0.0, |(p, q, w)| osc.harmonic_response(p, q, w).amplitude() * w + base_motion_speed(scene));
         let speed_scale = (bare_omega * xs0.abs()).max(forced_speed)
             .max(scene.initial_velocities.iter().fold(0.0, |m: f64, v| m.max(v.abs())))
             .max(length_scale / scene.horizon);
