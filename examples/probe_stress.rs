@@ -15,7 +15,7 @@ fn main() {
         format!("{{\"seed\":{seed},\"n\":{},\"w\":{w},\"xs0\":{},\"gap\":{},\"clr\":{},\"e\":{},\"rmin\":{rmin},\"mmax\":{mmax},\"zeta\":{},\"out\":\"{}\",\"detail\":\"{}\"}}",
             scene.balls.len(), scene.initial_displacement.abs(), c.gap, c.clearance, scene.restitution,
             f.damping / (2.0 * (f.stiffness * f.mass).sqrt()).max(1e-300),
-            match &r { Ok(run) if run.model.starts_with(lpc_damper::stress::REFUSED) => "refused", Ok(_) => "ok", Err(f) => f.check },
+            match &r { Ok(lpc_damper::stress::Passed::Refused { .. }) => "refused", Ok(_) => "ok", Err(f) => f.check },
             match &r { Err(f) => f.detail.replace('"', "'"), _ => String::new() })
     }).collect();
     for r in rows { println!("{r}"); }

@@ -41,6 +41,8 @@ pub struct Outcome {
     pub minimal_scene: Option<String>,
     /// The model's reason when it refused the scene (before or during the run): a pass.
     pub refused: Option<String>,
+    /// The refusal came during the run (the model stopped itself).
+    pub refused_during_run: bool,
 }
 
 /// A random valid scene file: 1 to 50 balls, mass ratios 1 to 1000, e in [0, 1], gaps from 0
@@ -79,8 +81,23 @@ pub fn random_scene_file(seed: u64, max_horizon: f64) -> SceneFile {
     }
 }
 
+/// A run that passed the checks.
+#[derive(Debug)]
+pub enum Passed {
+    /// The run, checked.
+    Run(Box<Run>),
+    /// The model refused the scene with this reason (a correct answer); `during_run` when it
+    /// stopped itself part way rather than refusing up front.
+    Refused {
+        /// Why.
+        reason: String,
+        /// Stopped during the run.
+        during_run: bool,
+    },
+}
+
 /// Runs `model` on `scene` and checks the run.
-pub fn check_run(model: Model, scene: &Scene) -> Result<Run, Failure> {
+pub fn check_run(model: Model, scene: &Scene) -> Result<Passed, Failure> {
     let outcome = catch_unwind(AssertUnwindSafe(|| model.simulate(scene)));
     let run = match outcome {
         Err(panic) => {
@@ -92,9 +109,8 @@ pub fn check_run(model: Model, scene: &Scene) -> Result<Run, Failure> {
             return Err(Failure { check: "panic", detail: msg });
         }
         // Refusing with a reason, before or during the run, is a correct answer.
-        Ok(Err(crate::model::ModelError::Refused(reason) | crate::model::ModelError::Unstable(reason))) => {
-            return Ok(refused_run(scene, &reason))
-        }
+        Ok(Err(crate::model::ModelError::Refused(reason))) => return Ok(Passed::Refused { reason, during_run: false }),
+        Ok(Err(crate::model::ModelError::Unstable(reason))) => return Ok(Passed::Refused { reason, during_run: true }),
         Ok(Err(e)) => {
             let check = if e.to_string().contains("stalled") { "stall" } else { "error" };
             return Err(Failure { check, detail: e.to_string() });
@@ -102,21 +118,9 @@ pub fn check_run(model: Model, scene: &Scene) -> Result<Run, Failure> {
         Ok(Ok(run)) => run,
     };
     check(model, scene, &run)?;
-    Ok(run)
+    Ok(Passed::Run(Box::new(run)))
 }
 
-/// Marks the model name of a stand-in run for a refused scene.
-pub const REFUSED: &str = "refused: ";
-
-/// A stand-in for a scene the model refuses with a reason (that is a correct answer); its
-/// model name is [`REFUSED`] followed by the reason.
-fn refused_run(scene: &Scene, reason: &str) -> Run {
-    Run {
-        sample_dt: scene.sample_dt,
-        initial_displacement: scene.initial_displacement,
-        ..Run::empty(&scene.name, &format!("{REFUSED}{reason}"))
-    }
-}
 
 /// The checks of a run of `model` on `scene` (see the module docs).
 pub fn check(model: Model, scene: &Scene, run: &Run) -> Result<(), Failure> {
@@ -295,14 +299,15 @@ pub fn stress(model: Model, seed: u64, count: u64, max_horizon: f64, progress: &
         .map(|s| {
             let file = random_scene_file(s, max_horizon);
             let scene = validate(&file).expect("generated scenes are valid");
-            let (failure, refused) = match check_run(model, &scene) {
-                Ok(run) => (None, run.model.strip_prefix(REFUSED).map(str::to_string)),
-                Err(f) => (Some(f), None),
+            let (failure, refused, refused_during_run) = match check_run(model, &scene) {
+                Ok(Passed::Run(_)) => (None, None, false),
+                Ok(Passed::Refused { reason, during_run }) => (None, Some(reason), during_run),
+                Err(f) => (Some(f), None, false),
             };
             let minimal_scene =
                 failure.as_ref().map(|f| toml::to_string(&shrink(model, &file, f.check)).unwrap_or_default());
             progress();
-            Outcome { seed: s, model: model.name(), failure, minimal_scene, refused }
+            Outcome { seed: s, model: model.name(), failure, minimal_scene, refused, refused_during_run }
         })
         .collect()
 }

@@ -1019,10 +1019,7 @@ fn cmd_stress(a: StressArgs) -> Result<()> {
                 let total = outcomes.iter().filter(|o| o.model == model.name()).count();
                 let failed = failures.iter().filter(|o| o.model == model.name()).count();
                 let refused = outcomes.iter().filter(|o| o.model == model.name() && o.refused.is_some()).count();
-                let unstable = outcomes
-                    .iter()
-                    .filter(|o| o.model == model.name() && o.refused.as_deref().is_some_and(|r| r.contains("stopped")))
-                    .count();
+                let unstable = outcomes.iter().filter(|o| o.model == model.name() && o.refused_during_run).count();
                 println!(
                     "{}: {} passed ({} of them refused with a reason, {} of those during the run), {} failed",
                     model.name(),
