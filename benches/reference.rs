@@ -1,12 +1,14 @@
 //! Criterion benchmarks of the reference model: one per paper scene (5 s horizon, 1 ms
-//! samples), plus the chain experiment. `cargo bench --bench reference`.
+//! samples), the forced LSL damper (4 s, where the frame's motion is not a free oscillation and
+//! contacts are found by the forced root search), plus the chain experiment.
+//! `cargo bench --bench reference`.
 
 use criterion::{criterion_group, criterion_main, Criterion};
 use lpc_damper::scene::{load, load_scene, scenes_dir};
 
 fn paper_scenes(c: &mut Criterion) {
     let mut group = c.benchmark_group("reference");
-    for name in ["no-damper", "conventional", "lpc-lsl", "lpc-lslsl", "chain-lll"] {
+    for name in ["no-damper", "conventional", "lpc-lsl", "lpc-lslsl", "chain-lll", "forced-lsl"] {
         let scene = load_scene(scenes_dir().join(format!("{name}.toml"))).unwrap();
         group.bench_function(name, |b| b.iter(|| lpc_damper::reference::simulate(std::hint::black_box(&scene)).unwrap()));
     }

@@ -4,7 +4,7 @@ use rayon::prelude::*;
 fn main() {
     let n: u64 = std::env::args().nth(1).unwrap().parse().unwrap();
     let rows: Vec<String> = (1..=n).into_par_iter().map(|seed| {
-        let file = lpc_damper::stress::random_scene_file(seed, 1.0);
+        let file = lpc_damper::stress::random_scene_file(seed, 1.0, false);
         let scene = lpc_damper::scene::from_file(file, "s", "s").unwrap().scene.unwrap();
         let r = lpc_damper::stress::check_run(lpc_damper::Model::Rapier, &scene);
         let f = scene.frame.unwrap();

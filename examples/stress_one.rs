@@ -12,7 +12,7 @@ fn main() {
     let seed: u64 = args[1].parse().unwrap();
     let max_h: f64 = args.get(2).map_or(100.0, |s| s.parse().unwrap());
     let model: lpc_damper::Model = args.get(3).map_or("reference", |s| s).parse().unwrap();
-    let file = lpc_damper::stress::random_scene_file(seed, max_h);
+    let file = lpc_damper::stress::random_scene_file(seed, max_h, false);
     if args.iter().any(|a| a == "--toml") {
         println!("{}", toml::to_string(&file).unwrap());
         return;

@@ -7,7 +7,13 @@
 //! spread by no more than twice that. Until then the horizon doubles (up to
 //! [`MAX_DOUBLINGS`] times). A response that never settles (impact dampers can respond
 //! chaotically near resonance) is reported with `steady = false`; its amplitude is then the
-//! largest peak of the last block, the worst case an engineer sizes for.
+//! largest peak of the last block, the worst case an engineer sizes for. Each frequency also
+//! reports how many impacts per forcing period it saw in that last block (two per period is
+//! the classic symmetric motion of a one-ball damper).
+//!
+//! A run that fails (a model stops with its reason, or the reference's postcondition finds a
+//! contact it missed) is never read as steady: its frequency carries the error and no
+//! amplitude, and the others are still reported.
 
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
@@ -26,20 +32,25 @@ pub const MAX_DOUBLINGS: u32 = 3;
 pub const SAMPLES_PER_PERIOD: f64 = 100.0;
 
 /// One frequency of the response (the JSON contract of `lpc frf`).
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct FrfPoint {
     /// Forcing frequency, Hz.
     pub frequency: f64,
-    /// Steady amplitude of `xs` with the damper, m.
-    pub amplitude: f64,
-    /// Steady amplitude of `xs` of the bare frame, m.
-    pub amplitude_no_damper: f64,
+    /// Steady amplitude of `xs` with the damper, m (`None` when its run failed).
+    pub amplitude: Option<f64>,
+    /// Steady amplitude of `xs` of the bare frame, m (`None` when its run failed).
+    pub amplitude_no_damper: Option<f64>,
     /// Whether the response with the damper reached a steady state.
     pub steady: bool,
     /// Whether the bare frame's did.
     pub steady_no_damper: bool,
     /// Simulated time used with the damper, s.
     pub horizon: f64,
+    /// Impacts per forcing period with the damper over the measuring window (the last block
+    /// of periods).
+    pub impacts_per_period: Option<f64>,
+    /// Why a run at this frequency failed, when one did.
+    pub error: Option<String>,
 }
 
 /// The steady-state reading of one run.
@@ -49,6 +60,8 @@ pub struct SteadyState {
     pub amplitude: f64,
     /// Whether the criterion holds.
     pub steady: bool,
+    /// Impacts per forcing period over the measuring window.
+    pub impacts_per_period: f64,
 }
 
 /// Reads the steady amplitude of `run`, forced with period `period`.
@@ -62,9 +75,15 @@ pub fn steady_state(run: &Run, period: f64) -> SteadyState {
             peaks[k] = peaks[k].max(x.abs());
         }
     }
+    // The measuring window: the last block, or every period when there are too few.
+    let window = periods.min(BLOCK_PERIODS);
+    let from = (periods - window) as f64 * period;
+    let to = periods as f64 * period;
+    let impacts = run.impacts.iter().filter(|i| i.t >= from && i.t < to).count();
+    let impacts_per_period = if window > 0 { impacts as f64 / window as f64 } else { 0.0 };
     if periods < 2 * BLOCK_PERIODS {
         let amplitude = peaks.iter().fold(0.0, |m: f64, p| m.max(*p));
-        return SteadyState { amplitude, steady: false };
+        return SteadyState { amplitude, steady: false, impacts_per_period };
     }
     let last = &peaks[periods - BLOCK_PERIODS..];
     let before = &peaks[periods - 2 * BLOCK_PERIODS..periods - BLOCK_PERIODS];
@@ -74,7 +93,7 @@ pub fn steady_state(run: &Run, period: f64) -> SteadyState {
     let min = last.iter().fold(f64::INFINITY, |m: f64, p| m.min(*p));
     let scale = m1.max(f64::MIN_POSITIVE);
     let steady = (m1 - m0).abs() <= STEADY_TOLERANCE * scale && max - min <= 2.0 * STEADY_TOLERANCE * scale;
-    SteadyState { amplitude: if steady { m1 } else { max }, steady }
+    SteadyState { amplitude: if steady { m1 } else { max }, steady, impacts_per_period }
 }
 
 /// The scene forced at `frequency`, sampled finely enough to read peaks, over at least
@@ -116,11 +135,12 @@ pub fn frequencies(from: f64, to: f64, steps: usize) -> Vec<f64> {
 }
 
 /// The frequency response of `scene` (which must be forced) at each frequency, with and
-/// without the damper, in parallel; `progress` is called after each run.
-pub fn frf(scene: &Scene, frequencies: &[f64], model: Model, progress: &(dyn Fn() + Sync)) -> Result<Vec<FrfPoint>, ModelError> {
+/// without the damper, in parallel; `progress` is called after each run. A run that fails
+/// leaves its frequency without that amplitude, not steady, with the error.
+pub fn frf(scene: &Scene, frequencies: &[f64], model: Model, progress: &(dyn Fn() + Sync)) -> Vec<FrfPoint> {
     let bare = scene.without_damper();
     let jobs: Vec<(usize, bool)> = (0..frequencies.len()).flat_map(|k| [(k, true), (k, false)]).collect();
-    let results: Vec<(SteadyState, f64)> = jobs
+    let results: Vec<Result<(SteadyState, f64), ModelError>> = jobs
         .par_iter()
         .map(|&(k, damper)| {
             let base = if damper { scene } else { &bare };
@@ -128,21 +148,26 @@ pub fn frf(scene: &Scene, frequencies: &[f64], model: Model, progress: &(dyn Fn(
             progress();
             r
         })
-        .collect::<Result<_, _>>()?;
-    Ok(frequencies
+        .collect();
+    frequencies
         .iter()
         .enumerate()
         .map(|(k, &frequency)| {
-            let (with, horizon) = results[2 * k];
-            let (without, _) = results[2 * k + 1];
+            let (with, without) = (&results[2 * k], &results[2 * k + 1]);
+            let error = [with, without]
+                .iter()
+                .find_map(|r| r.as_ref().err())
+                .map(|e| e.to_string());
             FrfPoint {
                 frequency,
-                amplitude: with.amplitude,
-                amplitude_no_damper: without.amplitude,
-                steady: with.steady,
-                steady_no_damper: without.steady,
-                horizon,
+                amplitude: with.as_ref().ok().map(|(r, _)| r.amplitude),
+                amplitude_no_damper: without.as_ref().ok().map(|(r, _)| r.amplitude),
+                steady: with.as_ref().is_ok_and(|(r, _)| r.steady),
+                steady_no_damper: without.as_ref().is_ok_and(|(r, _)| r.steady),
+                horizon: with.as_ref().map_or(0.0, |(_, h)| *h),
+                impacts_per_period: with.as_ref().ok().map(|(r, _)| r.impacts_per_period),
+                error,
             }
         })
-        .collect())
+        .collect()
 }

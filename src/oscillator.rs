@@ -13,6 +13,10 @@
 
 use std::f64::consts::PI;
 
+/// Ulps of round-off that one evaluation of a closed form may accumulate, with a factor of two
+/// to spare (see [`Oscillator::roundoff`]).
+pub const ROUNDOFF_ULPS: f64 = 16.0;
+
 /// Damping regime, with the constants its basis needs.
 #[derive(Debug, Clone, Copy, PartialEq)]
 enum Regime {
@@ -107,6 +111,39 @@ impl Oscillator {
     pub fn transition(&self, h: f64) -> [[f64; 2]; 2] {
         let (e, f) = self.basis(h);
         [[e + self.sigma * f, f], [-self.w0sq * f, e - self.sigma * f]]
+    }
+
+    /// The fastest rate (1/s) at which the basis turns or decays, `2 (sigma + w0)`: the
+    /// round-off of evaluating it at `t` grows as `1 + rate t` (the rounding of the arguments
+    /// of `exp`, `sin` and `cos`), see [`Oscillator::roundoff`].
+    pub fn rate(&self) -> f64 {
+        2.0 * (self.sigma + self.w0sq.sqrt())
+    }
+
+    /// A bound on `|F(t)|` for every `t >= 0` (`F <= t` always; this caps it): `1/w`
+    /// oscillating, `1/(2b)` overdamped, `1/(e sigma)` critical, infinite without damping or
+    /// spring.
+    fn f_cap(&self) -> f64 {
+        match self.regime {
+            Regime::Under { w } => 1.0 / w,
+            Regime::Over { b, .. } => 1.0 / (2.0 * b),
+            Regime::Critical if self.sigma > 0.0 => 1.0 / (std::f64::consts::E * self.sigma),
+            Regime::Critical => f64::INFINITY,
+        }
+    }
+
+    /// A bound on the round-off of evaluating `y(t) = y0 E(t) + (y1 + sigma y0) F(t)` (the
+    /// first component of [`Oscillator::state`]) in floating point, for any `t >= 0`.
+    ///
+    /// `|E| <= 1` and `|F| <= min(t, f_cap)` for `sigma >= 0`; `E` and `F` are computed with
+    /// a relative error of a few ulps plus the rounding of their arguments, `eps rate t`; the
+    /// products and the sum add a few ulps more. [`ROUNDOFF_ULPS`] covers all of it with a
+    /// factor of two to spare. It is the margin that the reference's root isolation adds to
+    /// every bound it clears an interval with (docs/MODEL.md, "Finding contacts in floating
+    /// point").
+    pub fn roundoff(&self, y0: f64, y1: f64, t: f64) -> f64 {
+        let t = t.max(0.0);
+        ROUNDOFF_ULPS * f64::EPSILON * (2.0 + self.rate() * t) * (y0.abs() + (y1 + self.sigma * y0).abs() * t.min(self.f_cap()))
     }
 
     /// The first time `t > after` at which the solution `y` with `y(0) = y0`, `y'(0) = y1`
@@ -224,6 +261,11 @@ impl Harmonic {
     pub fn state(&self, t: f64) -> (f64, f64) {
         let (s, c) = (self.omega * t).sin_cos();
         (self.sin * s + self.cos * c, self.omega * (self.sin * c - self.cos * s))
+    }
+    /// A bound on the round-off of [`Harmonic::derivative`] `n` at `t`: a few ulps of
+    /// `w^n (|X| + |Z|)`, plus the rounding of the phase `w t` (see [`Oscillator::roundoff`]).
+    pub fn roundoff(&self, t: f64, n: u32) -> f64 {
+        ROUNDOFF_ULPS * f64::EPSILON * self.omega.powi(n as i32) * (self.sin.abs() + self.cos.abs()) * (2.0 + (self.omega * t).abs())
     }
     /// Amplitude `sqrt(X^2 + Z^2)`, m.
     pub fn amplitude(&self) -> f64 {

@@ -102,7 +102,7 @@ fn frequency_response_of_the_bare_frame_is_its_receptance() {
             s
         };
         let freqs = frf::frequencies(3.0, 5.0, 5);
-        let points = frf::frf(&scene, &freqs, Model::Reference, &|| {}).unwrap();
+        let points = frf::frf(&scene, &freqs, Model::Reference, &|| {});
         assert_eq!(points.len(), 5);
         for p in points {
             let w = 2.0 * std::f64::consts::PI * p.frequency;
@@ -115,7 +115,8 @@ fn frequency_response_of_the_bare_frame_is_its_receptance() {
             // Steady means the last blocks agree within STEADY_TOLERANCE; the sampled peak of
             // a sine is low by at most 1 - cos(pi / SAMPLES_PER_PERIOD).
             let tol = frf::STEADY_TOLERANCE + 1.0 - (std::f64::consts::PI / frf::SAMPLES_PER_PERIOD).cos();
-            assert!((p.amplitude_no_damper / exact - 1.0).abs() <= tol, "{kind:?} {} Hz: {} vs {exact}", p.frequency, p.amplitude_no_damper);
+            let amplitude = p.amplitude_no_damper.expect("the bare frame's run succeeds");
+            assert!((amplitude / exact - 1.0).abs() <= tol, "{kind:?} {} Hz: {amplitude} vs {exact}", p.frequency);
         }
     }
 }

@@ -10,7 +10,7 @@ use lpc_damper::Model;
 #[test]
 fn stiff_frames_at_rest_do_not_stall() {
     for seed in [1557, 1977] {
-        let file = random_scene_file(seed, 100.0);
+        let file = random_scene_file(seed, 100.0, false);
         let scene = lpc_damper::scene::from_file(file, "stress", "stress").unwrap().scene.unwrap();
         if let Err(f) = check_run(Model::Reference, &scene) {
             panic!("seed {seed}: {} ({})", f.check, f.detail);

@@ -161,6 +161,10 @@ struct StressArgs {
     /// Longest horizon drawn, s.
     #[arg(long, default_value_t = 100.0)]
     max_horizon: f64,
+    /// Drive every scene by a harmonic force or base motion (from far below to far above the
+    /// frame's resonance, from barely impacting to violent).
+    #[arg(long)]
+    forced: bool,
     /// Output format on standard output.
     #[arg(long, value_enum, default_value_t = Format::Text)]
     format: Format,
@@ -650,7 +654,7 @@ fn cmd_frf(a: FrfArgs) -> Result<()> {
     let freqs = lpc_damper::frf::frequencies(from, to, a.steps);
     let bar = progress_bar(2 * freqs.len(), "frf");
     let start = std::time::Instant::now();
-    let points = lpc_damper::frf::frf(&scene, &freqs, a.model, &|| bar.inc(1))?;
+    let points = lpc_damper::frf::frf(&scene, &freqs, a.model, &|| bar.inc(1));
     bar.finish_and_clear();
     let elapsed = start.elapsed().as_secs_f64();
     if let Some(dir) = &a.out {
@@ -676,21 +680,37 @@ fn cmd_frf(a: FrfArgs) -> Result<()> {
                 2 * points.len(),
                 elapsed
             );
-            println!("{:>10} {:>14} {:>14} {:>8} {:>7}", "f Hz", "amp mm", "no damper mm", "ratio", "steady (with/without)");
+            println!(
+                "{:>10} {:>14} {:>14} {:>8} {:>16} {:>22}",
+                "f Hz", "amp mm", "no damper mm", "ratio", "impacts/period", "steady (with/without)"
+            );
+            let mm = |x: Option<f64>| x.map_or("failed".to_string(), |x| format!("{:.4}", x * 1e3));
             for p in &points {
+                let ratio = match (p.amplitude, p.amplitude_no_damper) {
+                    (Some(a), Some(b)) => format!("{:.3}", a / b),
+                    _ => "-".into(),
+                };
                 println!(
-                    "{:>10.4} {:>14.4} {:>14.4} {:>8.3} {:>7}",
+                    "{:>10.4} {:>14} {:>14} {:>8} {:>16} {:>22}",
                     p.frequency,
-                    p.amplitude * 1e3,
-                    p.amplitude_no_damper * 1e3,
-                    p.amplitude / p.amplitude_no_damper,
+                    mm(p.amplitude),
+                    mm(p.amplitude_no_damper),
+                    ratio,
+                    p.impacts_per_period.map_or("-".into(), |x| format!("{x:.2}")),
                     format!("{}/{}", if p.steady { "yes" } else { "no" }, if p.steady_no_damper { "yes" } else { "no" })
                 );
+            }
+            for p in points.iter().filter(|p| p.error.is_some()) {
+                println!("{} Hz failed: {}", p.frequency, p.error.as_deref().unwrap_or_default());
             }
             if let Some(dir) = &a.out {
                 println!("wrote frf.json, frf.csv, frf.png, frf.svg to {}", dir.display());
             }
         }
+    }
+    let failed = points.iter().filter(|p| p.error.is_some()).count();
+    if failed > 0 {
+        return Err(anyhow::anyhow!("{failed} of {} frequencies failed (see above)", points.len()));
     }
     Ok(())
 }
@@ -847,13 +867,13 @@ fn cmd_compare(a: CompareArgs) -> Result<()> {
                 st.solver_iterations
             );
             println!(
-                "{:>10} {:>10} {:>10} {:>12} {:>12} {:>12} {:>12} {:>8}",
-                "model", "wall ms", "x realtime", "rms xs mm", "early xs mm", "settle d s", "loss d %E0", "impacts"
+                "{:>10} {:>10} {:>10} {:>12} {:>12} {:>12} {:>12} {:>14}",
+                "model", "wall ms", "x realtime", "rms xs mm", "early xs mm", "settle d s", "loss d %E0", "impacts (d)"
             );
             let row = |name: &str, s: &RunSummary, e: Option<&Errors>| {
                 let e = e.copied();
                 println!(
-                    "{:>10} {:>10.3} {:>10.0} {:>12} {:>12} {:>12} {:>12} {:>8}",
+                    "{:>10} {:>10.3} {:>10.0} {:>12} {:>12} {:>12} {:>12} {:>14}",
                     name,
                     s.wall_time_s * 1e3,
                     s.horizon / s.wall_time_s,
@@ -862,7 +882,7 @@ fn cmd_compare(a: CompareArgs) -> Result<()> {
                     e.map_or("-".into(), |e| e.settling_time_diff.map_or("n/a".into(), |d| format!("{d:+.3}"))),
                     e.map_or("-".into(), |e| format!("{:+.3}", e.impact_loss_diff * 100.0)),
                     match e {
-                        Some(e) => format!("{}{:+}", s.impact_count, e.impact_count_diff),
+                        Some(e) => format!("{} ({:+})", s.impact_count, e.impact_count_diff),
                         None => s.impact_count.to_string(),
                     }
                 );
@@ -995,7 +1015,7 @@ fn cmd_stress(a: StressArgs) -> Result<()> {
     let start = std::time::Instant::now();
     for &model in &a.models {
         let bar = progress_bar(a.count as usize, &format!("stress {}", model.name()));
-        outcomes.extend(lpc_damper::stress::stress(model, a.seed, a.count, a.max_horizon, &|| bar.inc(1)));
+        outcomes.extend(lpc_damper::stress::stress(model, a.seed, a.count, a.max_horizon, a.forced, &|| bar.inc(1)));
         bar.finish_and_clear();
     }
     let failures: Vec<_> = outcomes.iter().filter(|o| o.failure.is_some()).collect();

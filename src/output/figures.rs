@@ -334,16 +334,17 @@ pub fn sweep_curves(parameter: &str, runs: &[(String, Run)]) -> Figure {
 /// Frequency response: steady amplitude of `xs` against forcing frequency, with and without
 /// the damper.
 pub fn frf_chart(points: &[crate::frf::FrfPoint], scene: &str, model: &str) -> Figure {
-    let f: Vec<f64> = points.iter().map(|p| p.frequency).collect();
+    // Frequencies whose run failed have no amplitude to draw.
+    let curve = |label: &str, amplitude: fn(&crate::frf::FrfPoint) -> Option<f64>| {
+        let known: Vec<(f64, f64)> = points.iter().filter_map(|p| amplitude(p).map(|a| (p.frequency, a * 1e3))).collect();
+        Curve { label: label.into(), x: known.iter().map(|k| k.0).collect(), y: known.iter().map(|k| k.1).collect() }
+    };
     Figure {
         name: "frf".into(),
         title: format!("{scene}: steady amplitude ({model})"),
         x_desc: "forcing frequency (Hz)".into(),
         y_desc: "amplitude of xs (mm)".into(),
-        curves: vec![
-            Curve { label: "with damper".into(), x: f.clone(), y: points.iter().map(|p| p.amplitude * 1e3).collect() },
-            Curve { label: "without damper".into(), x: f, y: points.iter().map(|p| p.amplitude_no_damper * 1e3).collect() },
-        ],
+        curves: vec![curve("with damper", |p| p.amplitude), curve("without damper", |p| p.amplitude_no_damper)],
         points: true,
     }
 }

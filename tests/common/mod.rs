@@ -2,6 +2,8 @@
 //! problem collection): scenes built in code whose answers are known by hand.
 #![allow(dead_code)]
 
+pub mod masri_caughey;
+
 use lpc_damper::scene::{ball_radius, Ball, BallKind, Container, Frame, RapierSettings, Scene};
 
 /// The paper's frame (Table 1).
