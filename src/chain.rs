@@ -1,4 +1,4 @@
-//! The chain experiment of MODEL.md §6: an incident ball strikes a chain of balls at rest; the
+//! The chain experiment of docs/MODEL.md §8: an incident ball strikes a chain of balls at rest; the
 //! kinetic energy ratio `KER = KE of all balls after / KE of the incident ball before`.
 
 use rayon::prelude::*;

@@ -1,4 +1,4 @@
-//! Headline metrics of MODEL.md §4, computed from a [`Run`]'s samples once, the same way for
+//! Headline metrics of docs/MODEL.md §7, computed from a [`Run`]'s samples once, the same way for
 //! every model: peaks after one bare period, RMS, settling time, energy remaining.
 
 use crate::run::Run;

@@ -16,7 +16,7 @@
 //!   raised to it.
 //! - **Frame.** Wall contact forces act on the frame (equal and opposite), so the frame moves
 //!   under its true force. The reported acceleration series stays the smooth part
-//!   `frame_force / ms` (MODEL.md §4). The frame's true acceleration is
+//!   `frame_force / ms` (docs/MODEL.md §6). The frame's true acceleration is
 //!   `(frame_force + wall contact force) / ms`; a wall impact's `peak_force` is the wall's
 //!   largest contact force, so the true acceleration during it reaches
 //!   `|a| + peak_force / ms`.

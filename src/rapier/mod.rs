@@ -2,7 +2,7 @@
 //! kinematic body moved by the exact damped-oscillator step, and every ball-wall impact is fed
 //! back into the frame as the opposite of the balls' momentum change.
 //!
-//! Where it departs from the impulse model (MODEL.md §3), and why:
+//! Where it departs from the impulse model (docs/MODEL.md §3-4), and why:
 //! - Rapier bounces a contact only on the step in which it is new (it carried no impulse the
 //!   step before); a contact that stays loaded is treated plastically. Balls that touch, or
 //!   whose gap closes within one step of another impact, therefore do not exchange momentum

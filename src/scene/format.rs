@@ -5,7 +5,7 @@
 use serde::{Deserialize, Serialize};
 
 /// A whole scene file. `[frame]` + `[balls]` describe a damper; `[chain]` describes the
-/// chain experiment of MODEL.md §6 instead.
+/// chain experiment of docs/MODEL.md §8 instead.
 #[derive(Debug, Clone, Deserialize, Serialize, Default)]
 #[serde(deny_unknown_fields)]
 pub struct SceneFile {
@@ -162,7 +162,7 @@ pub struct SweepFile {
     pub values_y: Option<Vec<Length>>,
 }
 
-/// `[chain]`: the KER experiment of MODEL.md §6.
+/// `[chain]`: the KER experiment of docs/MODEL.md §8.
 #[derive(Debug, Clone, Deserialize, Serialize)]
 #[serde(deny_unknown_fields)]
 pub struct ChainFile {

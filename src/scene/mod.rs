@@ -1,5 +1,5 @@
 //! Scene description and validation: the only place where a scene file is parsed and checked.
-//! Every model receives a [`Scene`] that is already known to be valid (MODEL.md §1-2, §6).
+//! Every model receives a [`Scene`] that is already known to be valid (docs/MODEL.md §1-2, §8).
 
 pub mod format;
 
@@ -8,7 +8,7 @@ use std::path::{Path, PathBuf};
 
 pub use format::{Arrangement, ForcingKind, Length, SceneFile};
 
-/// Default simulated time, s (MODEL.md §5).
+/// Default simulated time, s (docs/MODEL.md §8).
 pub const DEFAULT_HORIZON: f64 = 5.0;
 /// Default output sampling step, s.
 pub const DEFAULT_SAMPLE_DT: f64 = 1e-3;
@@ -48,7 +48,7 @@ pub enum SceneError {
     },
 }
 
-/// The spring-damped primary structure (MODEL.md Eq. 5).
+/// The spring-damped primary structure (docs/MODEL.md §1, Eq. 5).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Frame {
     /// `ms`, kg.
@@ -68,7 +68,7 @@ impl Frame {
         (wd2 > 0.0).then(|| wd2.sqrt())
     }
     /// The frame's acceleration without impulses and contact forces, `-(cs vs + ks xs)/ms`
-    /// (MODEL.md §4, free vibration), as every model reports it.
+    /// (docs/MODEL.md §6, free vibration), as every model reports it.
     pub fn acceleration(&self, xs: f64, vs: f64) -> f64 {
         -(self.damping * vs + self.stiffness * xs) / self.mass
     }
@@ -128,7 +128,7 @@ pub struct RapierSettings {
     pub ccd: Option<bool>,
 }
 
-/// Material of balls and walls for the compliant contact model (MODEL.md's steel by default).
+/// Material of balls and walls for the compliant contact model (docs/MODEL.md §9; steel by default).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct CompliantSettings {
     /// Young's modulus `E`, Pa.
@@ -259,7 +259,7 @@ impl Scene {
             }
         }
     }
-    /// The frame's reported acceleration `frame_force / ms` (MODEL.md §4), m/s^2.
+    /// The frame's reported acceleration `frame_force / ms` (docs/MODEL.md §6), m/s^2.
     pub fn frame_acceleration(&self, t: f64, xs: f64, vs: f64) -> f64 {
         match (self.frame, self.forcing) {
             (None, _) => 0.0,
