@@ -2,7 +2,7 @@
 //! with exit status 2, no panic and nothing written.
 
 use std::path::Path;
-use std::process::Command;
+use crate::common::lpc_command;
 
 const GOOD: &str = r#"
 name = "t"
@@ -30,7 +30,7 @@ fn run_lpc(text: &str, extra: &[&str]) -> (i32, String, bool) {
     let file = dir.path().join("scene.toml");
     std::fs::write(&file, text).unwrap();
     let out = dir.path().join("out");
-    let o = Command::new(env!("CARGO_BIN_EXE_lpc"))
+    let o = lpc_command()
         .arg("run")
         .arg(&file)
         .arg("--out")
@@ -134,7 +134,7 @@ fn not_toml_at_all() {
 
 #[test]
 fn missing_file() {
-    let o = Command::new(env!("CARGO_BIN_EXE_lpc")).args(["run", "no/such/scene.toml"]).output().unwrap();
+    let o = lpc_command().args(["run", "no/such/scene.toml"]).output().unwrap();
     assert_eq!(o.status.code(), Some(2));
     let stderr = String::from_utf8_lossy(&o.stderr);
     assert!(stderr.contains("no/such/scene.toml") && stderr.contains("cannot read"), "{stderr}");

@@ -1,7 +1,7 @@
 //! The reference against problems solved by hand: the bare frame's free vibration, a single
 //! ball on a free frame bouncing between the walls, and the first wall impact on a spring frame.
 
-mod common;
+use crate::common;
 
 use approx::assert_relative_eq;
 use common::*;

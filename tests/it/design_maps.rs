@@ -1,7 +1,7 @@
 //! Design maps and design search: grids of two parameters (`lpc sweep --x --y`), the heat map,
 //! `lpc optimize` against an exhaustive evaluation, `lpc frf` files, and the noise proxy.
 
-use std::process::Command;
+use crate::common;
 
 use lpc_damper::metrics::{metrics, noise};
 use lpc_damper::optimize::{optimize, Objective};
@@ -12,8 +12,9 @@ fn paper(name: &str) -> scene::Loaded {
     scene::load(scene::scenes_dir().join(name)).unwrap()
 }
 
+/// `lpc ARGS...`: its exit code, standard output and standard error.
 fn lpc(args: &[&str]) -> (i32, String, String) {
-    let o = Command::new(env!("CARGO_BIN_EXE_lpc")).args(args).output().unwrap();
+    let o = common::lpc(args);
     (o.status.code().unwrap_or(-1), String::from_utf8_lossy(&o.stdout).into_owned(), String::from_utf8_lossy(&o.stderr).into_owned())
 }
 

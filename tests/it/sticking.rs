@@ -2,7 +2,7 @@
 //! many balls and zero gaps finish in a bounded number of events with the balance intact and
 //! no ball outside the container.
 
-mod common;
+use crate::common;
 
 use common::*;
 use lpc_damper::reference::simulate;

@@ -4,7 +4,8 @@
 //! the scene.
 
 use lpc_damper::model::ModelError;
-use lpc_damper::{scene, Model};
+use crate::common;
+use lpc_damper::Model;
 
 const SCENE: &str = r#"
 name = "stress-174"
@@ -30,7 +31,7 @@ sample_dt = 0.0001
 
 #[test]
 fn the_contact_model_stops_with_the_reason_instead_of_a_wrong_run() {
-    let s = scene::parse(SCENE, "stress-174", "stress-174").unwrap().scene.unwrap();
+    let s = common::scene_from_toml(SCENE);
     match Model::Rapier.simulate(&s) {
         Err(ModelError::Unstable(reason)) => {
             assert!(reason.contains("stress-174") && reason.contains("right wall"), "{reason}");
@@ -45,7 +46,7 @@ fn the_contact_model_stops_with_the_reason_instead_of_a_wrong_run() {
 #[test]
 fn the_stability_map_still_sees_the_raw_behaviour() {
     // With the self-check off the same scene runs to the end (and shows the ball outside).
-    let s = scene::parse(SCENE, "stress-174", "stress-174").unwrap().scene.unwrap();
+    let s = common::scene_from_toml(SCENE);
     let mut settings = lpc_damper::rapier::settings(&s);
     settings.self_check = false;
     let run = lpc_damper::rapier::simulate_with(&s, settings).unwrap();

@@ -4,6 +4,26 @@
 
 pub mod masri_caughey;
 
+use std::ffi::OsStr;
+use std::process::{Command, Output};
+
+/// The `lpc` binary as a user runs it, from the repository's root (so `scenes/...` resolves).
+pub fn lpc_command() -> Command {
+    let mut command = Command::new(env!("CARGO_BIN_EXE_lpc"));
+    command.current_dir(env!("CARGO_MANIFEST_DIR"));
+    command
+}
+
+/// A valid scene from the text of a scene file (shrunk stress scenes are kept as text).
+pub fn scene_from_toml(text: &str) -> Scene {
+    lpc_damper::scene::parse(text, "test.toml", "test").expect("the scene parses").scene.expect("a single-run scene")
+}
+
+/// `lpc ARGS...`, run to completion.
+pub fn lpc<S: AsRef<OsStr>>(args: impl IntoIterator<Item = S>) -> Output {
+    lpc_command().args(args).output().expect("the lpc binary runs")
+}
+
 use lpc_damper::scene::{ball_radius, Ball, BallKind, Container, Frame, RapierSettings, Scene};
 
 /// The paper's frame (Table 1).

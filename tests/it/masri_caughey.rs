@@ -3,10 +3,10 @@
 //! it to 1e-6 relative in amplitude and approach speed and 1e-6 rad in impact phase. The first
 //! case is issue 17's scene, where the reference used to let the ball through the right wall.
 
-mod common;
+use crate::common;
 
 use std::f64::consts::PI;
-use std::process::Command;
+use crate::common::lpc_command;
 
 use common::masri_caughey::{ImpactDamper, Periodic};
 
@@ -58,7 +58,7 @@ fn run(d: &ImpactDamper, xs0: f64, periods: f64, dir: &std::path::Path) -> (Vec<
         d.frequency
     );
     std::fs::write(dir.join("scene.toml"), scene).unwrap();
-    let out = Command::new(env!("CARGO_BIN_EXE_lpc"))
+    let out = lpc_command()
         .arg("run")
         .arg(dir.join("scene.toml"))
         .args(["--horizon", &(periods / d.frequency).to_string(), "--sample-dt", "0.001", "--out"])

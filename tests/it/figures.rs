@@ -3,11 +3,7 @@
 //! a compare directory; bad input gets an error naming what is wrong.
 
 use std::path::Path;
-use std::process::Command;
-
-fn lpc(args: &[&str]) -> std::process::Output {
-    Command::new(env!("CARGO_BIN_EXE_lpc")).args(args).current_dir(env!("CARGO_MANIFEST_DIR")).output().unwrap()
-}
+use crate::common::lpc;
 
 /// Width, height and RGBA pixels of a PNG.
 fn decode(path: &Path) -> (u32, u32, Vec<[u8; 4]>) {

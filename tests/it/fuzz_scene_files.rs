@@ -78,7 +78,7 @@ proptest! {
 
     #[test]
     fn mutated_paper_scene_never_panics(cut in 0usize..2000, insert in "[\\x20-\\x7e\\n]{0,12}") {
-        let base = include_str!("../scenes/lpc-lsl.toml");
+        let base = include_str!("../../scenes/lpc-lsl.toml");
         let cut = cut.min(base.len());
         let cut = (0..=cut).rev().find(|&i| base.is_char_boundary(i)).unwrap_or(0);
         check(&format!("{}{}{}", &base[..cut], insert, &base[cut..]));

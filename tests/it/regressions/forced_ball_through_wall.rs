@@ -2,29 +2,9 @@
 //! scenes written to find such misses found three more ways for it to go wrong. One test per
 //! bug, each on the scene that showed it.
 
-use std::process::Command;
+use crate::common::{lpc_command, min_gap, scene_from_toml as scene};
 
-use lpc_damper::scene::{self, Scene};
 use lpc_damper::{reference, Model};
-
-fn scene(text: &str) -> Scene {
-    scene::parse(text, "test.toml", "test").unwrap().scene.unwrap()
-}
-
-/// Smallest gap between neighbours (walls included) over every sample.
-fn min_gap(scene: &Scene, run: &lpc_damper::run::Run) -> f64 {
-    let s = &run.series;
-    let (n, length) = (scene.balls.len(), scene.container.unwrap().length);
-    let mut min = f64::INFINITY;
-    for k in 0..s.len() {
-        let edge = |i: usize, side: f64| s.x[i][k] + side * scene.balls[i].radius;
-        min = min.min(edge(0, -1.0) - s.xs[k]).min(s.xs[k] + length - edge(n - 1, 1.0));
-        for i in 1..n {
-            min = min.min(edge(i, -1.0) - edge(i - 1, 1.0));
-        }
-    }
-    min
-}
 
 /// The sign-change scan of the forced frame's acceleration cleared a sub-interval whose end
 /// values differed in sign (a bound compared with a value smaller than its own round-off), so
@@ -109,7 +89,7 @@ fn frf_never_calls_a_failed_run_steady() {
          [forcing]\nkind = \"force\"\namplitude = 1.0\nfrequency = 5.0\n",
     )
     .unwrap();
-    let out = Command::new(env!("CARGO_BIN_EXE_lpc"))
+    let out = lpc_command()
         .arg("frf")
         .arg(&path)
         .args(["--freq", "4..5", "--steps", "2", "--model", "rapier", "--format", "json"])

@@ -3,7 +3,7 @@
 //! the stress run reported as a ball outside the container. The plug-in now projects sunk balls
 //! back (positions only) and bounds the step by the walls' chord error.
 
-use lpc_damper::scene;
+use crate::common;
 use lpc_damper::Model;
 
 const SCENE: &str = r#"
@@ -28,7 +28,7 @@ sample_dt = 0.00001
 
 #[test]
 fn a_ball_carried_by_a_fast_wall_stays_inside() {
-    let s = scene::parse(SCENE, "stress-12", "stress-12").unwrap().scene.unwrap();
+    let s = common::scene_from_toml(SCENE);
     let run = Model::Rapier.simulate(&s).unwrap();
     let c = s.container.unwrap();
     let r = s.balls[0].radius;

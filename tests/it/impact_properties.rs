@@ -1,7 +1,7 @@
 //! Property tests: every impact conserves momentum and never gains energy, for random masses,
 //! speeds and restitution; whole random free chains conserve momentum and balance energy.
 
-mod common;
+use crate::common;
 
 use lpc_damper::reference::{impact_law, simulate};
 use lpc_damper::scene::{ball_radius, Ball, BallKind, RapierSettings, Scene};

@@ -1,10 +1,9 @@
 //! `lpc check` passes on the committed goldens and catches a regression (exit status 3).
 
-use std::process::Command;
+use crate::common::lpc_command;
 
 fn lpc_check(golden: &std::path::Path) -> (Option<i32>, String) {
-    let o = Command::new(env!("CARGO_BIN_EXE_lpc"))
-        .current_dir(env!("CARGO_MANIFEST_DIR"))
+    let o = lpc_command()
         .args(["check", "scenes", "--golden"])
         .arg(golden)
         .output()

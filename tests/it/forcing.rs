@@ -2,7 +2,7 @@
 //! `m x'' + c x' + k x = P sin wt + Q cos wt`, for a force and for base motion, in both models;
 //! the energy balance with the excitation's work; the frequency response against `|H(w)|`.
 
-mod common;
+use crate::common;
 
 use lpc_damper::frf;
 use lpc_damper::scene::{Forcing, ForcingKind, Scene};

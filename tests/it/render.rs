@@ -5,15 +5,11 @@
 #![cfg(feature = "render")]
 
 use std::path::Path;
-use std::process::Command;
+use crate::common::{lpc, lpc_command};
 
 use lpc_damper::output::figures::read_series_csv;
 use lpc_damper::render::stage::{Layout, BACKGROUND};
 use lpc_damper::scene::{load_scene, BallKind};
-
-fn lpc(args: &[&str]) -> std::process::Output {
-    Command::new(env!("CARGO_BIN_EXE_lpc")).args(args).current_dir(env!("CARGO_MANIFEST_DIR")).output().unwrap()
-}
 
 fn decode(path: &Path) -> (u32, u32, Vec<u8>, usize) {
     let mut reader = png::Decoder::new(std::io::BufReader::new(std::fs::File::open(path).unwrap())).read_info().unwrap();
@@ -92,9 +88,8 @@ fn balls_are_drawn_where_the_physics_puts_them() {
 #[test]
 fn a_missing_graphics_driver_is_an_error_not_a_panic() {
     let out = tempfile::tempdir().unwrap();
-    let o = Command::new(env!("CARGO_BIN_EXE_lpc"))
+    let o = lpc_command()
         .args(["render", "scenes/conventional.toml", "--out", out.path().to_str().unwrap(), "--horizon", "0.1"])
-        .current_dir(env!("CARGO_MANIFEST_DIR"))
         .env("VK_ICD_FILENAMES", "/nonexistent/icd.json")
         .output()
         .unwrap();
@@ -134,9 +129,8 @@ fn rendering_never_changes_the_physics() {
 
 #[test]
 fn view_without_a_display_is_an_error_not_a_panic() {
-    let o = Command::new(env!("CARGO_BIN_EXE_lpc"))
+    let o = lpc_command()
         .args(["view", "scenes/conventional.toml", "--horizon", "0.1"])
-        .current_dir(env!("CARGO_MANIFEST_DIR"))
         .env_remove("DISPLAY")
         .env_remove("WAYLAND_DISPLAY")
         .output()

@@ -1,6 +1,6 @@
 //! The Rapier/Bevy contact model against closed forms, Eq. 9-10 and the reference.
 
-mod common;
+use crate::common;
 
 use approx::assert_relative_eq;
 use common::*;

@@ -1,7 +1,7 @@
 //! Energy balance (initial = mechanical now + damping dissipation + impact losses) to 1e-12 on
 //! every paper scene, every sweep value and every chain; no ball ever leaves the container.
 
-mod common;
+use crate::common;
 
 use lpc_damper::reference::simulate;
 

@@ -1,0 +1,26 @@
+//! The integration tests, one binary (as cargo's `tests/testsuite/main.rs`): one link against
+//! the library and Bevy instead of one per file. Each module is a property of the product;
+//! `regressions/` holds one test per fixed bug, on the scene that showed it; `common/` holds
+//! the known-solution problems and the one way to run the `lpc` binary.
+
+mod common;
+mod regressions;
+
+mod bad_scenes;
+mod bench_matches_compare;
+mod check_goldens;
+mod closed_form;
+mod compliant_model;
+mod design_maps;
+mod determinism;
+mod energy_balance;
+mod figures;
+mod forcing;
+mod fuzz_scene_files;
+mod impact_properties;
+mod masri_caughey;
+mod rapier_model;
+mod render;
+mod stability_map;
+mod sticking;
+mod stress;

@@ -1,0 +1,8 @@
+//! One test per fixed bug, each on the (shrunk) scene that showed it. A file is named for what
+//! went wrong; its module doc names the issue, the cause and the fix.
+
+mod forced_ball_through_wall;
+mod loaded_contact_sinks;
+mod squeezed_ball_stops;
+mod stale_impulse_bounce;
+mod zero_time_event_loop;
