@@ -26,7 +26,7 @@ use crate::model::ModelError;
 use crate::run::{EnergyAccount, Run};
 use crate::scene::{Body, Scene};
 pub use plugin::{DamperSet, LpcDamperPlugins, StepSettings};
-pub use stepping::Stepping;
+pub use crate::scene::Stepping;
 
 /// Default stepping (from the accuracy study in docs/BENCHMARKS.md).
 pub const DEFAULT_STEPPING: Stepping = Stepping::Aligned;

@@ -9,7 +9,8 @@ use bevy_rapier3d::rapier::dynamics::IntegrationParameters;
 
 use super::hooks::{ContactRole, RestitutionConfig, RestitutionHooks};
 use super::record::{feedback, record_samples, Recording};
-use super::stepping::{plan_step, StepPlan, Stepping};
+use super::stepping::{plan_step, StepPlan};
+use crate::scene::Stepping;
 use crate::oscillator::{gauss_legendre, Driven, Oscillator};
 use crate::scene::Scene;
 

@@ -13,37 +13,7 @@ use bevy_rapier3d::prelude::*;
 
 use super::plugin::{DamperScene, FrameState, StepClock, StepSettings};
 use super::record::Recording;
-
-/// How steps are chosen.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord, serde::Serialize, serde::Deserialize)]
-#[serde(rename_all = "lowercase")]
-pub enum Stepping {
-    /// Every step is `dt` long.
-    Fixed,
-    /// Steps end at contacts; `dt` is the longest step.
-    Aligned,
-}
-
-impl Stepping {
-    /// Name on the command line and in outputs.
-    pub fn name(self) -> &'static str {
-        match self {
-            Stepping::Fixed => "fixed",
-            Stepping::Aligned => "aligned",
-        }
-    }
-}
-
-impl std::str::FromStr for Stepping {
-    type Err = String;
-    fn from_str(s: &str) -> Result<Self, String> {
-        match s {
-            "fixed" => Ok(Stepping::Fixed),
-            "aligned" => Ok(Stepping::Aligned),
-            other => Err(format!("unknown stepping `{other}`; choose fixed or aligned")),
-        }
-    }
-}
+use crate::scene::Stepping;
 
 /// The length of the step about to be taken, s.
 #[derive(Resource, Debug, Clone, Copy)]

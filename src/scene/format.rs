@@ -105,7 +105,7 @@ pub struct RunFile {
 #[serde(deny_unknown_fields)]
 pub struct RapierFile {
     /// `"aligned"` (steps end at contacts) or `"fixed"`.
-    pub stepping: Option<crate::rapier::Stepping>,
+    pub stepping: Option<Stepping>,
     /// Fixed physics step (the longest step when aligned), s.
     pub dt: Option<f64>,
     /// Solver iterations per step.
@@ -263,6 +263,37 @@ impl Length {
     pub fn raw(self) -> f64 {
         match self {
             Length::Metres(x) | Length::Rr(x) => x,
+        }
+    }
+}
+
+/// How the Rapier model chooses its steps (a setting of the scene, read by that model).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord, serde::Serialize, serde::Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Stepping {
+    /// Every step is `dt` long.
+    Fixed,
+    /// Steps end at contacts; `dt` is the longest step.
+    Aligned,
+}
+
+impl Stepping {
+    /// Name on the command line and in outputs.
+    pub fn name(self) -> &'static str {
+        match self {
+            Stepping::Fixed => "fixed",
+            Stepping::Aligned => "aligned",
+        }
+    }
+}
+
+impl std::str::FromStr for Stepping {
+    type Err = String;
+    fn from_str(s: &str) -> Result<Self, String> {
+        match s {
+            "fixed" => Ok(Stepping::Fixed),
+            "aligned" => Ok(Stepping::Aligned),
+            other => Err(format!("unknown stepping `{other}`; choose fixed or aligned")),
         }
     }
 }

@@ -6,7 +6,7 @@ pub mod format;
 use std::f64::consts::PI;
 use std::path::{Path, PathBuf};
 
-pub use format::{Arrangement, ForcingKind, Length, SceneFile};
+pub use format::{Arrangement, ForcingKind, Length, SceneFile, Stepping};
 
 /// Default simulated time, s (docs/MODEL.md §8).
 pub const DEFAULT_HORIZON: f64 = 5.0;
@@ -119,7 +119,7 @@ pub struct Container {
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
 pub struct RapierSettings {
     /// How steps are chosen.
-    pub stepping: Option<crate::rapier::Stepping>,
+    pub stepping: Option<Stepping>,
     /// Fixed step (longest step when aligned), s.
     pub dt: Option<f64>,
     /// Solver iterations.
@@ -376,7 +376,7 @@ pub fn parse(text: &str, file: &str, default_name: &str) -> Result<Loaded, Scene
 
 /// Validates an already parsed file.
 pub fn from_file(parsed: SceneFile, file: &str, default_name: &str) -> Result<Loaded, SceneError> {
-    let v = Validator { file };
+    let v = Validator { file, flags: &[] };
     let name = parsed.name.clone().unwrap_or_else(|| default_name.to_string());
     if parsed.chain.is_some() && (parsed.frame.is_some() || parsed.balls.is_some()) {
         return Err(v.err("chain", "cannot be combined with [frame] or [balls]: a chain file describes only the KER experiment"));
@@ -487,12 +487,17 @@ pub fn apply_sweep_value(file: &SceneFile, parameter: &str, value: Length) -> Re
     Ok(f)
 }
 
+/// Checks values against the scene's rules and names what broke one.
 struct Validator<'a> {
     file: &'a str,
+    /// Fields whose value came from a command-line flag, and that flag (`run.horizon` ->
+    /// `--horizon`): an error names what the user typed.
+    flags: &'a [(&'static str, &'static str)],
 }
 
 impl Validator<'_> {
     fn err(&self, field: &str, rule: &str) -> SceneError {
+        let field = self.flags.iter().find(|(f, _)| *f == field).map_or(field, |(_, flag)| flag);
         SceneError::Invalid { file: self.file.into(), field: field.into(), rule: rule.into() }
     }
     fn finite(&self, field: &str, x: f64) -> Result<f64, SceneError> {
@@ -531,6 +536,62 @@ impl Validator<'_> {
         let dt = self.positive("run.sample_dt", run.sample_dt.unwrap_or(DEFAULT_SAMPLE_DT))?;
         check_sample_dt(horizon, dt).map_err(|rule| self.err("run.sample_dt", &rule))?;
         Ok((horizon, dt))
+    }
+}
+
+/// Values typed on the command line that replace a scene's (ripgrep's low and high
+/// arguments: the flags are collected as plain values, then validated here by the very rules
+/// of the file's fields, so no rule is written twice and a validated [`Scene`] is never
+/// changed afterwards, only replaced by a new validated one).
+#[derive(Debug, Clone, Copy, Default)]
+pub struct Overrides {
+    /// `--horizon`: simulated time, s.
+    pub horizon: Option<f64>,
+    /// `--sample-dt`: output sampling step, s.
+    pub sample_dt: Option<f64>,
+    /// `--stepping`: how the Rapier model chooses its steps.
+    pub stepping: Option<Stepping>,
+    /// `--dt`: the Rapier model's (longest) step, s.
+    pub dt: Option<f64>,
+    /// `--solver-iterations`: the Rapier model's solver iterations per step.
+    pub solver_iterations: Option<u32>,
+    /// `--ccd`: Rapier's swept CCD on the balls.
+    pub ccd: bool,
+}
+
+impl Overrides {
+    /// `scene` with these values, validated by the file's rules; an error names the flag when
+    /// the value came from one, and `file`.
+    pub fn apply(&self, scene: Scene, file: &str) -> Result<Scene, SceneError> {
+        let given = [
+            ("run.horizon", "--horizon", self.horizon.is_some()),
+            ("run.sample_dt", "--sample-dt", self.sample_dt.is_some()),
+            ("rapier.dt", "--dt", self.dt.is_some()),
+            ("rapier.solver_iterations", "--solver-iterations", self.solver_iterations.is_some()),
+        ];
+        let flags: Vec<_> = given.iter().filter(|g| g.2).map(|&(field, flag, _)| (field, flag)).collect();
+        let v = Validator { file, flags: &flags };
+        let run = format::RunFile { horizon: self.horizon.or(Some(scene.horizon)), sample_dt: self.sample_dt.or(Some(scene.sample_dt)) };
+        let (horizon, sample_dt) = v.run(&run, scene.horizon)?;
+        let r = &scene.rapier;
+        let rapier = rapier_settings(
+            &format::RapierFile {
+                stepping: self.stepping.or(r.stepping),
+                dt: self.dt.or(r.dt),
+                solver_iterations: self.solver_iterations.or(r.solver_iterations),
+                ccd: if self.ccd { Some(true) } else { r.ccd },
+            },
+            &v,
+        )?;
+        Ok(Scene { horizon, sample_dt, rapier, ..scene })
+    }
+    /// The Rapier flags alone against the file's rules (for commands that take lists of them
+    /// before any scene is loaded); an error names the flag.
+    pub fn check_rapier(&self) -> Result<(), SceneError> {
+        let flags = [("rapier.dt", "--dt"), ("rapier.solver_iterations", "--solver-iterations")];
+        let v = Validator { file: "(command line)", flags: &flags };
+        let r = format::RapierFile { stepping: self.stepping, dt: self.dt, solver_iterations: self.solver_iterations, ccd: Some(self.ccd) };
+        rapier_settings(&r, &v).map(drop)
     }
 }
 

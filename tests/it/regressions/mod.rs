@@ -1,6 +1,7 @@
 //! One test per fixed bug, each on the (shrunk) scene that showed it. A file is named for what
 //! went wrong; its module doc names the issue, the cause and the fix.
 
+mod check_bad_scene_exit_status;
 mod forced_ball_through_wall;
 mod loaded_contact_sinks;
 mod squeezed_ball_stops;

@@ -1,0 +1,112 @@
+//! Arguments and helpers that several commands share: output formats, the Rapier model's
+//! flags, loading a scene with command-line overrides, ranges and sizes, JSON and progress.
+
+use std::path::Path;
+
+use clap::ValueEnum;
+use indicatif::{ProgressBar, ProgressStyle};
+
+use lpc_damper::scene::{self, Overrides, Scene, SceneError, Stepping};
+
+use crate::exit::Result;
+
+/// Output format on standard output.
+#[derive(Clone, Copy, ValueEnum, PartialEq, Eq)]
+pub enum Format {
+    Text,
+    Json,
+}
+
+/// Output format on standard output, for commands whose result is a table.
+#[derive(Clone, Copy, ValueEnum, PartialEq, Eq)]
+pub enum TableFormat {
+    Text,
+    Json,
+    Csv,
+}
+
+/// Settings of the Rapier model that every command accepts.
+#[derive(clap::Args, Clone, Copy)]
+pub struct RapierArgs {
+    /// Rapier model: `aligned` (steps end at contacts) or `fixed` steps.
+    #[arg(long)]
+    stepping: Option<Stepping>,
+    /// Rapier model: physics step (the longest one when aligned), s.
+    #[arg(long)]
+    dt: Option<f64>,
+    /// Rapier model: solver iterations per step (overrides the scene's).
+    #[arg(long)]
+    solver_iterations: Option<u32>,
+    /// Rapier model: turn on Rapier's swept CCD for the balls.
+    #[arg(long)]
+    ccd: bool,
+}
+
+impl RapierArgs {
+    /// These flags, with `--horizon` and `--sample-dt` where a command has them, as overrides
+    /// that the scene module validates by the file's own rules.
+    pub fn overrides(self, horizon: Option<f64>, sample_dt: Option<f64>) -> Overrides {
+        Overrides {
+            horizon,
+            sample_dt,
+            stepping: self.stepping,
+            dt: self.dt,
+            solver_iterations: self.solver_iterations,
+            ccd: self.ccd,
+        }
+    }
+}
+
+/// The scene at `path` with `overrides` applied (and validated) by the scene module.
+pub fn load_scene(path: &Path, overrides: Overrides) -> std::result::Result<Scene, SceneError> {
+    overrides.apply(scene::load_scene(path)?, &path.display().to_string())
+}
+
+/// Replaces `scene` (one of a sweep's or a chain's) by itself with `overrides` applied and
+/// validated by the scene module.
+pub fn override_scene(scene: &mut Scene, overrides: Overrides, path: &Path) -> std::result::Result<(), SceneError> {
+    *scene = overrides.apply(scene.clone(), &path.display().to_string())?;
+    Ok(())
+}
+
+/// A flag (or a field of the scene at `path`) that breaks `rule`.
+pub fn invalid(path: &Path, field: &str, rule: impl Into<String>) -> SceneError {
+    SceneError::Invalid { file: path.display().to_string(), field: field.into(), rule: rule.into() }
+}
+
+/// `WIDTHxHEIGHT` in pixels, each between 100 and 8000.
+pub fn parse_size(s: &str) -> std::result::Result<(u32, u32), String> {
+    let bad = || format!("`{s}` is not a size WIDTHxHEIGHT between 100x100 and 8000x8000");
+    let (w, h) = s.split_once(['x', 'X']).ok_or_else(bad)?;
+    let (w, h): (u32, u32) = (w.trim().parse().map_err(|_| bad())?, h.trim().parse().map_err(|_| bad())?);
+    if !(100..=8000).contains(&w) || !(100..=8000).contains(&h) {
+        return Err(bad());
+    }
+    Ok((w, h))
+}
+
+/// A frequency range `A..B` (positive, increasing) given as `field`.
+pub fn parse_range(text: &str, path: &Path, field: &str) -> std::result::Result<(f64, f64), SceneError> {
+    let invalid = |rule: String| invalid(path, field, rule);
+    let (a, b) = text.split_once("..").ok_or_else(|| invalid(format!("`{text}` is not a range: write `A..B`")))?;
+    let num = |s: &str| s.trim().parse::<f64>().map_err(|_| invalid(format!("`{s}` in `{text}` is not a number")));
+    let (a, b) = (num(a)?, num(b)?);
+    if !(a.is_finite() && b.is_finite() && a > 0.0 && b >= a) {
+        return Err(invalid(format!("`{text}` must be positive and increasing")));
+    }
+    Ok((a, b))
+}
+
+/// `value` as pretty JSON on standard output.
+pub fn print_json<T: serde::Serialize>(value: &T) -> Result<()> {
+    println!("{}", serde_json::to_string_pretty(value)?);
+    Ok(())
+}
+
+/// A progress bar on a terminal when there is enough work to wait for; hidden otherwise.
+pub fn progress_bar(len: usize, label: &str) -> ProgressBar {
+    let bar = if len > 4 { ProgressBar::new(len as u64) } else { ProgressBar::hidden() };
+    bar.set_style(ProgressStyle::with_template("{msg} [{bar:30}] {pos}/{len} ({elapsed})").expect("valid template"));
+    bar.set_message(label.to_string());
+    bar
+}

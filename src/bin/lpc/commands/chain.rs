@@ -1,0 +1,46 @@
+//! `lpc chain`: the chain experiment's kinetic energy ratio against the number of large balls.
+
+use std::path::PathBuf;
+
+use lpc_damper::chain::{run_chain, KerRow};
+use lpc_damper::scene;
+use lpc_damper::Model;
+
+use crate::args::{invalid, override_scene, print_json, Format, RapierArgs};
+use crate::exit::{ExitStatus, Result};
+
+#[derive(clap::Args)]
+pub struct Args {
+    /// Chain scene file (default: scenes/chain-ker.toml).
+    scene: Option<PathBuf>,
+    /// Model to run.
+    #[arg(long, default_value = "reference")]
+    model: Model,
+    /// Output format on standard output.
+    #[arg(long, value_enum, default_value_t = Format::Text)]
+    format: Format,
+    #[command(flatten)]
+    rapier: RapierArgs,
+}
+
+pub fn run(a: Args) -> Result<ExitStatus> {
+    let path = a.scene.unwrap_or_else(|| PathBuf::from("scenes/chain-ker.toml"));
+    let loaded = scene::load(&path)?;
+    let mut cases =
+        loaded.chain.ok_or_else(|| invalid(&path, "chain", "is missing: `lpc chain` needs a scene file with a [chain] table"))?;
+    for c in &mut cases {
+        override_scene(&mut c.scene, a.rapier.overrides(None, None), &path)?;
+    }
+    let rows: Vec<KerRow> = run_chain(&cases, a.model)?;
+    match a.format {
+        Format::Json => print_json(&rows)?,
+        Format::Text => {
+            println!("kinetic energy ratio ({}): KE of all balls after / KE of the incident ball", a.model.name());
+            println!("{:>7} {:>7} {:>10}", "large", "small", "KER");
+            for r in &rows {
+                println!("{:>7} {:>7} {:>10.4}", r.large, r.small, r.ker);
+            }
+        }
+    }
+    Ok(ExitStatus::Success)
+}

@@ -1,0 +1,59 @@
+//! `lpc check`: headless regression runs of every scene with every model against the goldens.
+
+use std::path::PathBuf;
+
+use lpc_damper::check;
+use lpc_damper::Model;
+
+use crate::exit::{ExitStatus, Result};
+
+#[derive(clap::Args)]
+pub struct Args {
+    /// Directory of scene files.
+    #[arg(default_value = "scenes")]
+    dir: PathBuf,
+    /// Directory of golden files.
+    #[arg(long, default_value = "tests/golden")]
+    golden: PathBuf,
+    /// Models, comma-separated.
+    #[arg(long, value_delimiter = ',', default_value = "reference,rapier,compliant")]
+    models: Vec<Model>,
+    /// Rewrite the golden files from this run.
+    #[arg(long)]
+    update: bool,
+    /// Print every compared value, not only the failures.
+    #[arg(long)]
+    verbose: bool,
+}
+
+pub fn run(a: Args) -> Result<ExitStatus> {
+    let now = check::current(&a.dir, &a.models)?;
+    let mut rows = Vec::new();
+    for g in &now {
+        if a.update {
+            check::write_golden(&a.golden, g)?;
+        }
+        let golden = if a.update { Some(g.clone()) } else { check::read_golden(&a.golden, g)? };
+        rows.extend(check::compare(g, golden.as_ref()));
+    }
+    let fmt = |x: Option<f64>| x.map_or("-".to_string(), |v| format!("{v:.6e}"));
+    println!("{:<34} {:>9} {:<18} {:>14} {:>14} {:>10} {:>6}", "case", "model", "metric", "golden", "now", "tolerance", "");
+    for r in rows.iter().filter(|r| a.verbose || !r.ok) {
+        println!(
+            "{:<34} {:>9} {:<18} {:>14} {:>14} {:>10.1e} {:>6}",
+            r.case,
+            r.model,
+            r.metric,
+            fmt(r.golden),
+            fmt(r.now),
+            r.tolerance,
+            if r.ok { "ok" } else { "FAIL" }
+        );
+    }
+    let failed = rows.iter().filter(|r| !r.ok).count();
+    println!("{} passed, {} failed", rows.len() - failed, failed);
+    if a.update {
+        println!("golden files rewritten in {}", a.golden.display());
+    }
+    Ok(if failed == 0 { ExitStatus::Success } else { ExitStatus::Regression })
+}

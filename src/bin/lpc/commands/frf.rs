@@ -1,0 +1,148 @@
+//! `lpc frf`: the steady amplitude of the frame against forcing frequency, with and without the damper.
+
+use std::path::PathBuf;
+
+use anyhow::Context;
+use clap::ValueEnum;
+
+use lpc_damper::output::write_atomic;
+use lpc_damper::scene;
+use lpc_damper::Model;
+
+use crate::args::{invalid, load_scene, parse_range, print_json, progress_bar, Format, RapierArgs};
+use crate::exit::{CommandError, ExitStatus, Result};
+
+#[derive(clap::Args)]
+pub struct Args {
+    /// Scene file.
+    scene: PathBuf,
+    /// Frequency range `A..B` in Hz.
+    #[arg(long)]
+    freq: String,
+    /// Number of frequencies, evenly spaced over the range.
+    #[arg(long, default_value_t = 21)]
+    steps: usize,
+    /// Model to run.
+    #[arg(long, default_value = "reference")]
+    model: Model,
+    /// Forcing kind, when the scene has no [forcing] table (or to override it).
+    #[arg(long, value_enum)]
+    kind: Option<ForcingKindArg>,
+    /// Forcing amplitude (N for a force, m for base motion), when the scene has no [forcing]
+    /// table (or to override it).
+    #[arg(long)]
+    amplitude: Option<f64>,
+    /// Output format on standard output.
+    #[arg(long, value_enum, default_value_t = Format::Text)]
+    format: Format,
+    /// Write frf.json, frf.csv and the plot (frf.png, frf.svg) into this directory.
+    #[arg(long)]
+    out: Option<PathBuf>,
+    #[command(flatten)]
+    rapier: RapierArgs,
+}
+
+#[derive(Clone, Copy, ValueEnum)]
+enum ForcingKindArg {
+    Force,
+    Base,
+}
+
+pub fn run(a: Args) -> Result<ExitStatus> {
+    let mut scene = load_scene(&a.scene, a.rapier.overrides(None, None))?;
+    let (from, to) = parse_range(&a.freq, &a.scene, "--freq")?;
+    let invalid = |field: &str, rule: String| invalid(&a.scene, field, rule);
+    if a.steps == 0 || a.steps > 10_000 {
+        return Err(invalid("--steps", format!("must lie in 1..=10000 (got {})", a.steps)).into());
+    }
+    if a.kind.is_some() || a.amplitude.is_some() {
+        let g = scene.forcing.get_or_insert(scene::Forcing { kind: scene::ForcingKind::Force, amplitude: 0.0, frequency: from });
+        if let Some(k) = a.kind {
+            g.kind = match k {
+                ForcingKindArg::Force => scene::ForcingKind::Force,
+                ForcingKindArg::Base => scene::ForcingKind::Base,
+            };
+        }
+        if let Some(x) = a.amplitude {
+            if !(x.is_finite() && x > 0.0) {
+                return Err(invalid("--amplitude", format!("must be a positive number (got {x})")).into());
+            }
+            g.amplitude = x;
+        }
+    }
+    let Some(g) = scene.forcing else {
+        return Err(invalid("forcing", "is missing: give the scene a [forcing] table, or --kind and --amplitude".into()).into());
+    };
+    if g.amplitude == 0.0 {
+        return Err(invalid("forcing.amplitude", "is 0: give --amplitude".into()).into());
+    }
+    if let Some(f) = scene.frame {
+        // An undamped frame driven at resonance has no steady state (scene validation's rule).
+        let w0 = (f.stiffness / f.mass).sqrt() / (2.0 * std::f64::consts::PI);
+        if f.damping == 0.0 && from <= w0 && w0 <= to {
+            return Err(invalid("--freq", format!("{from}..{to} Hz contains the undamped frame's resonance {w0:.6} Hz, where no steady state exists")).into());
+        }
+    }
+    let freqs = lpc_damper::frf::frequencies(from, to, a.steps);
+    let bar = progress_bar(2 * freqs.len(), "frf");
+    let start = std::time::Instant::now();
+    let points = lpc_damper::frf::frf(&scene, &freqs, a.model, &|| bar.inc(1));
+    bar.finish_and_clear();
+    let elapsed = start.elapsed().as_secs_f64();
+    if let Some(dir) = &a.out {
+        write_atomic(&dir.join("frf.json"), &serde_json::to_vec_pretty(&points)?)
+            .with_context(|| format!("writing {}", dir.display()))?;
+        let mut w = csv::Writer::from_writer(Vec::new());
+        for p in &points {
+            w.serialize(p)?;
+        }
+        write_atomic(&dir.join("frf.csv"), &w.into_inner()?).with_context(|| format!("writing {}", dir.display()))?;
+        let fig = lpc_damper::output::figures::frf_chart(&points, &scene.name, a.model.name());
+        lpc_damper::output::figures::write(&fig, dir, (900, 560))?;
+    }
+    match a.format {
+        Format::Json => print_json(&points)?,
+        Format::Text => {
+            println!(
+                "frequency response of {} ({}, {:?} forcing, amplitude {}; {} runs in {:.2} s)",
+                scene.name,
+                a.model.name(),
+                g.kind,
+                g.amplitude,
+                2 * points.len(),
+                elapsed
+            );
+            println!(
+                "{:>10} {:>14} {:>14} {:>8} {:>16} {:>22}",
+                "f Hz", "amp mm", "no damper mm", "ratio", "impacts/period", "steady (with/without)"
+            );
+            let mm = |x: Option<f64>| x.map_or("failed".to_string(), |x| format!("{:.4}", x * 1e3));
+            for p in &points {
+                let ratio = match (p.amplitude, p.amplitude_no_damper) {
+                    (Some(a), Some(b)) => format!("{:.3}", a / b),
+                    _ => "-".into(),
+                };
+                println!(
+                    "{:>10.4} {:>14} {:>14} {:>8} {:>16} {:>22}",
+                    p.frequency,
+                    mm(p.amplitude),
+                    mm(p.amplitude_no_damper),
+                    ratio,
+                    p.impacts_per_period.map_or("-".into(), |x| format!("{x:.2}")),
+                    format!("{}/{}", if p.steady { "yes" } else { "no" }, if p.steady_no_damper { "yes" } else { "no" })
+                );
+            }
+            for p in points.iter().filter(|p| p.error.is_some()) {
+                println!("{} Hz failed: {}", p.frequency, p.error.as_deref().unwrap_or_default());
+            }
+            if let Some(dir) = &a.out {
+                println!("wrote frf.json, frf.csv, frf.png, frf.svg to {}", dir.display());
+            }
+        }
+    }
+    let failed = points.iter().filter(|p| p.error.is_some()).count();
+    if failed > 0 {
+        return Err(CommandError::failure(anyhow::anyhow!("{failed} of {} frequencies failed (see above)", points.len())));
+    }
+    Ok(ExitStatus::Success)
+}

@@ -1,0 +1,131 @@
+//! `lpc optimize`: the design with the shortest settling time (or the lowest resonant amplitude)
+//! inside a given container length.
+
+use std::path::PathBuf;
+
+use clap::ValueEnum;
+use indicatif::ProgressStyle;
+
+use lpc_damper::scene;
+use lpc_damper::Model;
+
+use crate::args::{invalid, parse_range, print_json, progress_bar, Format};
+use crate::exit::{ExitStatus, Result};
+
+#[derive(clap::Args)]
+pub struct Args {
+    /// Scene file (its [balls] table is the starting design).
+    scene: PathBuf,
+    /// Inner container length (m, or `<k> Rr`); default: the scene's.
+    #[arg(long)]
+    container_length: Option<String>,
+    /// A design parameter and its range: `PARAM=A..B:N` or `PARAM=V1,V2,...` (repeatable).
+    #[arg(long = "vary")]
+    vary: Vec<String>,
+    /// Ball arrangements to try, comma-separated (default: the scene's).
+    #[arg(long)]
+    arrangements: Option<String>,
+    /// What to minimise.
+    #[arg(long, value_enum, default_value_t = ObjectiveArg::SettlingTime)]
+    objective: ObjectiveArg,
+    /// Frequency range `A..B` in Hz for the resonant amplitude.
+    #[arg(long)]
+    freq: Option<String>,
+    /// Frequencies over that range.
+    #[arg(long, default_value_t = 9)]
+    steps: usize,
+    /// Refinements around the best grid point.
+    #[arg(long, default_value_t = 2)]
+    refinements: u32,
+    /// Model to run.
+    #[arg(long, default_value = "reference")]
+    model: Model,
+    /// Designs listed in the text output.
+    #[arg(long, default_value_t = 10)]
+    top: usize,
+    /// Output format on standard output.
+    #[arg(long, value_enum, default_value_t = Format::Text)]
+    format: Format,
+}
+
+#[derive(Clone, Copy, ValueEnum)]
+enum ObjectiveArg {
+    SettlingTime,
+    ResonantAmplitude,
+}
+
+pub fn run(a: Args) -> Result<ExitStatus> {
+    use lpc_damper::optimize::{optimize, Objective};
+    let loaded = scene::load(&a.scene)?;
+    let invalid = |field: &str, rule: String| invalid(&a.scene, field, rule);
+    let Some(base) = loaded.scene.clone() else {
+        return Err(invalid("frame", "is missing: a design needs a damper scene".into()).into());
+    };
+    let length = match &a.container_length {
+        Some(text) => match text.trim().parse::<f64>() {
+            Ok(x) if x.is_finite() && x > 0.0 => scene::Length::Metres(x),
+            _ => scene::Length::try_from_text(text)
+                .ok_or_else(|| invalid("--container-length", format!("`{text}` is not a positive length (m or `<k> Rr`)")))?,
+        },
+        None => scene::Length::Metres(base.container.map_or(0.0, |c| c.length)),
+    };
+    let axes = a
+        .vary
+        .iter()
+        .map(|v| lpc_damper::sweep::parse_axis(v).map_err(|rule| invalid("--vary", rule)))
+        .collect::<std::result::Result<Vec<_>, _>>()?;
+    let arrangements: Vec<String> = match &a.arrangements {
+        Some(list) => list.split(',').map(|s| s.trim().to_string()).filter(|s| !s.is_empty()).collect(),
+        None => match &loaded.file.balls.as_ref().map(|b| b.arrangement.clone()) {
+            Some(scene::Arrangement::Letters(l)) => vec![l.clone()],
+            _ => return Err(invalid("--arrangements", "is needed: the scene lists its balls explicitly".into()).into()),
+        },
+    };
+    if arrangements.is_empty() {
+        return Err(invalid("--arrangements", "is empty".into()).into());
+    }
+    let objective = match a.objective {
+        ObjectiveArg::SettlingTime => Objective::SettlingTime,
+        ObjectiveArg::ResonantAmplitude => {
+            let text = a.freq.as_deref().ok_or_else(|| invalid("--freq", "is needed for the resonant amplitude".into()))?;
+            let (from, to) = parse_range(text, &a.scene, "--freq")?;
+            Objective::ResonantAmplitude { from, to, steps: a.steps.max(1) }
+        }
+    };
+    let bar = progress_bar(usize::MAX >> 1, "designs");
+    bar.set_style(ProgressStyle::with_template("{msg} {pos} ({elapsed})").expect("valid template"));
+    let start = std::time::Instant::now();
+    let search = optimize(&loaded, &axes, &arrangements, length, objective, a.model, a.refinements, &|| bar.inc(1))?;
+    bar.finish_and_clear();
+    match a.format {
+        Format::Json => print_json(&search)?,
+        Format::Text => {
+            let unit = match objective {
+                Objective::SettlingTime => "settling time s",
+                Objective::ResonantAmplitude { .. } => "resonant amplitude mm",
+            };
+            let scale = if matches!(objective, Objective::SettlingTime) { 1.0 } else { 1e3 };
+            println!(
+                "{} designs evaluated in {:.2} s ({} infeasible: balls do not fit {length}); container length fixed",
+                search.ranking.len() + search.infeasible,
+                start.elapsed().as_secs_f64(),
+                search.infeasible
+            );
+            println!("{:>12} {:>12} {:>22}  parameters", "arrangement", "clearance mm", unit);
+            for d in search.ranking.iter().take(a.top) {
+                let params = d.values.iter().map(|(p, v)| format!("{p}={v}")).collect::<Vec<_>>().join(" ");
+                println!(
+                    "{:>12} {:>12.3} {:>22}  {params}",
+                    d.arrangement,
+                    d.clearance * 1e3,
+                    d.objective.map_or("not settled".into(), |x| format!("{:.4}", x * scale))
+                );
+            }
+            match &search.best {
+                Some(b) => println!("best: {} with {}", b.arrangement, b.values.iter().map(|(p, v)| format!("{p}={v}")).collect::<Vec<_>>().join(" ")),
+                None => println!("no feasible design settled"),
+            }
+        }
+    }
+    Ok(ExitStatus::Success)
+}

@@ -1,0 +1,107 @@
+//! `lpc plot`: the paper's figures from a scene, a run directory or a compare directory.
+
+use std::path::{Path, PathBuf};
+
+use lpc_damper::chain::run_chain;
+use lpc_damper::scene;
+use lpc_damper::Model;
+
+use crate::args::{invalid, override_scene, parse_size, RapierArgs};
+use crate::exit::{ExitStatus, Result};
+
+#[derive(clap::Args)]
+pub struct Args {
+    /// A scene file (damper: Figs. 8-12; [sweep]: Figs. 13-16; [chain]: Fig. 5), a directory
+    /// written by `lpc run --out` (its series), or one written by `lpc compare --out` (overlay).
+    input: PathBuf,
+    /// Directory for the figures.
+    #[arg(long)]
+    out: PathBuf,
+    /// Model that runs a scene.
+    #[arg(long, default_value = "reference")]
+    model: Model,
+    /// Figure size in pixels, WIDTHxHEIGHT.
+    #[arg(long, default_value = "1000x640", value_parser = parse_size)]
+    size: (u32, u32),
+    #[command(flatten)]
+    rapier: RapierArgs,
+}
+
+pub fn run(a: Args) -> Result<ExitStatus> {
+    use lpc_damper::output::figures::{self, Figure};
+    let mut figs: Vec<Figure> = vec![];
+    if a.input.is_dir() {
+        let series = |dir: &Path| dir.join("series.csv");
+        let name_of = |dir: &Path, key: &str| -> Option<String> {
+            let text = std::fs::read(dir.join("summary.json")).ok()?;
+            let v: serde_json::Value = serde_json::from_slice(&text).ok()?;
+            v.get(key)?.as_str().map(str::to_string)
+        };
+        if series(&a.input).is_file() {
+            let s = figures::read_series_csv(&series(&a.input))?;
+            let mut run = lpc_damper::run::Run::empty(
+                &name_of(&a.input, "scene").unwrap_or_else(|| "run".into()),
+                &name_of(&a.input, "model").unwrap_or_else(|| "model".into()),
+            );
+            run.series = s;
+            figs.extend(figures::time_histories(&run, None));
+            figs.push(figures::ball_positions(&run, None));
+        } else {
+            let mut models = vec![];
+            let mut entries: Vec<PathBuf> =
+                std::fs::read_dir(&a.input)?.filter_map(|e| e.ok().map(|e| e.path())).filter(|p| series(p).is_file()).collect();
+            entries.sort();
+            for dir in entries {
+                let name = dir.file_name().map_or("model".into(), |n| n.to_string_lossy().into_owned());
+                models.push((name, figures::read_series_csv(&series(&dir))?));
+            }
+            if models.is_empty() {
+                return Err(invalid(
+                    &a.input,
+                    "input",
+                    "holds no series.csv (expected a directory of `lpc run --out` or `lpc compare --out`)",
+                )
+                .into());
+            }
+            let scene_name = name_of(&a.input.join(&models[0].0), "scene").unwrap_or_default();
+            figs.push(figures::overlay(&models, &scene_name));
+        }
+    } else {
+        let loaded = scene::load(&a.input)?;
+        if let Some(mut cases) = loaded.chain.clone() {
+            for c in &mut cases {
+                override_scene(&mut c.scene, a.rapier.overrides(None, None), &a.input)?;
+            }
+            figs.push(figures::ker_chart(&run_chain(&cases, a.model)?, a.model.name()));
+        } else if loaded.file.sweep.is_some() {
+            use rayon::prelude::*;
+            let mut scenes = lpc_damper::sweep::sweep_scenes(&loaded)?;
+            for (_, s) in &mut scenes {
+                override_scene(s, a.rapier.overrides(None, None), &a.input)?;
+            }
+            let parameter = loaded.file.sweep.as_ref().map_or(String::new(), |s| s.parameter.clone());
+            let values: Vec<String> = loaded.file.sweep.as_ref().map_or(vec![], |s| s.values.iter().map(|v| v.to_string()).collect());
+            let runs = scenes
+                .par_iter()
+                .zip(values)
+                .map(|((_, s), label)| Ok((label, a.model.simulate(s)?)))
+                .collect::<std::result::Result<Vec<_>, lpc_damper::model::ModelError>>()?;
+            figs.push(figures::sweep_curves(&parameter, &runs));
+        } else {
+            let mut s = loaded.scene.clone().expect("a scene file without [chain] has [frame]");
+            override_scene(&mut s, a.rapier.overrides(None, None), &a.input)?;
+            let run = a.model.simulate(&s)?;
+            let bare = lpc_damper::reference::simulate(&s.without_damper())?;
+            figs.extend(figures::time_histories(&run, (!s.balls.is_empty()).then_some(&bare)));
+            if !s.balls.is_empty() {
+                figs.push(figures::ball_positions(&run, s.container.map(|c| c.length)));
+            }
+        }
+    }
+    for f in &figs {
+        for p in figures::write(f, &a.out, a.size)? {
+            println!("{}", p.display());
+        }
+    }
+    Ok(ExitStatus::Success)
+}

@@ -1,0 +1,44 @@
+//! `lpc stability`: the contact model's stability map (step size x impact speed).
+
+use crate::args::{print_json, Format};
+use crate::exit::{ExitStatus, Result};
+
+#[derive(clap::Args)]
+pub struct Args {
+    /// Output format on standard output.
+    #[arg(long, value_enum, default_value_t = Format::Text)]
+    format: Format,
+}
+
+pub fn run(a: Args) -> Result<ExitStatus> {
+    use lpc_damper::stability::{self, Case, CONFIGS, DTS, SPEEDS};
+    let cells = stability::map();
+    match a.format {
+        Format::Json => print_json(&cells)?,
+        Format::Text => {
+            println!("outcome per impact speed (rows, m/s) and step (columns, s); energy error vs the reference in %");
+            for case in Case::ALL {
+                for config in CONFIGS {
+                    println!("\n{} / {}", case.name(), config.name);
+                    print!("{:>8}", "u \\ dt");
+                    for dt in DTS {
+                        print!(" {:>22}", format!("{dt:e}"));
+                    }
+                    println!();
+                    for speed in SPEEDS {
+                        print!("{speed:>8}");
+                        for dt in DTS {
+                            let c = cells
+                                .iter()
+                                .find(|c| c.case == case && c.config == config.name && c.dt == dt && c.speed == speed)
+                                .expect("cell");
+                            print!(" {:>22}", format!("{} {:+.1}", c.outcome, 100.0 * c.energy_error));
+                        }
+                        println!();
+                    }
+                }
+            }
+        }
+    }
+    Ok(ExitStatus::Success)
+}

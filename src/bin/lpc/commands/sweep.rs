@@ -1,0 +1,139 @@
+//! `lpc sweep`: a scene's [sweep] table, or one or two axes given as flags (a design map), in parallel.
+
+use std::path::PathBuf;
+
+use anyhow::Context;
+
+use lpc_damper::output::write_atomic;
+use lpc_damper::scene;
+use lpc_damper::Model;
+
+use crate::args::{invalid, override_scene, print_json, progress_bar, Format, RapierArgs};
+use crate::exit::{ExitStatus, Result};
+
+#[derive(clap::Args)]
+pub struct Args {
+    /// Scene file with a [sweep] table.
+    scene: PathBuf,
+    /// Model to run.
+    #[arg(long, default_value = "reference")]
+    model: Model,
+    /// Simulated time, s (overrides the scene's).
+    #[arg(long)]
+    horizon: Option<f64>,
+    /// Output format on standard output.
+    #[arg(long, value_enum, default_value_t = Format::Text)]
+    format: Format,
+    /// Also write sweep.json (and, for a grid, the design map sweep-map.png/.svg) into this
+    /// directory.
+    #[arg(long)]
+    out: Option<PathBuf>,
+    /// First axis instead of the file's [sweep]: `PARAM=V1,V2,...` or `PARAM=A..B:N`
+    /// (lengths may be `0.5Rr`).
+    #[arg(long)]
+    x: Option<String>,
+    /// Second axis (makes a grid): same syntax as --x.
+    #[arg(long)]
+    y: Option<String>,
+    /// Metric of the design map (one of settling_time, energy_remaining, peak_contact_force,
+    /// peak_displacement, peak_acceleration, rms_displacement, impact_count).
+    #[arg(long, default_value = "settling_time")]
+    metric: String,
+    #[command(flatten)]
+    rapier: RapierArgs,
+}
+
+pub fn run(a: Args) -> Result<ExitStatus> {
+    let loaded = scene::load(&a.scene)?;
+    let invalid = |field: &str, rule: String| invalid(&a.scene, field, rule);
+    if !lpc_damper::sweep::MAP_METRICS.contains(&a.metric.as_str()) {
+        return Err(invalid("--metric", format!("`{}` is not one of {}", a.metric, lpc_damper::sweep::MAP_METRICS.join(", "))).into());
+    }
+    let mut axes = match &a.x {
+        Some(x) => vec![lpc_damper::sweep::parse_axis(x).map_err(|rule| invalid("--x", rule))?],
+        None if a.y.is_some() => return Err(invalid("--y", "needs --x".into()).into()),
+        None => lpc_damper::sweep::file_axes(&loaded)?,
+    };
+    if let Some(y) = &a.y {
+        axes.truncate(1);
+        axes.push(lpc_damper::sweep::parse_axis(y).map_err(|rule| invalid("--y", rule))?);
+    }
+    if loaded.scene.is_none() {
+        return Err(invalid("frame", "is missing: a sweep needs a damper scene".into()).into());
+    }
+    let mut grid = lpc_damper::sweep::grid_scenes(&loaded, &axes)?;
+    for g in &mut grid {
+        override_scene(&mut g.scene, a.rapier.overrides(a.horizon, None), &a.scene)?;
+    }
+    let parameters: Vec<String> = axes.iter().map(|x| x.parameter.clone()).collect();
+    let parameter = parameters.join(" x ");
+    let bar = progress_bar(grid.len(), "sweep");
+    let start = std::time::Instant::now();
+    let points = lpc_damper::sweep::run_grid(&parameters, &grid, a.model, &|| bar.inc(1))?;
+    bar.finish_and_clear();
+    let elapsed = start.elapsed().as_secs_f64();
+    if let Some(dir) = &a.out {
+        write_atomic(&dir.join("sweep.json"), &serde_json::to_vec_pretty(&points)?)
+            .with_context(|| format!("writing {}", dir.display()))?;
+        if axes.len() == 2 {
+            let (nx, ny) = (axes[0].values.len(), axes[1].values.len());
+            let z = (0..ny)
+                .map(|r| (0..nx).map(|c| lpc_damper::sweep::metric_value(&points[r * nx + c].summary, &a.metric)).collect())
+                .collect();
+            let map = lpc_damper::output::figures::HeatMap {
+                name: "sweep-map".into(),
+                title: format!("{}: {} ({})", loaded.scene.as_ref().map_or("", |s| s.name.as_str()), a.metric, a.model.name()),
+                x: (axis_title(&axes[0]), axes[0].values.iter().map(|v| v.raw()).collect()),
+                y: (axis_title(&axes[1]), axes[1].values.iter().map(|v| v.raw()).collect()),
+                z,
+                z_desc: a.metric.clone(),
+            };
+            lpc_damper::output::figures::write_heat_map(&map, dir, (900, 640))?;
+        }
+    }
+    match a.format {
+        Format::Json => print_json(&points)?,
+        Format::Text => {
+            println!(
+                "sweep of `{parameter}` ({}, {} runs in {:.3} s: {:.1} scene-runs per second)",
+                a.model.name(),
+                points.len(),
+                elapsed,
+                points.len() as f64 / elapsed
+            );
+            let y_head = parameters.get(1).map_or(String::new(), |p| format!("{p:>12} "));
+            println!(
+                "{:>12} {y_head}{:>8} {:>12} {:>12} {:>10} {:>10} {:>9}",
+                parameters[0], "impacts", "peak xs mm", "peak a m/s2", "rms xs mm", "settle s", "E left %"
+            );
+            for p in &points {
+                let m = &p.summary.metrics;
+                let y = p.value_y.map_or(String::new(), |v| format!("{v:>12} "));
+                println!(
+                    "{:>12} {y}{:>8} {:>12.4} {:>12.4} {:>10.4} {:>10} {:>9.3}",
+                    p.value,
+                    p.summary.impact_count,
+                    m.peak_displacement * 1e3,
+                    m.peak_acceleration,
+                    m.rms_displacement * 1e3,
+                    m.settling_time.map_or("-".into(), |t| format!("{t:.3}")),
+                    m.energy_remaining.unwrap_or(f64::NAN) * 100.0
+                );
+            }
+            if let (Some(dir), 2) = (&a.out, axes.len()) {
+                println!("wrote sweep.json, sweep-map.png, sweep-map.svg to {}", dir.display());
+            }
+        }
+    }
+    Ok(ExitStatus::Success)
+}
+
+/// An axis's parameter, with `(Rr)` when its values are multiples of the reference radius.
+fn axis_title(axis: &lpc_damper::sweep::Axis) -> String {
+    let rr = axis.values.iter().any(|v| matches!(v, scene::Length::Rr(_)));
+    if rr {
+        format!("{} (Rr)", axis.parameter)
+    } else {
+        axis.parameter.clone()
+    }
+}
