@@ -128,6 +128,7 @@ pub fn feedback(
     frame: Option<ResMut<FrameState>>,
     mut rec: ResMut<Recording>,
     mut context: Query<(&RapierContextSimulation, &RapierContextColliders, &mut RapierRigidBodySet)>,
+    mut velocities: Query<&mut Velocity>,
     mut scratch: Local<Scratch>,
 ) {
     let Some(bodies) = bodies else { return };
@@ -239,6 +240,14 @@ pub fn feedback(
             lin.x = v_new[i] as f32;
             body.set_linvel(lin, true);
             v_new[i] = lin.x as f64; // what Rapier will carry on with
+            // bevy_rapier wrote the step's velocity into the ball's `Velocity` before this
+            // system ran, and in an app driven by `app.update()` it copies a changed
+            // `Velocity` back into the body at the next step: it must hold the corrected one.
+            if let Ok(mut velocity) = velocities.get_mut(bodies.balls[i]) {
+                if velocity.linear != lin {
+                    velocity.linear = lin;
+                }
+            }
         }
         impulses(v_new, &rec.v, dp, active, j);
     }

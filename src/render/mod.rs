@@ -8,6 +8,7 @@
 //! time: the run is sampled at a step that divides the frame interval
 //! ([`crate::run::frame_sampling`]).
 
+pub mod animation;
 pub mod offscreen;
 pub mod stage;
 pub mod window;

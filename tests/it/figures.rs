@@ -8,7 +8,7 @@ use crate::common::lpc;
 /// Width, height and RGBA pixels of a PNG.
 fn decode(path: &Path) -> (u32, u32, Vec<[u8; 4]>) {
     let mut reader = png::Decoder::new(std::io::BufReader::new(std::fs::File::open(path).unwrap())).read_info().unwrap();
-    let mut buf = vec![0; reader.output_buffer_size()];
+    let mut buf = vec![0; reader.output_buffer_size().unwrap()];
     let info = reader.next_frame(&mut buf).unwrap();
     let channels = info.color_type.samples();
     let px = buf[..info.buffer_size()]

@@ -13,7 +13,7 @@ use lpc_damper::scene::{load_scene, BallKind};
 
 fn decode(path: &Path) -> (u32, u32, Vec<u8>, usize) {
     let mut reader = png::Decoder::new(std::io::BufReader::new(std::fs::File::open(path).unwrap())).read_info().unwrap();
-    let mut buf = vec![0; reader.output_buffer_size()];
+    let mut buf = vec![0; reader.output_buffer_size().unwrap()];
     let info = reader.next_frame(&mut buf).unwrap();
     buf.truncate(info.buffer_size());
     (info.width, info.height, buf, info.color_type.samples())
@@ -37,6 +37,16 @@ fn balls_are_drawn_where_the_physics_puts_them() {
     let dir = out.path().to_str().unwrap();
     let o = lpc(&["render", "scenes/lpc-lsl.toml", "--out", dir, "--horizon", "0.4", "--fps", "20", "--size", "480x270"]);
     assert!(o.status.success(), "{}\n{}", String::from_utf8_lossy(&o.stdout), String::from_utf8_lossy(&o.stderr));
+    // Off-screen on a machine without a Wayland session, nothing but the summary is printed.
+    assert!(String::from_utf8_lossy(&o.stderr).trim().is_empty(), "{}", String::from_utf8_lossy(&o.stderr));
+    // The animation beside the frames: a GIF of the frames' size, one image per frame, each
+    // shown 100/fps hundredths of a second (one simulated second per second).
+    let gif = std::fs::read(out.path().join("animation.gif")).unwrap();
+    assert_eq!(&gif[..6], b"GIF89a");
+    assert_eq!((u16::from_le_bytes([gif[6], gif[7]]), u16::from_le_bytes([gif[8], gif[9]])), (SIZE.0 as u16, SIZE.1 as u16));
+    let delays: Vec<u16> = gif.windows(6).filter(|w| w[..3] == [0x21, 0xF9, 0x04]).map(|w| u16::from_le_bytes([w[4], w[5]])).collect();
+    assert_eq!(delays.len(), (0.4 * FPS).round() as usize + 1, "one graphic control block per frame");
+    assert!(delays.iter().all(|&d| d == (100.0 / FPS) as u16), "{delays:?}");
     let scene = load_scene("scenes/lpc-lsl.toml").unwrap();
     let layout = Layout::of(&scene);
     let series = read_series_csv(&out.path().join("series.csv")).unwrap();

@@ -4,6 +4,7 @@
 mod check_bad_scene_exit_status;
 mod forced_ball_through_wall;
 mod loaded_contact_sinks;
+mod plugin_driven_by_app_update;
 mod squeezed_ball_stops;
 mod stale_impulse_bounce;
 mod zero_time_event_loop;

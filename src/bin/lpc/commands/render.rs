@@ -57,9 +57,47 @@ pub fn run(a: Args) -> Result<ExitStatus> {
 #[cfg(feature = "render")]
 fn render_run(s: &Scene, run: &lpc_damper::run::Run, a: &Args, per_frame: usize) -> Result<()> {
     let options = lpc_damper::render::RenderOptions { out: a.out.clone(), size: a.size, samples_per_frame: per_frame };
-    let frames = lpc_damper::render::render_frames(s, run, &options)?;
-    println!("{} frames ({}x{}, {} fps, sample step {:e} s) in {}", frames.len(), a.size.0, a.size.1, a.fps, run.sample_dt, a.out.display());
+    let runtime = quiet_wayland_probe();
+    let frames = lpc_damper::render::render_frames(s, run, &options);
+    if let Some(dir) = runtime {
+        let _ = std::fs::remove_dir(dir);
+    }
+    let frames = frames?;
+    let gif = a.out.join("animation.gif");
+    lpc_damper::render::animation::write_gif(&frames, a.fps, &gif)?;
+    println!(
+        "{} frames ({}x{}, {} fps, sample step {:e} s) and {} in {}",
+        frames.len(),
+        a.size.0,
+        a.size.1,
+        a.fps,
+        run.sample_dt,
+        gif.file_name().map_or_else(String::new, |n| n.to_string_lossy().into_owned()),
+        a.out.display()
+    );
     Ok(())
+}
+
+/// Mesa's Vulkan driver probes for a Wayland display even off-screen, and libwayland prints
+/// "XDG_RUNTIME_DIR is invalid or not set" on every run where the variable is unset (CI,
+/// containers, ssh sessions). An empty private runtime directory makes the probe fail
+/// quietly; nothing else reads it. Returns the directory to remove afterwards.
+#[cfg(feature = "render")]
+fn quiet_wayland_probe() -> Option<PathBuf> {
+    if std::env::var_os("XDG_RUNTIME_DIR").is_some_and(|d| !d.is_empty()) {
+        return None;
+    }
+    let dir = std::env::temp_dir().join(format!("lpc-runtime-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).ok()?;
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::PermissionsExt;
+        std::fs::set_permissions(&dir, std::fs::Permissions::from_mode(0o700)).ok()?;
+    }
+    // Edition 2021: setting a variable is safe; it happens before the renderer starts its
+    // threads, while only the main thread (and rayon's idle pool) exists.
+    std::env::set_var("XDG_RUNTIME_DIR", &dir);
+    Some(dir)
 }
 
 #[cfg(not(feature = "render"))]
