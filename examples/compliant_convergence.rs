@@ -4,7 +4,7 @@
 //!
 //! `cargo run --release --example compliant_convergence`
 
-use lpc_damper::compare::errors;
+use lpc_damper::studies::compare::errors;
 use lpc_damper::compliant::{simulate, simulate_with, Options};
 use lpc_damper::scene::{load_scene, scenes_dir};
 

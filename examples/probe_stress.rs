@@ -4,9 +4,9 @@ use rayon::prelude::*;
 fn main() {
     let n: u64 = std::env::args().nth(1).unwrap().parse().unwrap();
     let rows: Vec<String> = (1..=n).into_par_iter().map(|seed| {
-        let file = lpc_damper::stress::random_scene_file(seed, 1.0, false);
+        let file = lpc_damper::studies::stress::random_scene_file(seed, 1.0, false);
         let scene = lpc_damper::scene::from_file(file, "s", "s").unwrap().scene.unwrap();
-        let r = lpc_damper::stress::check_run(lpc_damper::Model::Rapier, &scene);
+        let r = lpc_damper::studies::stress::check_run(lpc_damper::Model::Rapier, &scene);
         let f = scene.frame.unwrap();
         let w = (f.stiffness / f.mass).sqrt();
         let c = scene.container.unwrap();
@@ -15,7 +15,7 @@ fn main() {
         format!("{{\"seed\":{seed},\"n\":{},\"w\":{w},\"xs0\":{},\"gap\":{},\"clr\":{},\"e\":{},\"rmin\":{rmin},\"mmax\":{mmax},\"zeta\":{},\"out\":\"{}\",\"detail\":\"{}\"}}",
             scene.balls.len(), scene.initial_displacement.abs(), c.gap, c.clearance, scene.restitution,
             f.damping / (2.0 * (f.stiffness * f.mass).sqrt()).max(1e-300),
-            match &r { Ok(lpc_damper::stress::Passed::Refused { .. }) => "refused", Ok(_) => "ok", Err(f) => f.check },
+            match &r { Ok(lpc_damper::studies::stress::Passed::Refused { .. }) => "refused", Ok(_) => "ok", Err(f) => f.check },
             match &r { Err(f) => f.detail.replace('"', "'"), _ => String::new() })
     }).collect();
     for r in rows { println!("{r}"); }

@@ -4,7 +4,7 @@
 use std::time::Instant;
 
 use lpc_damper::scene::{load, load_scene, scenes_dir, Arrangement, Length};
-use lpc_damper::sweep::{run_sweep, sweep_scenes};
+use lpc_damper::studies::sweep::{run_sweep, sweep_scenes};
 use lpc_damper::Model;
 
 fn main() {

@@ -11,7 +11,7 @@ fn main() {
         s.initial_displacement *= 1.0 + eps;
         s.initial_positions.iter_mut().for_each(|x| *x += scene.initial_displacement * eps);
         let run = lpc_damper::reference::simulate(&s).unwrap();
-        let e = lpc_damper::compare::errors(&run, &base);
+        let e = lpc_damper::studies::compare::errors(&run, &base);
         println!(
             "{:>8.0e} {:>10.4} {:>12.6} {:>12} {:>10.3} {:>8}",
             eps,

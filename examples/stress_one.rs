@@ -12,14 +12,14 @@ fn main() {
     let seed: u64 = args[1].parse().unwrap();
     let max_h: f64 = args.get(2).map_or(100.0, |s| s.parse().unwrap());
     let model: lpc_damper::Model = args.get(3).map_or("reference", |s| s).parse().unwrap();
-    let file = lpc_damper::stress::random_scene_file(seed, max_h, false);
+    let file = lpc_damper::studies::stress::random_scene_file(seed, max_h, false);
     if args.iter().any(|a| a == "--toml") {
         println!("{}", toml::to_string(&file).unwrap());
         return;
     }
     let scene = lpc_damper::scene::from_file(file, "s", "s").unwrap().scene.unwrap();
     let t = std::time::Instant::now();
-    let r = lpc_damper::stress::check_run(model, &scene);
+    let r = lpc_damper::studies::stress::check_run(model, &scene);
     if let Err(f) = &r { println!("{}", f.detail); }
-    println!("seed {seed}: {:.3} s balls {} horizon {:.2} -> {:?}", t.elapsed().as_secs_f64(), scene.balls.len(), scene.horizon, r.map(|p| match p { lpc_damper::stress::Passed::Run(r) => Some((r.events, r.impacts.len())), lpc_damper::stress::Passed::Refused { .. } => None }).map_err(|f| f.check));
+    println!("seed {seed}: {:.3} s balls {} horizon {:.2} -> {:?}", t.elapsed().as_secs_f64(), scene.balls.len(), scene.horizon, r.map(|p| match p { lpc_damper::studies::stress::Passed::Run(r) => Some((r.events, r.impacts.len())), lpc_damper::studies::stress::Passed::Refused { .. } => None }).map_err(|f| f.check));
 }

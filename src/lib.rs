@@ -17,15 +17,9 @@
 //! ```
 #![warn(missing_docs)]
 
-pub mod bench;
-pub mod chain;
-pub mod check;
-pub mod compare;
 pub mod compliant;
-pub mod frf;
 pub mod metrics;
 pub mod model;
-pub mod optimize;
 pub mod oscillator;
 pub mod output;
 pub mod rapier;
@@ -34,8 +28,6 @@ pub mod render;
 pub mod reference;
 pub mod run;
 pub mod scene;
-pub mod stability;
-pub mod stress;
-pub mod sweep;
+pub mod studies;
 
 pub use model::Model;

@@ -428,7 +428,7 @@ impl<'s, 'a> Driver<'s, 'a> {
             y[sys.x(i)] = scene.initial_positions[i];
             y[sys.v(i)] = scene.initial_velocities[i];
         }
-        let samples = (scene.horizon / scene.sample_dt * (1.0 + 1e-12)).floor() as usize + 1;
+        let samples = scene.sample_count();
         Driver {
             sys,
             options,

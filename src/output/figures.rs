@@ -9,7 +9,7 @@ use std::sync::Once;
 use plotters::coord::Shift;
 use plotters::prelude::*;
 
-use crate::chain::KerRow;
+use crate::studies::chain::KerRow;
 use crate::run::{Run, Series};
 
 /// The font every bitmap figure is drawn with (DejaVu Sans, bundled so that figures look the
@@ -333,9 +333,9 @@ pub fn sweep_curves(parameter: &str, runs: &[(String, Run)]) -> Figure {
 
 /// Frequency response: steady amplitude of `xs` against forcing frequency, with and without
 /// the damper.
-pub fn frf_chart(points: &[crate::frf::FrfPoint], scene: &str, model: &str) -> Figure {
+pub fn frf_chart(points: &[crate::studies::frf::FrfPoint], scene: &str, model: &str) -> Figure {
     // Frequencies whose run failed have no amplitude to draw.
-    let curve = |label: &str, amplitude: fn(&crate::frf::FrfPoint) -> Option<f64>| {
+    let curve = |label: &str, amplitude: fn(&crate::studies::frf::FrfPoint) -> Option<f64>| {
         let known: Vec<(f64, f64)> = points.iter().filter_map(|p| amplitude(p).map(|a| (p.frequency, a * 1e3))).collect();
         Curve { label: label.into(), x: known.iter().map(|k| k.0).collect(), y: known.iter().map(|k| k.1).collect() }
     };

@@ -4,7 +4,7 @@ use std::path::Path;
 
 use plotters::prelude::*;
 
-use crate::bench::BenchRow;
+use crate::studies::bench::BenchRow;
 
 /// Log-log plot of early error against computing cost per simulated second, one series per
 /// scene and model/stepping, Pareto-optimal settings circled.

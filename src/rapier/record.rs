@@ -50,7 +50,7 @@ impl Recording {
     /// An empty recording for `scene`.
     pub fn new(scene: &Scene) -> Self {
         let n = scene.balls.len();
-        let samples = (scene.horizon / scene.sample_dt * (1.0 + 1e-12)).floor() as usize + 1;
+        let samples = scene.sample_count();
         let m_min = scene.balls.iter().map(|b| b.mass).fold(f64::INFINITY, f64::min);
         Recording {
             series: Series::with_capacity(n, samples),

@@ -531,7 +531,7 @@ impl<'a> Solver<'a> {
         let speed_scale = (bare_omega * xs0.abs()).max(forced_speed)
             .max(scene.initial_velocities.iter().fold(0.0, |m: f64, v| m.max(v.abs())))
             .max(length_scale / scene.horizon);
-        let samples = (scene.horizon / scene.sample_dt * (1.0 + 1e-12)).floor() as usize + 1;
+        let samples = scene.sample_count();
         let mut s = Solver {
             scene,
             n,

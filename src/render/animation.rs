@@ -10,7 +10,7 @@ use std::path::{Path, PathBuf};
 use super::RenderError;
 
 /// NeuQuant's sampling factor: 1 is the best palette and slowest, 30 the fastest; 10 is the
-/// encoder's documented compromise and keeps a 640x360 frame to tens of milliseconds.
+/// `gif` crate's documented compromise between palette quality and time.
 const QUANTISER_SPEED: i32 = 10;
 
 /// Shortest frame delay in hundredths of a second: browsers and viewers slow anything

@@ -228,6 +228,13 @@ pub fn ball_radius(mass: f64, density: f64) -> f64 {
 }
 
 impl Scene {
+    /// Samples every model writes: at `k sample_dt` for every `k` with `k sample_dt` within
+    /// the horizon (a relative 1e-12 of slack, so a horizon that is a whole number of steps
+    /// in exact arithmetic keeps its last sample after rounding).
+    pub fn sample_count(&self) -> usize {
+        (self.horizon / self.sample_dt * (1.0 + 1e-12)).floor() as usize + 1
+    }
+
     /// Initial mechanical energy: spring energy plus balls' kinetic energy.
     pub fn initial_energy(&self) -> f64 {
         let spring = self.frame.map_or(0.0, |f| f.energy(self.initial_displacement, 0.0));

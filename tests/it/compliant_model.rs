@@ -9,7 +9,7 @@
 //! scales (its Hertz length and speed); an impact takes about 10^2 steps, so quantities set
 //! by one impact are good to about 1e-7 relative and are checked at 1e-6.
 
-use lpc_damper::compare::errors;
+use lpc_damper::studies::compare::errors;
 use lpc_damper::compliant::{self, contact, Options, DEFAULT_TOLERANCE};
 use lpc_damper::reference::impact_law;
 use lpc_damper::run::Run;
@@ -274,7 +274,7 @@ fn touching_chain_passes_momentum_and_balances_energy() {
             let p0 = s.balls[0].mass * 1.4;
             assert!((p - p0).abs() <= 1e-12 * p0, "{}: momentum {p} vs {p0}", s.name);
             assert!(r.energy.balance_error.abs() <= r.events as f64 * DEFAULT_TOLERANCE, "{}: {:e}", s.name, r.energy.balance_error);
-            let ker = lpc_damper::chain::ker(s, &r);
+            let ker = lpc_damper::studies::chain::ker(s, &r);
             if e == 1.0 {
                 assert!((ker - 1.0).abs() <= 1e-6, "{}: KER {ker}", s.name);
             } else {

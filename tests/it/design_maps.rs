@@ -4,9 +4,9 @@
 use crate::common;
 
 use lpc_damper::metrics::{metrics, noise};
-use lpc_damper::optimize::{optimize, Objective};
+use lpc_damper::studies::optimize::{optimize, Objective};
 use lpc_damper::scene::{self, Length};
-use lpc_damper::sweep::{grid_scenes, parse_axis};
+use lpc_damper::studies::sweep::{grid_scenes, parse_axis};
 
 fn paper(name: &str) -> scene::Loaded {
     scene::load(scene::scenes_dir().join(name)).unwrap()

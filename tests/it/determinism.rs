@@ -2,7 +2,7 @@
 
 use lpc_damper::output::RunSummary;
 use lpc_damper::scene::{load, scenes_dir};
-use lpc_damper::sweep::{run_sweep, sweep_scenes};
+use lpc_damper::studies::sweep::{run_sweep, sweep_scenes};
 use lpc_damper::Model;
 
 fn sweep_on(threads: usize, model: Model) -> Vec<RunSummary> {

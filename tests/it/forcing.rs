@@ -4,7 +4,7 @@
 
 use crate::common;
 
-use lpc_damper::frf;
+use lpc_damper::studies::frf;
 use lpc_damper::scene::{Forcing, ForcingKind, Scene};
 use lpc_damper::{reference, Model};
 

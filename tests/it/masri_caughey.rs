@@ -149,11 +149,11 @@ fn frf_reads_the_periodic_motion() {
         d.frame_mass, d.stiffness, d.damping, d.ball_mass, d.restitution, 0.5 * d.travel, 0.5 * d.travel, d.force, d.frequency
     );
     let scene = lpc_damper::scene::parse(&text, "masri.toml", "masri").unwrap().scene.unwrap();
-    let point = lpc_damper::frf::frf(&scene, &[d.frequency], lpc_damper::Model::Reference, &|| {}).remove(0);
+    let point = lpc_damper::studies::frf::frf(&scene, &[d.frequency], lpc_damper::Model::Reference, &|| {}).remove(0);
     let exact = d.solutions().into_iter().filter(|p| p.admissible).map(|p| p.amplitude).fold(0.0, f64::max);
     assert!(point.steady, "{point:?}");
     assert_eq!(point.impacts_per_period, Some(2.0));
-    let tol = lpc_damper::frf::STEADY_TOLERANCE + 1.0 - (PI / lpc_damper::frf::SAMPLES_PER_PERIOD).cos();
+    let tol = lpc_damper::studies::frf::STEADY_TOLERANCE + 1.0 - (PI / lpc_damper::studies::frf::SAMPLES_PER_PERIOD).cos();
     let amplitude = point.amplitude.unwrap();
     assert!((amplitude / exact - 1.0).abs() <= tol, "{amplitude} vs {exact}");
 }

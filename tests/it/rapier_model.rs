@@ -4,7 +4,7 @@ use crate::common;
 
 use approx::assert_relative_eq;
 use common::*;
-use lpc_damper::compare::errors;
+use lpc_damper::studies::compare::errors;
 use lpc_damper::output::files::{impacts_csv, series_csv};
 use lpc_damper::output::RunSummary;
 use lpc_damper::reference::impact_law;

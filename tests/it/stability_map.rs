@@ -2,9 +2,9 @@
 //! into a wall, the plug-in's speculative margin does not, and aligned stepping stays accurate
 //! at a step far longer than the free space a ball crosses in it.
 
-use lpc_damper::stability::{cell, Case, CONFIGS};
+use lpc_damper::studies::stability::{cell, Case, CONFIGS};
 
-fn config(name: &str) -> lpc_damper::stability::Config {
+fn config(name: &str) -> lpc_damper::studies::stability::Config {
     *CONFIGS.iter().find(|c| c.name == name).expect("config")
 }
 

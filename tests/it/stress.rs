@@ -4,7 +4,7 @@
 //! pass every check (no panic, finite, no energy gained, impact losses bounded, momentum kept
 //! on free frames, balls inside, no stall). The full count is a documented command.
 
-use lpc_damper::stress::{stress, Outcome};
+use lpc_damper::studies::stress::{stress, Outcome};
 use lpc_damper::Model;
 
 /// Every outcome passed; otherwise the count, the first failure and its shrunk scene.
@@ -36,9 +36,9 @@ fn forced_random_scenes_pass_every_check() {
 
 #[test]
 fn generated_scenes_are_reproducible_from_their_seed() {
-    let a = toml::to_string(&lpc_damper::stress::random_scene_file(42, 100.0, false)).unwrap();
-    let b = toml::to_string(&lpc_damper::stress::random_scene_file(42, 100.0, false)).unwrap();
-    let c = toml::to_string(&lpc_damper::stress::random_scene_file(43, 100.0, false)).unwrap();
+    let a = toml::to_string(&lpc_damper::studies::stress::random_scene_file(42, 100.0, false)).unwrap();
+    let b = toml::to_string(&lpc_damper::studies::stress::random_scene_file(42, 100.0, false)).unwrap();
+    let c = toml::to_string(&lpc_damper::studies::stress::random_scene_file(43, 100.0, false)).unwrap();
     assert_eq!(a, b);
     assert_ne!(a, c);
 }

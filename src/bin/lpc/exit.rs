@@ -1,17 +1,16 @@
 //! How a command ends, and the process exit code each ending maps to (in one place).
 //!
 //! The exit class of an error is decided where the error is made, by its type: a
-//! [`SceneError`] (a scene file or a flag that cannot exist) is bad input; a library error
+//! [`SceneError`] (a scene file or a flag that cannot exist) is bad input; a study's error
 //! that wraps one says so in its own variant; everything else is a failed run. Nothing
 //! searches an error chain for a type that a transparent wrapper may hide.
 
 use std::process::ExitCode;
 
-use lpc_damper::check::CheckError;
 use lpc_damper::model::ModelError;
-use lpc_damper::optimize::OptimizeError;
 use lpc_damper::output::figures::FigureError;
 use lpc_damper::scene::SceneError;
+use lpc_damper::studies::StudyError;
 
 /// How a command ended.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -67,20 +66,11 @@ impl From<SceneError> for CommandError {
     }
 }
 
-impl From<CheckError> for CommandError {
-    fn from(e: CheckError) -> Self {
+impl From<StudyError> for CommandError {
+    fn from(e: StudyError) -> Self {
         match e {
-            CheckError::Scene(s) => CommandError::bad_input(s),
+            StudyError::Scene(s) => CommandError::bad_input(s),
             other => CommandError::failure(other),
-        }
-    }
-}
-
-impl From<OptimizeError> for CommandError {
-    fn from(e: OptimizeError) -> Self {
-        match e {
-            OptimizeError::Scene(s) => CommandError::bad_input(s),
-            OptimizeError::Model(m) => CommandError::failure(m),
         }
     }
 }

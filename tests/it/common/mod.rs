@@ -74,7 +74,7 @@ pub fn all_paper_scenes() -> Vec<Scene> {
     for p in paths {
         let loaded = lpc_damper::scene::load(&p).unwrap();
         if loaded.file.sweep.is_some() {
-            out.extend(lpc_damper::sweep::sweep_scenes(&loaded).unwrap().into_iter().map(|(_, s)| s));
+            out.extend(lpc_damper::studies::sweep::sweep_scenes(&loaded).unwrap().into_iter().map(|(_, s)| s));
         } else if let Some(s) = loaded.scene {
             out.push(s);
         }

@@ -96,7 +96,7 @@ fn frf_never_calls_a_failed_run_steady() {
         .output()
         .unwrap();
     assert_eq!(out.status.code(), Some(1), "{}", String::from_utf8_lossy(&out.stderr));
-    let points: Vec<lpc_damper::frf::FrfPoint> = serde_json::from_slice(&out.stdout).unwrap();
+    let points: Vec<lpc_damper::studies::frf::FrfPoint> = serde_json::from_slice(&out.stdout).unwrap();
     assert_eq!(points.len(), 2);
     for p in points {
         assert!(!p.steady && p.amplitude.is_none() && p.error.is_some(), "{p:?}");

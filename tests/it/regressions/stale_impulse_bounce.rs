@@ -3,7 +3,7 @@
 //! solved plastically: a small ball between two large ones stuck to one of them. The plug-in
 //! now applies the bounce Rapier skipped; the chain experiment must match the reference.
 
-use lpc_damper::chain::{ker, run_chain};
+use lpc_damper::studies::chain::{ker, run_chain};
 use lpc_damper::scene::{load, scenes_dir};
 use lpc_damper::Model;
 

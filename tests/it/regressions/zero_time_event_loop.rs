@@ -4,7 +4,7 @@
 //! for a new search). Both judge the sign alike now, and an event's pair is always searched
 //! again.
 
-use lpc_damper::stress::{check_run, random_scene_file};
+use lpc_damper::studies::stress::{check_run, random_scene_file};
 use lpc_damper::Model;
 
 #[test]

@@ -54,7 +54,7 @@ pub fn run(a: Args) -> Result<ExitStatus> {
     for &it in &a.solver_iterations {
         Overrides { solver_iterations: Some(it), ..Overrides::default() }.check_rapier()?;
     }
-    let plan = lpc_damper::bench::Plan {
+    let plan = lpc_damper::studies::bench::Plan {
         models: a.models.clone(),
         steppings: a.stepping.clone(),
         dts: a.dt.clone(),
@@ -71,7 +71,7 @@ pub fn run(a: Args) -> Result<ExitStatus> {
     let mut rows = Vec::new();
     for p in &paths {
         let scene = load_scene(p, Overrides { horizon: a.horizon, ..Overrides::default() })?;
-        rows.extend(lpc_damper::bench::bench_scene(&scene, &plan, &|| bar.inc(1))?);
+        rows.extend(lpc_damper::studies::bench::bench_scene(&scene, &plan, &|| bar.inc(1))?);
     }
     bar.finish_and_clear();
     let csv_bytes = bench_csv(&rows)?;
@@ -116,7 +116,7 @@ pub fn run(a: Args) -> Result<ExitStatus> {
     Ok(ExitStatus::Success)
 }
 
-fn bench_csv(rows: &[lpc_damper::bench::BenchRow]) -> Result<Vec<u8>> {
+fn bench_csv(rows: &[lpc_damper::studies::bench::BenchRow]) -> Result<Vec<u8>> {
     let mut w = csv::Writer::from_writer(Vec::new());
     w.write_record([
         "scene", "model", "stepping", "dt", "solver_iterations", "wall_s_per_sim_s", "steps_per_sim_s", "rms_xs",

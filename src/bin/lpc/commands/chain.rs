@@ -2,7 +2,7 @@
 
 use std::path::PathBuf;
 
-use lpc_damper::chain::{run_chain, KerRow};
+use lpc_damper::studies::chain::{run_chain, KerRow};
 use lpc_damper::scene;
 use lpc_damper::Model;
 

@@ -2,7 +2,7 @@
 
 use std::path::PathBuf;
 
-use lpc_damper::check;
+use lpc_damper::studies::check;
 use lpc_damper::Model;
 
 use crate::exit::{ExitStatus, Result};

@@ -4,7 +4,7 @@ use std::path::PathBuf;
 
 use anyhow::Context;
 
-use lpc_damper::compare::{errors, Errors};
+use lpc_damper::studies::compare::{errors, Errors};
 use lpc_damper::output::{write_run_dir, RunSummary};
 use lpc_damper::Model;
 

@@ -83,10 +83,10 @@ pub fn run(a: Args) -> Result<ExitStatus> {
             return Err(invalid("--freq", format!("{from}..{to} Hz contains the undamped frame's resonance {w0:.6} Hz, where no steady state exists")).into());
         }
     }
-    let freqs = lpc_damper::frf::frequencies(from, to, a.steps);
+    let freqs = lpc_damper::studies::frf::frequencies(from, to, a.steps);
     let bar = progress_bar(2 * freqs.len(), "frf");
     let start = std::time::Instant::now();
-    let points = lpc_damper::frf::frf(&scene, &freqs, a.model, &|| bar.inc(1));
+    let points = lpc_damper::studies::frf::frf(&scene, &freqs, a.model, &|| bar.inc(1));
     bar.finish_and_clear();
     let elapsed = start.elapsed().as_secs_f64();
     if let Some(dir) = &a.out {

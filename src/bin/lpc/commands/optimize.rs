@@ -55,7 +55,7 @@ enum ObjectiveArg {
 }
 
 pub fn run(a: Args) -> Result<ExitStatus> {
-    use lpc_damper::optimize::{optimize, Objective};
+    use lpc_damper::studies::optimize::{optimize, Objective};
     let loaded = scene::load(&a.scene)?;
     let invalid = |field: &str, rule: String| invalid(&a.scene, field, rule);
     let Some(base) = loaded.scene.clone() else {
@@ -72,7 +72,7 @@ pub fn run(a: Args) -> Result<ExitStatus> {
     let axes = a
         .vary
         .iter()
-        .map(|v| lpc_damper::sweep::parse_axis(v).map_err(|rule| invalid("--vary", rule)))
+        .map(|v| lpc_damper::studies::sweep::parse_axis(v).map_err(|rule| invalid("--vary", rule)))
         .collect::<std::result::Result<Vec<_>, _>>()?;
     let arrangements: Vec<String> = match &a.arrangements {
         Some(list) => list.split(',').map(|s| s.trim().to_string()).filter(|s| !s.is_empty()).collect(),

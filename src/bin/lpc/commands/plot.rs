@@ -2,7 +2,7 @@
 
 use std::path::{Path, PathBuf};
 
-use lpc_damper::chain::run_chain;
+use lpc_damper::studies::chain::run_chain;
 use lpc_damper::scene;
 use lpc_damper::Model;
 
@@ -75,7 +75,7 @@ pub fn run(a: Args) -> Result<ExitStatus> {
             figs.push(figures::ker_chart(&run_chain(&cases, a.model)?, a.model.name()));
         } else if loaded.file.sweep.is_some() {
             use rayon::prelude::*;
-            let mut scenes = lpc_damper::sweep::sweep_scenes(&loaded)?;
+            let mut scenes = lpc_damper::studies::sweep::sweep_scenes(&loaded)?;
             for (_, s) in &mut scenes {
                 override_scene(s, a.rapier.overrides(None, None), &a.input)?;
             }

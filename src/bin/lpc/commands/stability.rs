@@ -11,7 +11,7 @@ pub struct Args {
 }
 
 pub fn run(a: Args) -> Result<ExitStatus> {
-    use lpc_damper::stability::{self, Case, CONFIGS, DTS, SPEEDS};
+    use lpc_damper::studies::stability::{self, Case, CONFIGS, DTS, SPEEDS};
     let cells = stability::map();
     match a.format {
         Format::Json => print_json(&cells)?,

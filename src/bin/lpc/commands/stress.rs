@@ -39,7 +39,7 @@ pub fn run(a: Args) -> Result<ExitStatus> {
     let start = std::time::Instant::now();
     for &model in &a.models {
         let bar = progress_bar(a.count as usize, &format!("stress {}", model.name()));
-        outcomes.extend(lpc_damper::stress::stress(model, a.seed, a.count, a.max_horizon, a.forced, &|| bar.inc(1)));
+        outcomes.extend(lpc_damper::studies::stress::stress(model, a.seed, a.count, a.max_horizon, a.forced, &|| bar.inc(1)));
         bar.finish_and_clear();
     }
     let failures: Vec<_> = outcomes.iter().filter(|o| o.failure.is_some()).collect();

@@ -46,22 +46,22 @@ pub struct Args {
 pub fn run(a: Args) -> Result<ExitStatus> {
     let loaded = scene::load(&a.scene)?;
     let invalid = |field: &str, rule: String| invalid(&a.scene, field, rule);
-    if !lpc_damper::sweep::MAP_METRICS.contains(&a.metric.as_str()) {
-        return Err(invalid("--metric", format!("`{}` is not one of {}", a.metric, lpc_damper::sweep::MAP_METRICS.join(", "))).into());
+    if !lpc_damper::studies::sweep::MAP_METRICS.contains(&a.metric.as_str()) {
+        return Err(invalid("--metric", format!("`{}` is not one of {}", a.metric, lpc_damper::studies::sweep::MAP_METRICS.join(", "))).into());
     }
     let mut axes = match &a.x {
-        Some(x) => vec![lpc_damper::sweep::parse_axis(x).map_err(|rule| invalid("--x", rule))?],
+        Some(x) => vec![lpc_damper::studies::sweep::parse_axis(x).map_err(|rule| invalid("--x", rule))?],
         None if a.y.is_some() => return Err(invalid("--y", "needs --x".into()).into()),
-        None => lpc_damper::sweep::file_axes(&loaded)?,
+        None => lpc_damper::studies::sweep::file_axes(&loaded)?,
     };
     if let Some(y) = &a.y {
         axes.truncate(1);
-        axes.push(lpc_damper::sweep::parse_axis(y).map_err(|rule| invalid("--y", rule))?);
+        axes.push(lpc_damper::studies::sweep::parse_axis(y).map_err(|rule| invalid("--y", rule))?);
     }
     if loaded.scene.is_none() {
         return Err(invalid("frame", "is missing: a sweep needs a damper scene".into()).into());
     }
-    let mut grid = lpc_damper::sweep::grid_scenes(&loaded, &axes)?;
+    let mut grid = lpc_damper::studies::sweep::grid_scenes(&loaded, &axes)?;
     for g in &mut grid {
         override_scene(&mut g.scene, a.rapier.overrides(a.horizon, None), &a.scene)?;
     }
@@ -69,7 +69,7 @@ pub fn run(a: Args) -> Result<ExitStatus> {
     let parameter = parameters.join(" x ");
     let bar = progress_bar(grid.len(), "sweep");
     let start = std::time::Instant::now();
-    let points = lpc_damper::sweep::run_grid(&parameters, &grid, a.model, &|| bar.inc(1))?;
+    let points = lpc_damper::studies::sweep::run_grid(&parameters, &grid, a.model, &|| bar.inc(1))?;
     bar.finish_and_clear();
     let elapsed = start.elapsed().as_secs_f64();
     if let Some(dir) = &a.out {
@@ -78,7 +78,7 @@ pub fn run(a: Args) -> Result<ExitStatus> {
         if axes.len() == 2 {
             let (nx, ny) = (axes[0].values.len(), axes[1].values.len());
             let z = (0..ny)
-                .map(|r| (0..nx).map(|c| lpc_damper::sweep::metric_value(&points[r * nx + c].summary, &a.metric)).collect())
+                .map(|r| (0..nx).map(|c| lpc_damper::studies::sweep::metric_value(&points[r * nx + c].summary, &a.metric)).collect())
                 .collect();
             let map = lpc_damper::output::figures::HeatMap {
                 name: "sweep-map".into(),
@@ -129,7 +129,7 @@ pub fn run(a: Args) -> Result<ExitStatus> {
 }
 
 /// An axis's parameter, with `(Rr)` when its values are multiples of the reference radius.
-fn axis_title(axis: &lpc_damper::sweep::Axis) -> String {
+fn axis_title(axis: &lpc_damper::studies::sweep::Axis) -> String {
     let rr = axis.values.iter().any(|v| matches!(v, scene::Length::Rr(_)));
     if rr {
         format!("{} (Rr)", axis.parameter)

@@ -4,7 +4,7 @@
 
 use serde::{Deserialize, Serialize};
 
-use crate::compare::{errors, Errors};
+use crate::studies::compare::{errors, Errors};
 use crate::model::{Model, ModelError};
 use crate::rapier::Stepping;
 use crate::scene::Scene;

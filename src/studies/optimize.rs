@@ -10,10 +10,11 @@
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
-use crate::frf;
-use crate::model::{Model, ModelError};
+use super::StudyError;
+use crate::studies::frf;
+use crate::model::Model;
 use crate::scene::{self, Arrangement, Length, Loaded, SceneError};
-use crate::sweep::Axis;
+use crate::studies::sweep::Axis;
 
 /// Points per axis in each refinement.
 pub const REFINE_POINTS: usize = 5;
@@ -58,16 +59,6 @@ pub struct Search {
     pub infeasible: usize,
 }
 
-/// Why a search could not run.
-#[derive(Debug, thiserror::Error)]
-pub enum OptimizeError {
-    /// Bad scene or axes.
-    #[error(transparent)]
-    Scene(#[from] SceneError),
-    /// A model failed.
-    #[error(transparent)]
-    Model(#[from] ModelError),
-}
 
 /// Searches `arrangements` x the grid of `axes` (refined `refinements` times) for the design
 /// minimising `objective`, with the container's inner length fixed to `container_length`.
@@ -80,7 +71,7 @@ pub fn optimize(
     model: Model,
     refinements: u32,
     progress: &(dyn Fn() + Sync),
-) -> Result<Search, OptimizeError> {
+) -> Result<Search, StudyError> {
     let invalid = |field: &str, rule: String| SceneError::Invalid { file: loaded.path.clone(), field: field.into(), rule };
     if axes.iter().any(|a| a.parameter == "clearance") {
         return Err(invalid("clearance", "follows from the container length here: vary gap, mass_ratio, ... instead".into()).into());
@@ -120,7 +111,7 @@ pub fn optimize(
                     let hi = values[(k + 1).min(values.len() - 1)];
                     (0..REFINE_POINTS)
                         .map(|i| {
-                            let x = crate::sweep::tidy(lo.raw() + (hi.raw() - lo.raw()) * i as f64 / (REFINE_POINTS - 1) as f64);
+                            let x = crate::studies::sweep::tidy(lo.raw() + (hi.raw() - lo.raw()) * i as f64 / (REFINE_POINTS - 1) as f64);
                             match lo {
                                 Length::Metres(_) => Length::Metres(x),
                                 Length::Rr(_) => Length::Rr(x),
@@ -161,7 +152,7 @@ fn evaluate(
     objective: Objective,
     model: Model,
     progress: &(dyn Fn() + Sync),
-) -> Result<(Vec<Design>, usize), OptimizeError> {
+) -> Result<(Vec<Design>, usize), StudyError> {
     let mut points: Vec<Vec<Length>> = vec![vec![]];
     for values in grid {
         points = points.iter().flat_map(|p| values.iter().map(move |v| [p.clone(), vec![*v]].concat())).collect();
@@ -200,7 +191,7 @@ fn evaluate(
                 objective: value,
             }))
         })
-        .collect::<Result<_, OptimizeError>>()?;
+        .collect::<Result<_, StudyError>>()?;
     let infeasible = results.iter().filter(|r| r.is_none()).count();
     Ok((results.into_iter().flatten().collect(), infeasible))
 }

@@ -19,11 +19,12 @@ use std::path::{Path, PathBuf};
 
 use serde::{Deserialize, Serialize};
 
-use crate::chain::{run_chain, KerRow};
+use super::StudyError;
+use crate::studies::chain::{run_chain, KerRow};
 use crate::metrics::{metrics, Metrics};
-use crate::model::{Model, ModelError};
-use crate::scene::{self, SceneError};
-use crate::sweep::sweep_scenes;
+use crate::model::Model;
+use crate::scene;
+use crate::studies::sweep::sweep_scenes;
 
 /// What is kept of one run.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -59,29 +60,11 @@ pub struct Row {
     pub ok: bool,
 }
 
-/// A failure to run the check at all.
-#[derive(Debug, thiserror::Error)]
-pub enum CheckError {
-    /// A scene is invalid.
-    #[error(transparent)]
-    Scene(#[from] SceneError),
-    /// A model failed.
-    #[error(transparent)]
-    Model(#[from] ModelError),
-    /// A golden file could not be read or written.
-    #[error("{path}: {message}")]
-    Io {
-        /// Path.
-        path: String,
-        /// Why.
-        message: String,
-    },
-}
 
 /// Runs every case of every scene file in `dir` with every model.
-pub fn current(dir: &Path, models: &[Model]) -> Result<Vec<Golden>, CheckError> {
+pub fn current(dir: &Path, models: &[Model]) -> Result<Vec<Golden>, StudyError> {
     let mut paths: Vec<PathBuf> = std::fs::read_dir(dir)
-        .map_err(|e| CheckError::Io { path: dir.display().to_string(), message: e.to_string() })?
+        .map_err(|e| StudyError::Io { path: dir.display().to_string(), message: e.to_string() })?
         .filter_map(|e| e.ok().map(|e| e.path()))
         .filter(|p| p.extension().is_some_and(|x| x == "toml"))
         .collect();
@@ -122,14 +105,14 @@ pub fn golden_path(golden_dir: &Path, case: &str, model: &str) -> PathBuf {
 }
 
 /// Reads the golden of `g`'s case and model, if any.
-pub fn read_golden(golden_dir: &Path, g: &Golden) -> Result<Option<Golden>, CheckError> {
+pub fn read_golden(golden_dir: &Path, g: &Golden) -> Result<Option<Golden>, StudyError> {
     let path = golden_path(golden_dir, &g.case, &g.model);
     match std::fs::read(&path) {
         Ok(bytes) => serde_json::from_slice(&bytes)
             .map(Some)
-            .map_err(|e| CheckError::Io { path: path.display().to_string(), message: e.to_string() }),
+            .map_err(|e| StudyError::Io { path: path.display().to_string(), message: e.to_string() }),
         Err(e) if e.kind() == std::io::ErrorKind::NotFound => Ok(None),
-        Err(e) => Err(CheckError::Io { path: path.display().to_string(), message: e.to_string() }),
+        Err(e) => Err(StudyError::Io { path: path.display().to_string(), message: e.to_string() }),
     }
 }
 
@@ -189,8 +172,8 @@ pub fn compare(now: &Golden, golden: Option<&Golden>) -> Vec<Row> {
 }
 
 /// Writes `g` as its golden file.
-pub fn write_golden(golden_dir: &Path, g: &Golden) -> Result<(), CheckError> {
+pub fn write_golden(golden_dir: &Path, g: &Golden) -> Result<(), StudyError> {
     let path = golden_path(golden_dir, &g.case, &g.model);
     let bytes = serde_json::to_vec_pretty(g).expect("serialises");
-    crate::output::write_atomic(&path, &bytes).map_err(|e| CheckError::Io { path: path.display().to_string(), message: e.to_string() })
+    crate::output::write_atomic(&path, &bytes).map_err(|e| StudyError::Io { path: path.display().to_string(), message: e.to_string() })
 }
