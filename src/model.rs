@@ -1,32 +1,11 @@
-//! The models behind one interface: anything that turns a [`Scene`] into a [`Run`].
+//! The models behind one interface: [`Model::simulate`] turns a [`Scene`] into a [`Run`]
+//! (the label [`Model`] itself lives with the outputs in `run`, which every model writes).
 
+pub use crate::run::Model;
 use crate::run::Run;
 use crate::scene::Scene;
 
-/// A model of the damper.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
-pub enum Model {
-    /// The exact event-driven impulse solver.
-    Reference,
-    /// Rapier colliders in a headless Bevy app.
-    Rapier,
-    /// Hertz contacts with Hunt-Crossley damping, integrated through every contact.
-    Compliant,
-}
-
 impl Model {
-    /// Every model, in report order.
-    pub const ALL: &'static [Model] = &[Model::Reference, Model::Rapier, Model::Compliant];
-
-    /// Name used on the command line and in outputs.
-    pub fn name(self) -> &'static str {
-        match self {
-            Model::Reference => "reference",
-            Model::Rapier => "rapier",
-            Model::Compliant => "compliant",
-        }
-    }
-
     /// Runs the model on `scene`.
     pub fn simulate(self, scene: &Scene) -> Result<Run, ModelError> {
         match self {
@@ -34,17 +13,6 @@ impl Model {
             Model::Rapier => crate::rapier::simulate(scene),
             Model::Compliant => Ok(crate::compliant::simulate(scene)?),
         }
-    }
-}
-
-impl std::str::FromStr for Model {
-    type Err = String;
-    fn from_str(s: &str) -> Result<Self, String> {
-        Model::ALL
-            .iter()
-            .copied()
-            .find(|m| m.name() == s)
-            .ok_or_else(|| format!("unknown model `{s}`; choose one of {}", Model::ALL.iter().map(|m| m.name()).collect::<Vec<_>>().join(", ")))
     }
 }
 

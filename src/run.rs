@@ -3,6 +3,49 @@
 
 use crate::scene::{Body, Scene};
 
+/// A model of the damper.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord, serde::Serialize, serde::Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Model {
+    /// The exact event-driven impulse solver.
+    Reference,
+    /// Rapier colliders in a headless Bevy app.
+    Rapier,
+    /// Hertz contacts with Hunt-Crossley damping, integrated through every contact.
+    Compliant,
+}
+
+impl Model {
+    /// Every model, in report order.
+    pub const ALL: &'static [Model] = &[Model::Reference, Model::Rapier, Model::Compliant];
+
+    /// Name used on the command line and in outputs.
+    pub fn name(self) -> &'static str {
+        match self {
+            Model::Reference => "reference",
+            Model::Rapier => "rapier",
+            Model::Compliant => "compliant",
+        }
+    }
+}
+
+impl std::fmt::Display for Model {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
+impl std::str::FromStr for Model {
+    type Err = String;
+    fn from_str(s: &str) -> Result<Self, String> {
+        Model::ALL
+            .iter()
+            .copied()
+            .find(|m| m.name() == s)
+            .ok_or_else(|| format!("unknown model `{s}`; choose one of {}", Model::ALL.iter().map(|m| m.name()).collect::<Vec<_>>().join(", ")))
+    }
+}
+
 /// Series sampled every `sample_dt` from `t = 0` to the horizon (inclusive where it falls on a sample).
 #[derive(Debug, Clone, Default, PartialEq)]
 pub struct Series {
@@ -118,7 +161,7 @@ pub struct Run {
     /// Scene name.
     pub scene: String,
     /// Model name (`reference`, `rapier`, ...).
-    pub model: String,
+    pub model: Model,
     /// Simulated time actually covered, s.
     pub horizon: f64,
     /// Output step, s.
@@ -155,10 +198,10 @@ pub fn frame_sampling(fps: f64, sample_dt: f64) -> (f64, usize) {
 impl Run {
     /// A run of nothing: no samples, no impacts, no energy (a stand-in for a refused scene,
     /// or a shell to hold a series read back from a file).
-    pub fn empty(scene: &str, model: &str) -> Self {
+    pub fn empty(scene: &str, model: Model) -> Self {
         Run {
             scene: scene.into(),
-            model: model.into(),
+            model,
             horizon: 0.0,
             sample_dt: 0.0,
             initial_displacement: 0.0,

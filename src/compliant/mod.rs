@@ -796,7 +796,7 @@ impl<'s, 'a> Driver<'s, 'a> {
         let final_velocities = (0..sys.n).map(|i| self.y[sys.v(i)]).collect();
         Ok(Run {
             scene: scene.name.clone(),
-            model: "compliant".into(),
+            model: crate::run::Model::Compliant,
             horizon,
             sample_dt: scene.sample_dt,
             initial_displacement: scene.initial_displacement,

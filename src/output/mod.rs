@@ -57,7 +57,7 @@ pub struct RunSummary {
     /// Scene name.
     pub scene: String,
     /// Model name.
-    pub model: String,
+    pub model: crate::run::Model,
     /// s.
     pub horizon: f64,
     /// Number of impacts.
@@ -80,7 +80,7 @@ impl RunSummary {
     pub fn of(run: &Run) -> Self {
         RunSummary {
             scene: run.scene.clone(),
-            model: run.model.clone(),
+            model: run.model,
             horizon: run.horizon,
             impact_count: run.impacts.len(),
             impacts: run

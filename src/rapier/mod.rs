@@ -176,7 +176,7 @@ pub fn collect(world: &mut World, scene: &Scene, steps: u64) -> Run {
     );
     Run {
         scene: scene.name.clone(),
-        model: "rapier".into(),
+        model: crate::run::Model::Rapier,
         horizon: scene.horizon,
         sample_dt: scene.sample_dt,
         initial_displacement: scene.initial_displacement,

@@ -1524,7 +1524,7 @@ impl<'a> Solver<'a> {
         );
         Run {
             scene: self.scene.name.clone(),
-            model: "reference".into(),
+            model: crate::run::Model::Reference,
             horizon: self.horizon,
             sample_dt: self.scene.sample_dt,
             initial_displacement: self.scene.initial_displacement,

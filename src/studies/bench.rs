@@ -29,7 +29,7 @@ pub struct BenchRow {
     /// Scene name.
     pub scene: String,
     /// Model name.
-    pub model: &'static str,
+    pub model: Model,
     /// The setting.
     pub settings: Settings,
     /// Median computing time per simulated second.
@@ -99,7 +99,7 @@ pub fn bench_scene(scene: &Scene, plan: &Plan, progress: &dyn Fn()) -> Result<Ve
                 let (cost, run) = timed(scene, model)?;
                 rows.push(BenchRow {
                     scene: scene.name.clone(),
-                    model: model.name(),
+                    model,
                     settings: Settings { stepping: "event-driven", dt: None, solver_iterations: None, tolerance: None },
                     wall_s_per_sim_s: cost,
                     errors: errors(&run, &reference),
@@ -121,7 +121,7 @@ pub fn bench_scene(scene: &Scene, plan: &Plan, progress: &dyn Fn()) -> Result<Ve
                     let run = last.expect("at least one run");
                     rows.push(BenchRow {
                         scene: scene.name.clone(),
-                        model: model.name(),
+                        model,
                         settings: Settings { stepping: "adaptive", dt: None, solver_iterations: None, tolerance: Some(tolerance) },
                         wall_s_per_sim_s: median(times) / scene.horizon,
                         errors: errors(&run, &reference),
@@ -139,7 +139,7 @@ pub fn bench_scene(scene: &Scene, plan: &Plan, progress: &dyn Fn()) -> Result<Ve
                             let (cost, run) = timed(&s, model)?;
                             rows.push(BenchRow {
                                 scene: scene.name.clone(),
-                                model: model.name(),
+                                model,
                                 settings: Settings { stepping: stepping.name(), dt: Some(dt), solver_iterations: Some(it), tolerance: None },
                                 wall_s_per_sim_s: cost,
                                 errors: errors(&run, &reference),
@@ -160,7 +160,7 @@ pub fn bench_scene(scene: &Scene, plan: &Plan, progress: &dyn Fn()) -> Result<Ve
 /// Marks the rows that no other setting of the same scene and model dominates in
 /// (cost, early error). (Across models the exact reference would dominate everything.)
 pub fn mark_pareto(rows: &mut [BenchRow]) {
-    let key: Vec<(&str, &str, f64, f64)> =
+    let key: Vec<(&str, Model, f64, f64)> =
         rows.iter().map(|r| (r.scene.as_str(), r.model, r.wall_s_per_sim_s, r.errors.max_xs_early)).collect();
     let front: Vec<bool> = key
         .iter()
@@ -183,7 +183,7 @@ mod tests {
     fn row(cost: f64, err: f64) -> BenchRow {
         BenchRow {
             scene: "s".into(),
-            model: "rapier",
+            model: Model::Rapier,
             settings: Settings { stepping: "fixed", dt: None, solver_iterations: None, tolerance: None },
             wall_s_per_sim_s: cost,
             errors: Errors { rms_xs: 0.0, max_xs_early: err, settling_time_diff: None, impact_loss_diff: 0.0, impact_count_diff: 0 },

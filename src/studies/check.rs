@@ -32,7 +32,7 @@ pub struct Golden {
     /// Case name (scene, sweep value or chain).
     pub case: String,
     /// Model name.
-    pub model: String,
+    pub model: Model,
     /// Impacts.
     pub impact_count: usize,
     /// Headline metrics.
@@ -47,7 +47,7 @@ pub struct Row {
     /// Case name.
     pub case: String,
     /// Model name.
-    pub model: String,
+    pub model: Model,
     /// Metric name.
     pub metric: String,
     /// Golden value (`None`: no golden).
@@ -83,7 +83,7 @@ pub fn current(dir: &Path, models: &[Model]) -> Result<Vec<Golden>, StudyError> 
                 let run = model.simulate(s)?;
                 out.push(Golden {
                     case: s.name.clone(),
-                    model: model.name().into(),
+                    model,
                     impact_count: run.impacts.len(),
                     metrics: Some(metrics(&run)),
                     ker: vec![],
@@ -91,7 +91,7 @@ pub fn current(dir: &Path, models: &[Model]) -> Result<Vec<Golden>, StudyError> 
             }
             if let Some(chain) = &loaded.chain {
                 let name = loaded.file.name.clone().unwrap_or_else(|| "chain".into());
-                out.push(Golden { case: name, model: model.name().into(), impact_count: 0, metrics: None, ker: run_chain(chain, model)? });
+                out.push(Golden { case: name, model, impact_count: 0, metrics: None, ker: run_chain(chain, model)? });
             }
         }
     }
@@ -99,14 +99,14 @@ pub fn current(dir: &Path, models: &[Model]) -> Result<Vec<Golden>, StudyError> 
 }
 
 /// Golden file of one case and model.
-pub fn golden_path(golden_dir: &Path, case: &str, model: &str) -> PathBuf {
+pub fn golden_path(golden_dir: &Path, case: &str, model: Model) -> PathBuf {
     let safe: String = case.chars().map(|c| if c.is_ascii_alphanumeric() || c == '-' || c == '.' { c } else { '_' }).collect();
     golden_dir.join(format!("{safe}.{model}.json"))
 }
 
 /// Reads the golden of `g`'s case and model, if any.
 pub fn read_golden(golden_dir: &Path, g: &Golden) -> Result<Option<Golden>, StudyError> {
-    let path = golden_path(golden_dir, &g.case, &g.model);
+    let path = golden_path(golden_dir, &g.case, g.model);
     match std::fs::read(&path) {
         Ok(bytes) => serde_json::from_slice(&bytes)
             .map(Some)
@@ -117,8 +117,8 @@ pub fn read_golden(golden_dir: &Path, g: &Golden) -> Result<Option<Golden>, Stud
 }
 
 /// Tolerance of one metric for a model: `(relative, absolute)`.
-fn tolerance(model: &str, metric: &str) -> (f64, f64) {
-    if model == "reference" {
+fn tolerance(model: Model, metric: &str) -> (f64, f64) {
+    if model == Model::Reference {
         return if metric == "impact_count" { (0.0, 0.0) } else { (1e-9, 1e-15) };
     }
     match metric {
@@ -156,7 +156,7 @@ pub fn compare(now: &Golden, golden: Option<&Golden>) -> Vec<Row> {
         .enumerate()
         .map(|(i, (metric, value))| {
             let g = golden_values.as_ref().and_then(|gv| gv.get(i).filter(|(m, _)| *m == metric).map(|(_, v)| *v));
-            let (rel, abs) = tolerance(&now.model, &metric);
+            let (rel, abs) = tolerance(now.model, &metric);
             let (golden, ok, tol) = match (g, value) {
                 (None, _) => (None, false, abs),
                 (Some(None), None) => (None, true, abs),
@@ -166,14 +166,14 @@ pub fn compare(now: &Golden, golden: Option<&Golden>) -> Vec<Row> {
                 }
                 (Some(gv), _) => (gv, false, abs),
             };
-            Row { case: now.case.clone(), model: now.model.clone(), metric, golden, now: value, tolerance: tol, ok }
+            Row { case: now.case.clone(), model: now.model, metric, golden, now: value, tolerance: tol, ok }
         })
         .collect()
 }
 
 /// Writes `g` as its golden file.
 pub fn write_golden(golden_dir: &Path, g: &Golden) -> Result<(), StudyError> {
-    let path = golden_path(golden_dir, &g.case, &g.model);
+    let path = golden_path(golden_dir, &g.case, g.model);
     let bytes = serde_json::to_vec_pretty(g).expect("serialises");
     crate::output::write_atomic(&path, &bytes).map_err(|e| StudyError::Io { path: path.display().to_string(), message: e.to_string() })
 }

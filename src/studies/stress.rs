@@ -34,7 +34,7 @@ pub struct Outcome {
     /// Seed of this scene.
     pub seed: u64,
     /// Model.
-    pub model: &'static str,
+    pub model: Model,
     /// `None` when every check passed.
     pub failure: Option<Failure>,
     /// The shrunk scene that still fails, as TOML.
@@ -362,7 +362,7 @@ pub fn stress(model: Model, seed: u64, count: u64, max_horizon: f64, forced: boo
             let minimal_scene =
                 failure.as_ref().map(|f| toml::to_string(&shrink(model, &file, f.check)).unwrap_or_default());
             progress();
-            Outcome { seed: s, model: model.name(), failure, minimal_scene, refused, refused_during_run }
+            Outcome { seed: s, model, failure, minimal_scene, refused, refused_during_run }
         })
         .collect()
 }

@@ -124,7 +124,7 @@ fn frequency_response_of_the_bare_frame_is_its_receptance() {
 #[test]
 fn a_steady_reading_needs_agreeing_blocks() {
     // A decaying response is not steady; a constant sine is, with its amplitude.
-    let mut run = lpc_damper::run::Run::empty("t", "test");
+    let mut run = lpc_damper::run::Run::empty("t", lpc_damper::Model::Reference);
     let period = 0.1;
     run.horizon = 40.0 * period;
     for k in 0..=4000 {

@@ -58,7 +58,7 @@ pub fn run(a: Args) -> Result<ExitStatus> {
     }
     if let Some(dir) = &a.out {
         for run in std::iter::once(&reference).chain(&runs) {
-            let d = dir.join(&run.model);
+            let d = dir.join(run.model.name());
             write_run_dir(run, &d).with_context(|| format!("writing outputs to {}", d.display()))?;
         }
     }

@@ -39,10 +39,10 @@ pub fn run(a: Args) -> Result<ExitStatus> {
         };
         if series(&a.input).is_file() {
             let s = figures::read_series_csv(&series(&a.input))?;
-            let mut run = lpc_damper::run::Run::empty(
-                &name_of(&a.input, "scene").unwrap_or_else(|| "run".into()),
-                &name_of(&a.input, "model").unwrap_or_else(|| "model".into()),
-            );
+            let model = name_of(&a.input, "model").and_then(|m| m.parse::<Model>().ok()).ok_or_else(|| {
+                invalid(&a.input.join("summary.json"), "model", "is missing or names no model (expected a directory of `lpc run --out`)")
+            })?;
+            let mut run = lpc_damper::run::Run::empty(&name_of(&a.input, "scene").unwrap_or_else(|| "run".into()), model);
             run.series = s;
             figs.extend(figures::time_histories(&run, None));
             figs.push(figures::ball_positions(&run, None));

@@ -60,10 +60,10 @@ pub fn run(a: Args) -> Result<ExitStatus> {
                 }
             }
             for &model in &a.models {
-                let total = outcomes.iter().filter(|o| o.model == model.name()).count();
-                let failed = failures.iter().filter(|o| o.model == model.name()).count();
-                let refused = outcomes.iter().filter(|o| o.model == model.name() && o.refused.is_some()).count();
-                let unstable = outcomes.iter().filter(|o| o.model == model.name() && o.refused_during_run).count();
+                let total = outcomes.iter().filter(|o| o.model == model).count();
+                let failed = failures.iter().filter(|o| o.model == model).count();
+                let refused = outcomes.iter().filter(|o| o.model == model && o.refused.is_some()).count();
+                let unstable = outcomes.iter().filter(|o| o.model == model && o.refused_during_run).count();
                 println!(
                     "{}: {} passed ({} of them refused with a reason, {} of those during the run), {} failed",
                     model.name(),
