@@ -1,0 +1,314 @@
+//! State changes at an event: advancing to it, impacts, merges of touching runs, releases, and
+//! the resolution of every contact of one instant.
+
+use super::*;
+
+impl Solver<'_> {
+    pub(super) fn advance(&mut self, t: f64) {
+        let dt = t - self.t;
+        for i in 0..self.n {
+            if self.hold[i] == Hold::Free {
+                let step = self.v[i] * dt;
+                self.x[i] += step;
+                // Every ball moves at every event, so a pair that moves as one (equal
+                // velocities, no event of its own) sees its gap wander by this rounding.
+                self.drift[i] += f64::EPSILON * (self.x[i].abs() + step.abs());
+            }
+        }
+        self.t = t;
+    }
+
+    /// Starts a new frame segment at the current time with velocity `v` and the current load.
+    pub(super) fn set_frame(&mut self, v: f64) {
+        self.book_segment_energy();
+        let (xs, _, _) = self.frame_now();
+        let osc = if self.seg.osc.mass == self.frame_mass + self.held_mass {
+            self.seg.osc
+        } else {
+            Oscillator::new(self.frame_mass + self.held_mass, self.damping, self.stiffness)
+        };
+        self.seg = Segment::new(self.t, xs, v, osc, self.load);
+        self.segment += 1;
+        self.span = self.group_span();
+        self.frame_dirty = true;
+    }
+
+    /// Books what the frame's damper dissipated, and the excitation put in, over the current
+    /// segment up to now: closed form when free; when forced, Gauss-Legendre on pieces of a
+    /// sixteenth of the shorter period (exact to round-off, see [`gauss_legendre`]).
+    pub(super) fn book_segment_energy(&mut self) {
+        let tau = self.t - self.seg.t0;
+        let Some(f) = self.seg.forced else {
+            self.damping_loss += self.seg.osc.dissipated(self.seg.x0, self.seg.v0, tau);
+            return;
+        };
+        let seg = self.seg;
+        let scene = self.scene;
+        let [damping, work] = gauss_legendre(seg.t0, self.t, f.scan, |t| {
+            let (xs, vs) = seg.state(t);
+            [scene.damping_power(t, vs), scene.forcing_power(t, xs, vs)]
+        });
+        self.damping_loss += damping;
+        self.forcing_work += work;
+    }
+
+    pub(super) fn touch_ball(&mut self, i: usize) {
+        self.dirty[i] = true;
+        self.dirty[i + 1] = true;
+    }
+
+    pub(super) fn record(&mut self, p: usize, approach_speed: f64, energy_lost: f64, impulses: u32) {
+        let (a, b) = self.pair_bodies(p);
+        self.fastest = self.fastest.max(approach_speed);
+        self.impact_loss += energy_lost;
+        // Sequential impulses across one pair at one instant are one impact of that pair.
+        if let Some(k) = self.last_impact[p] {
+            let last = &mut self.impacts[k];
+            if last.t == self.t {
+                last.energy_lost += energy_lost;
+                last.impulses += impulses;
+                return;
+            }
+        }
+        self.last_impact[p] = Some(self.impacts.len());
+        self.impacts.push(Impact { t: self.t, a, b, approach_speed, energy_lost, impulses, peak_force: None, contact_duration: None });
+    }
+
+    /// An impact with restitution `e` across pair `p`.
+    pub(super) fn collide(&mut self, p: usize, approach_speed: f64) {
+        match self.gap(p) {
+            Gap::Fixed => {}
+            Gap::Linear { .. } => {
+                let (i, j) = (p - 1, p);
+                let (vi, vj, lost) = impact_law(self.mass[i], self.v[i], self.mass[j], self.v[j], self.e);
+                self.v[i] = vi;
+                self.v[j] = vj;
+                self.touch_ball(i);
+                self.touch_ball(j);
+                self.record(p, approach_speed, lost, 1);
+            }
+            Gap::Frame { ball, .. } => {
+                let (_, vs, _) = self.frame_now();
+                let group = self.frame_mass + self.held_mass;
+                let (vb, vf, lost) = impact_law(self.mass[ball], self.v[ball], group, vs, self.e);
+                self.v[ball] = vb;
+                self.touch_ball(ball);
+                self.set_frame(vf);
+                self.record(p, approach_speed, lost, 1);
+            }
+        }
+    }
+
+    /// Is pair `p` touching and slow enough (relative speed below `v_stick`) to move as one?
+    pub(super) fn stuck_pair(&self, p: usize) -> bool {
+        self.pair_now(p).is_some_and(|q| q.g <= q.tol && q.rate.abs() < self.v_stick)
+    }
+
+    /// Perfectly inelastic merge of the run of touching slow bodies around pair `p`; a run that
+    /// reaches the frame is held by it.
+    pub(super) fn merge_run(&mut self, p: usize, approach_speed: f64) {
+        let range = self.pair_range();
+        let (mut lo, mut hi) = (p, p);
+        // Extend across pairs of free balls only: the frame's group is one body already.
+        while lo > range.start && self.left_body_free(lo) && self.stuck_pair(lo - 1) {
+            lo -= 1;
+        }
+        while hi + 1 < range.end && self.right_body_free(hi) && self.stuck_pair(hi + 1) {
+            hi += 1;
+        }
+        // The run holds bodies lo-1 ..= hi (body -1 and body n being the walls).
+        let reaches_left = lo == 0 || self.hold[lo - 1] != Hold::Free;
+        let reaches_right = hi == self.n || self.hold[hi] != Hold::Free;
+        let with_frame = self.has_frame() && self.walls && (reaches_left || reaches_right);
+        let balls: Vec<usize> =
+            (lo.saturating_sub(1)..(hi + 1).min(self.n)).filter(|&i| self.hold[i] == Hold::Free).collect();
+        let (_, vs, _) = self.frame_now();
+        let group = self.frame_mass + self.held_mass;
+        let (mut pm, mut m) = (0.0, 0.0);
+        for &i in &balls {
+            pm += self.mass[i] * self.v[i];
+            m += self.mass[i];
+        }
+        if with_frame {
+            pm += group * vs;
+            m += group;
+        }
+        let vc = pm / m;
+        let mut lost = 0.0;
+        for &i in &balls {
+            lost += 0.5 * self.mass[i] * (self.v[i] - vc).powi(2);
+            self.v[i] = vc;
+            self.touch_ball(i);
+        }
+        if with_frame {
+            lost += 0.5 * group * (vs - vc).powi(2);
+            let (xs, _, _) = self.frame_now();
+            let side = if reaches_left { Hold::Left } else { Hold::Right };
+            for &i in &balls {
+                self.hold[i] = side;
+                self.offset[i] = self.x[i] - xs;
+                self.held_mass += self.mass[i];
+            }
+            if reaches_left && reaches_right {
+                self.packed = true;
+            }
+            self.set_frame(vc);
+        }
+        self.record(p, approach_speed, lost, balls.len() as u32 + with_frame as u32);
+    }
+
+    pub(super) fn left_body_free(&self, p: usize) -> bool {
+        p >= 1 && self.hold[p - 1] == Hold::Free
+    }
+    pub(super) fn right_body_free(&self, p: usize) -> bool {
+        p < self.n && self.hold[p] == Hold::Free
+    }
+
+    /// Releases the held runs whose wall would now pull on them.
+    pub(super) fn release(&mut self) -> bool {
+        if self.held_mass == 0.0 || self.packed {
+            return false;
+        }
+        let (xs, vs, a) = self.frame_now();
+        let mut released = false;
+        for i in 0..self.n {
+            let pulled = match self.hold[i] {
+                Hold::Left => a < 0.0,
+                Hold::Right => a > 0.0,
+                Hold::Free => false,
+            };
+            if pulled {
+                self.hold[i] = Hold::Free;
+                self.x[i] = xs + self.offset[i];
+                self.drift[i] += f64::EPSILON * self.x[i].abs();
+                self.v[i] = vs;
+                self.held_mass -= self.mass[i];
+                self.touch_ball(i);
+                released = true;
+            }
+        }
+        if released {
+            if self.hold.iter().all(|h| *h == Hold::Free) {
+                self.held_mass = 0.0; // no round-off residue
+            }
+            self.set_frame(vs);
+        }
+        released
+    }
+
+    /// What `resolve` needs of pair `p` now: the speed at which it approaches when it touches
+    /// (`None` when it does not touch, does not approach, or drifts off a wall that
+    /// accelerates away, see [`Solver::reopens`]), and whether the frame presses it together.
+    pub(super) fn contact_now(&self, p: usize) -> Contact {
+        let Some(PairNow { g, rate, tol, curvature }) = self.pair_now(p) else {
+            return Contact { approach: None, pressed: false, frame: false };
+        };
+        let frame = curvature.is_some();
+        if g > tol {
+            return Contact { approach: None, pressed: false, frame };
+        }
+        let drifting_off = curvature.is_some_and(|c| self.reopens(rate, c));
+        Contact {
+            approach: (rate < 0.0 && !drifting_off).then_some(-rate),
+            pressed: curvature.is_some_and(|c| c < 0.0) && rate < self.v_stick,
+            frame,
+        }
+    }
+
+    /// Resolves everything that happens at the current instant: impacts of touching
+    /// approaching pairs (fastest first), merges of slow ones, holds and releases.
+    ///
+    /// A cascade at one instant can take thousands of impulses (a light ball between heavy
+    /// ones), so each pass re-reads only the pairs its last impulse changed: the pair's
+    /// neighbours, and every ball-frame pair when the frame's velocity changed.
+    pub(super) fn resolve(&mut self) -> Result<(), ReferenceError> {
+        let range = self.pair_range();
+        let mut contacts = std::mem::take(&mut self.contacts);
+        contacts.clear();
+        contacts.resize(self.n + 1, Contact { approach: None, pressed: false, frame: false });
+        let mut impulses = 0usize;
+        // Pairs to re-read: all, or the neighbours of `changed` (and the frame's pairs).
+        let mut all = true;
+        let mut changed = (0usize, false);
+        // Each pass changes the state (an impulse, a merge or a release); more passes than the
+        // impulse cap allows plus a few per body means two judgements disagree and would
+        // cycle: a stall to report, not a hang.
+        let most_passes = MAX_IMPULSES_PER_INSTANT + 8 * (self.n + 1);
+        for _ in 0..most_passes {
+            if all {
+                for p in range.clone() {
+                    contacts[p] = self.contact_now(p);
+                }
+            } else {
+                let (p, frame) = changed;
+                for q in p.saturating_sub(1)..=p + 1 {
+                    if range.contains(&q) {
+                        contacts[q] = self.contact_now(q);
+                    }
+                }
+                if frame {
+                    for q in range.clone() {
+                        if contacts[q].frame {
+                            contacts[q] = self.contact_now(q);
+                        }
+                    }
+                }
+            }
+            let mut fastest: Option<(usize, f64)> = None;
+            let mut pressed: Option<usize> = None;
+            for p in range.clone() {
+                let c = contacts[p];
+                if let Some(u) = c.approach {
+                    if fastest.is_none_or(|(_, v)| u > v) {
+                        fastest = Some((p, u));
+                    }
+                }
+                if c.pressed && pressed.is_none() {
+                    pressed = Some(p);
+                }
+            }
+            all = true;
+            if let Some((p, u)) = fastest {
+                let bounce_returns_fast = match self.gap(p) {
+                    Gap::Frame { s, .. } => {
+                        let a = -s * self.frame_now().2;
+                        a < 0.0 && 2.0 * self.e * u / -a < self.t_stick
+                    }
+                    _ => false,
+                };
+                // With e = 0 a touching approaching run ends as one body: merge it at once
+                // instead of converging to that through a geometric series of impulses.
+                // A pair striking again within a contact duration is in persistent contact.
+                let repeats_within_contact = self.last_impact[p]
+                    .is_some_and(|k| self.impacts[k].t < self.t && self.t - self.impacts[k].t < CONTACT_DURATION);
+                if self.e > 0.0
+                    && u >= self.v_stick
+                    && !bounce_returns_fast
+                    && !repeats_within_contact
+                    && impulses < MAX_IMPULSES_PER_INSTANT
+                {
+                    self.collide(p, u);
+                    impulses += 1;
+                    (all, changed) = (false, (p, contacts[p].frame));
+                } else {
+                    self.merge_run(p, u);
+                }
+                continue;
+            }
+            if let Some(p) = pressed {
+                self.merge_run(p, 0.0);
+                continue;
+            }
+            if !self.release() {
+                self.contacts = contacts;
+                return Ok(());
+            }
+        }
+        Err(ReferenceError::Stalled {
+            scene: self.scene.name.clone(),
+            events: self.events,
+            t: self.t,
+            why: format!("{most_passes} impacts, merges and releases at one instant did not settle"),
+        })
+    }
+}

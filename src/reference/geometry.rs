@@ -1,0 +1,224 @@
+//! Where the bodies are relative to each other now: gaps, their rates and tolerances, and the
+//! contact invariant checked after every event.
+
+use super::*;
+
+/// A pair's gap now (see [`Solver::pair_now`]).
+#[derive(Debug, Clone, Copy)]
+pub(super) struct PairNow {
+    pub(super) g: f64,
+    pub(super) rate: f64,
+    pub(super) tol: f64,
+    pub(super) curvature: Option<f64>,
+}
+
+/// A pair at the current instant, as `resolve` judges it (see [`Solver::contact_now`]).
+#[derive(Debug, Clone, Copy)]
+pub(super) struct Contact {
+    pub(super) approach: Option<f64>,
+    pub(super) pressed: bool,
+    pub(super) frame: bool,
+}
+
+/// The frame at the current instant (see [`Solver::frame_now`]).
+#[derive(Debug, Clone, Copy)]
+pub(super) struct FrameNow {
+    pub(super) segment: u64,
+    pub(super) t: f64,
+    pub(super) xs: f64,
+    pub(super) vs: f64,
+    pub(super) accel_ahead: f64,
+}
+
+/// The gap of a pair as a function of time.
+#[derive(Debug, Clone, Copy)]
+pub(super) enum Gap {
+    /// Both sides move with the frame: the gap never changes.
+    Fixed,
+    /// Two free balls: `g(t) = g + rate (t - t_now)`.
+    Linear { g: f64, rate: f64 },
+    /// A free ball `ball` against the frame: `g(t) = s (x_ball(t) - xs(t)) + k`.
+    Frame { ball: usize, s: f64, k: f64 },
+}
+
+impl Solver<'_> {
+    pub(super) fn gap(&self, p: usize) -> Gap {
+        // Right edge of the left body and left edge of the right body: either a free ball's
+        // (`Ok((ball, edge offset))`) or the frame's (`Err(offset from xs)`).
+        let left = if p == 0 {
+            Err(0.0)
+        } else {
+            let i = p - 1;
+            if self.hold[i] == Hold::Free {
+                Ok((i, self.radius[i]))
+            } else {
+                Err(self.offset[i] + self.radius[i])
+            }
+        };
+        let right = if p == self.n {
+            Err(self.length)
+        } else if self.hold[p] == Hold::Free {
+            Ok((p, -self.radius[p]))
+        } else {
+            Err(self.offset[p] - self.radius[p])
+        };
+        match (left, right) {
+            (Err(_), Err(_)) => Gap::Fixed,
+            (Ok((i, ri)), Ok((j, rj))) => {
+                Gap::Linear { g: (self.x[j] + rj) - (self.x[i] + ri), rate: self.v[j] - self.v[i] }
+            }
+            (Err(c), Ok((j, rj))) => Gap::Frame { ball: j, s: 1.0, k: rj - c },
+            (Ok((i, ri)), Err(c)) => Gap::Frame { ball: i, s: -1.0, k: c - ri },
+        }
+    }
+
+    /// Gap and its rate for a ball-frame pair at time `t` (the ball flies from `self.t`).
+    #[inline]
+    pub(super) fn frame_gap_at(&self, ball: usize, s: f64, k: f64, t: f64) -> (f64, f64) {
+        let (xs, vs) = self.seg.state(t);
+        let xb = self.x[ball] + self.v[ball] * (t - self.t);
+        (s * (xb - xs) + k, s * (self.v[ball] - vs))
+    }
+
+    /// A ball-frame pair's gap, its rate and its contact tolerance at `t`: the length
+    /// tolerance plus what the gap's value can err by (the rounding accumulated in the ball's
+    /// position, the round-off of the frame's closed form and of the gap's sum, and two ulps
+    /// of time at the gap's rate or the fastest speed of the run so far, whichever is faster: a
+    /// contact taken at that speed is placed no closer, and bodies that then move together
+    /// keep that overlap). The reference
+    /// takes no contact below minus this, and its postcondition checks it (docs/MODEL.md).
+    pub(super) fn frame_gap_tolerance(&self, ball: usize, s: f64, k: f64, t: f64) -> (f64, f64, f64) {
+        let (xs, vs) = self.seg.state(t);
+        let xb = self.x[ball] + self.v[ball] * (t - self.t);
+        let rate = s * (self.v[ball] - vs);
+        (s * (xb - xs) + k, rate, self.frame_tolerance(ball, t, xb, xs, k, rate))
+    }
+
+    /// The contact tolerance of a ball-frame gap `s (xb - xs) + k` of rate `rate` at `t` (see
+    /// [`Solver::frame_gap_tolerance`]).
+    pub(super) fn frame_tolerance(&self, ball: usize, t: f64, xb: f64, xs: f64, k: f64, rate: f64) -> f64 {
+        let eps = f64::EPSILON;
+        self.tol
+            + self.drift[ball]
+            + self.seg.position_roundoff(t)
+            + 4.0 * eps * (xb.abs() + xs.abs() + k.abs())
+            + 2.0 * eps * t.abs() * rate.abs().max(self.fastest)
+    }
+
+    /// The contact tolerance of ball-ball pair `p` of rate `rate` now (see
+    /// [`Solver::frame_gap_tolerance`]).
+    pub(super) fn ball_gap_tolerance(&self, p: usize, rate: f64) -> f64 {
+        let (i, j) = (p - 1, p);
+        let eps = f64::EPSILON;
+        self.tol
+            + self.drift[i]
+            + self.drift[j]
+            + 4.0 * eps * (self.x[i].abs() + self.x[j].abs() + self.radius[i] + self.radius[j])
+            + 2.0 * eps * self.t.abs() * rate.abs().max(self.fastest)
+    }
+
+    /// Pair `p` now: its gap, the gap's rate, its contact tolerance and, for a ball-frame
+    /// pair, the gap's curvature (positive when the wall accelerates away from the ball);
+    /// `None` for a pair that moves as one body.
+    pub(super) fn pair_now(&self, p: usize) -> Option<PairNow> {
+        match self.gap(p) {
+            Gap::Fixed => None,
+            Gap::Linear { g, rate } => Some(PairNow { g, rate, tol: self.ball_gap_tolerance(p, rate), curvature: None }),
+            Gap::Frame { ball, s, k } => {
+                let (xs, vs, a) = self.frame_now();
+                let xb = self.x[ball];
+                let rate = s * (self.v[ball] - vs);
+                let tol = self.frame_tolerance(ball, self.t, xb, xs, k, rate);
+                Some(PairNow { g: s * (xb - xs) + k, rate, tol, curvature: Some(-s * a) })
+            }
+        }
+    }
+
+    /// The postcondition of every event (docs/MODEL.md §10): the pair whose contact triggered
+    /// it touches, and no pair overlaps, within the contact tolerance. An overlap accepted at a
+    /// contact moves on with bodies that move together (held, merged, released), under a
+    /// tolerance that may then be smaller (a held ball's gap carries the frame's round-off, a
+    /// free pair's does not), so no pair may overlap by more than the largest tolerance a
+    /// touching pair has had so far. A violation means a contact was missed or mistimed: an
+    /// error naming the scene, the time and the pair, never a silent wrong run.
+    pub(super) fn check_contacts(&mut self, trigger: Option<usize>) -> Result<(), ReferenceError> {
+        for p in self.pair_range() {
+            let Some(PairNow { g, tol, .. }) = self.pair_now(p) else { continue };
+            if g.abs() <= tol {
+                self.accepted_overlap = self.accepted_overlap.max(tol);
+            }
+            let apart = trigger == Some(p) && g > tol;
+            let allowed = tol.max(self.accepted_overlap);
+            if g < -allowed || apart {
+                let (a, b) = self.pair_bodies(p);
+                return Err(ReferenceError::ContactInvariant {
+                    scene: self.scene.name.clone(),
+                    t: self.t,
+                    pair: format!("{} / {}", Scene::body_name(a), Scene::body_name(b)),
+                    broken: if apart { "are apart at their contact" } else { "overlap" },
+                    by: g.abs(),
+                    tolerance: if apart { tol } else { allowed },
+                });
+            }
+        }
+        Ok(())
+    }
+
+    /// The bodies either side of pair `p`.
+    pub(super) fn pair_bodies(&self, p: usize) -> (Body, Body) {
+        (if p == 0 { Body::LeftWall } else { Body::Ball(p - 1) }, if p == self.n { Body::RightWall } else { Body::Ball(p) })
+    }
+
+    /// The frame's position, velocity and acceleration ahead ([`Solver::accel_ahead`]) now.
+    pub(super) fn frame_now(&self) -> (f64, f64, f64) {
+        if let Some(n) = self.now.get() {
+            if n.segment == self.segment && n.t == self.t {
+                return (n.xs, n.vs, n.accel_ahead);
+            }
+        }
+        let (xs, vs) = self.seg.state(self.t);
+        let accel_ahead = self.accel_ahead(self.t);
+        self.now.set(Some(FrameNow { segment: self.segment, t: self.t, xs, vs, accel_ahead }));
+        (xs, vs, accel_ahead)
+    }
+
+    /// The frame's acceleration just after `t`: its value, with the sign of the first
+    /// derivative that is not round-off when the acceleration itself is (at a sign change).
+    /// Every sign involved is that of `-(c v + k x)` and its derivatives, whatever the mass
+    /// the frame carries, so holding and releasing a ball always agree.
+    pub(super) fn accel_ahead(&self, t: f64) -> f64 {
+        if let Some(f) = &self.seg.forced {
+            let [(a, sa), (jerk, sj), (snap, _)] = self.seg.forced_derivatives(f, t);
+            if a.abs() > ROUNDOFF_RELATIVE * sa {
+                return a;
+            }
+            let sign = if jerk.abs() > ROUNDOFF_RELATIVE * sj {
+                jerk.signum()
+            } else if snap == 0.0 {
+                return 0.0;
+            } else {
+                snap.signum()
+            };
+            return sign * a.abs().max(f64::MIN_POSITIVE);
+        }
+        let (x, v) = self.seg.state(t);
+        let o = &self.seg.osc;
+        let a = o.accel(x, v);
+        // Scales of a and its derivative over the motion (w0 |v| matters where x passes 0).
+        let rate = 2.0 * o.sigma + o.w0sq.sqrt();
+        if a.abs() > ROUNDOFF_RELATIVE * (o.w0sq * x.abs() + rate * v.abs()) {
+            return a;
+        }
+        let jerk = -2.0 * o.sigma * a - o.w0sq * v;
+        let sign = if jerk.abs() > ROUNDOFF_RELATIVE * (rate * a.abs() + o.w0sq * v.abs()) {
+            jerk.signum()
+        } else {
+            let snap = -2.0 * o.sigma * jerk - o.w0sq * a;
+            if snap == 0.0 {
+                return 0.0;
+            }
+            snap.signum()
+        };
+        sign * a.abs().max(f64::MIN_POSITIVE)
+    }
+}
