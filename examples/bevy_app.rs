@@ -5,8 +5,7 @@
 //! `cargo run --release --example bevy_app [SCENE]` (default `scenes/lpc-lsl.toml`).
 
 use bevy::prelude::*;
-use lpc_damper::rapier::plugin::{FrameState, StepClock};
-use lpc_damper::rapier::{settings, DamperSet, LpcDamperPlugins};
+use lpc_damper::rapier::{settings, DamperSet, FrameState, LpcDamperPlugins, StepClock};
 
 /// What the app's own system collects: the frame's displacement every tenth of a second.
 #[derive(Resource, Default)]

@@ -16,6 +16,7 @@
 pub mod hooks;
 pub mod plugin;
 pub mod record;
+pub mod resources;
 pub mod stepping;
 
 use std::time::Instant;
@@ -25,7 +26,8 @@ use bevy::prelude::*;
 use crate::model::ModelError;
 use crate::run::{EnergyAccount, Run};
 use crate::scene::{Body, Scene};
-pub use plugin::{DamperSet, LpcDamperPlugins, StepSettings};
+pub use plugin::{DamperSet, DamperStep, LpcDamperPlugins};
+pub use resources::{Bodies, DamperScene, FrameState, Recording, StepClock, StepPlan, StepSettings};
 pub use crate::scene::Stepping;
 
 /// Default stepping (from the accuracy study in docs/BENCHMARKS.md).
@@ -41,7 +43,7 @@ pub const STEPS_PER_FRAME_PERIOD: f64 = 40.0;
 
 /// Rapier's allowed contact overlap (`0.005 length_unit`), m: what a contact may sink before
 /// Rapier corrects it.
-pub const ALLOWED_OVERLAP: f64 = 0.005 * plugin::LENGTH_UNIT as f64;
+pub const ALLOWED_OVERLAP: f64 = 0.005 * resources::LENGTH_UNIT as f64;
 /// Energy a step's contacts may gain, relative to the energy put in (f32 velocities, one
 /// rounding per impulse): beyond it the run stops as unstable.
 pub const ENERGY_GAIN_TOLERANCE: f64 = 1e-3;
@@ -144,16 +146,16 @@ pub fn simulate_with(scene: &Scene, settings: StepSettings) -> Result<Run, Model
     // first step; the rest run the lean step schedule alone.
     app.update();
     let world = app.world_mut();
-    while world.resource::<plugin::StepClock>().t < scene.horizon * (1.0 - 1e-12) {
-        world.run_schedule(plugin::DamperStep);
-        if let Some(reason) = world.resource::<record::Recording>().failure.clone() {
+    while world.resource::<StepClock>().t < scene.horizon * (1.0 - 1e-12) {
+        world.run_schedule(DamperStep);
+        if let Some(reason) = world.resource::<Recording>().failure.clone() {
             return Err(ModelError::Unstable(format!(
                 "scene `{}`: the contact model stopped: {reason}; the reference and compliant models can run it",
                 scene.name
             )));
         }
     }
-    let steps = app.world().resource::<plugin::StepClock>().steps;
+    let steps = app.world().resource::<StepClock>().steps;
     let mut run = collect(app.world_mut(), scene, steps);
     run.wall_time_s = start.elapsed().as_secs_f64();
     Ok(run)
@@ -161,8 +163,8 @@ pub fn simulate_with(scene: &Scene, settings: StepSettings) -> Result<Run, Model
 
 /// The [`Run`] recorded in `world`.
 pub fn collect(world: &mut World, scene: &Scene, steps: u64) -> Run {
-    let rec = world.remove_resource::<record::Recording>().expect("recording");
-    let frame = world.get_resource::<plugin::FrameState>().copied();
+    let rec = world.remove_resource::<Recording>().expect("recording");
+    let frame = world.get_resource::<FrameState>().copied();
     let (xs, vs) = frame.map_or((0.0, 0.0), |f| f.now);
     let f = scene.frame;
     let final_ = scene.frame_energy(scene.horizon, xs, vs)

@@ -1,6 +1,7 @@
 //! The Bevy plug-in group: spawns a scene as Rapier bodies, drives the kinematic spring-damped
 //! frame, feeds impacts back into it and records what happened. Each small plug-in owns its
-//! systems and resources; [`DamperSet`] orders them around Rapier's [`PhysicsSet`].
+//! systems; the resources they share are in `resources`; [`DamperSchedulePlugin`] states the
+//! order of a step once, for the lean [`DamperStep`] schedule and for Bevy's main schedules.
 
 use bevy::app::PluginGroupBuilder;
 use bevy::prelude::*;
@@ -8,89 +9,11 @@ use bevy_rapier3d::prelude::*;
 use bevy_rapier3d::rapier::dynamics::IntegrationParameters;
 
 use super::hooks::{ContactRole, RestitutionConfig, RestitutionHooks};
-use super::record::{feedback, record_samples, Recording};
-use super::stepping::{plan_step, StepPlan};
-use crate::scene::Stepping;
+use super::record::{feedback, record_samples};
+use super::resources::*;
+use super::stepping::plan_step;
 use crate::oscillator::{gauss_legendre, Driven, Oscillator};
 use crate::scene::Scene;
-
-/// Rapier's length unit: the balls are centimetres, so are the tolerances.
-pub const LENGTH_UNIT: f32 = 0.01;
-
-/// How the contact model steps.
-#[derive(Resource, Debug, Clone, Copy, PartialEq)]
-pub struct StepSettings {
-    /// How steps are chosen.
-    pub stepping: Stepping,
-    /// Physics step (the longest one with aligned stepping), s.
-    pub dt: f64,
-    /// Rapier solver iterations per step.
-    pub solver_iterations: usize,
-    /// Rapier's swept CCD on the balls.
-    pub ccd: bool,
-    /// Contacts are predicted as far ahead as the scene's speed scale carries a ball in two
-    /// steps (the plug-in's choice), rather than Rapier's fixed 0.02 length units (only the
-    /// stability map turns this off, to show why it is needed).
-    pub speculative_margin: bool,
-    /// Stop with [`crate::model::ModelError::Unstable`] when a ball is pushed through a wall or
-    /// contacts gain energy, rather than return a wrong run (only the stability map turns this
-    /// off, to measure the raw behaviour).
-    pub self_check: bool,
-}
-
-impl StepSettings {
-    /// Fixed steps of `dt` with the plug-in's other defaults.
-    pub fn fixed(dt: f64, solver_iterations: usize) -> Self {
-        StepSettings { stepping: Stepping::Fixed, dt, solver_iterations, ccd: false, speculative_margin: true, self_check: true }
-    }
-}
-
-/// The scene being simulated.
-#[derive(Resource, Debug, Clone)]
-pub struct DamperScene(pub Scene);
-
-/// Entities of the scene, balls left to right.
-#[derive(Resource, Debug, Clone, Default)]
-pub struct Bodies {
-    /// The kinematic frame carrying the walls.
-    pub frame: Option<Entity>,
-    /// Left and right wall colliders.
-    pub walls: Option<(Entity, Entity)>,
-    /// Ball bodies (each is its own collider).
-    pub balls: Vec<Entity>,
-}
-
-/// Marks the frame's kinematic body.
-#[derive(Component, Debug)]
-pub struct FrameBody;
-
-/// The frame's exact state (f64), advanced in closed form; impacts arrive as velocity jumps.
-#[derive(Resource, Debug, Clone, Copy)]
-pub struct FrameState {
-    /// The bare frame's oscillator, with the scene's harmonic load.
-    pub motion: Driven,
-    /// Time at the start of the current step, s.
-    pub t_start: f64,
-    /// Displacement and velocity at the start of the current step.
-    pub start: (f64, f64),
-    /// Displacement and velocity at the end of the step, before the impact impulses.
-    pub before_impulses: (f64, f64),
-    /// Displacement and velocity now (end of the last step, impulses included).
-    pub now: (f64, f64),
-    /// Energy dissipated by `cs` so far, J.
-    pub damping_loss: f64,
-    /// Work done by the excitation so far, J.
-    pub forcing_work: f64,
-}
-
-/// Steps taken so far and the simulated time they cover.
-#[derive(Resource, Debug, Clone, Copy, Default)]
-pub struct StepClock {
-    /// Steps taken.
-    pub steps: u64,
-    /// Time at the end of the last step, s.
-    pub t: f64,
-}
 
 /// A lean schedule holding one physics step and nothing else: the plug-in's systems and
 /// Rapier's step, without Bevy's main schedule or bevy_rapier's ECS synchronisation
@@ -100,13 +23,17 @@ pub struct StepClock {
 #[derive(bevy::ecs::schedule::ScheduleLabel, Debug, Clone, PartialEq, Eq, Hash)]
 pub struct DamperStep;
 
-/// Ordering of the plug-in's systems within one physics step.
+/// The phases of one physics step, in order. [`DamperSchedulePlugin`] configures the order
+/// once, for the lean [`DamperStep`] schedule and for Bevy's main schedules.
 #[derive(SystemSet, Debug, Clone, Copy, PartialEq, Eq, Hash)]
 pub enum DamperSet {
     /// Before the Rapier step: choose its length.
     Plan,
     /// Before the Rapier step: move the kinematic frame to where the oscillator will be.
     DriveFrame,
+    /// Rapier's step (in [`DamperStep`]; in the main schedules bevy_rapier's own
+    /// [`PhysicsSet`]s run it in `PostUpdate`).
+    Step,
     /// After the step: measure the balls' velocity jumps and feed the impulse to the frame.
     Feedback,
     /// After the feedback: write samples.
@@ -124,6 +51,7 @@ pub struct LpcDamperPlugins {
 impl PluginGroup for LpcDamperPlugins {
     fn build(self) -> PluginGroupBuilder {
         PluginGroupBuilder::start::<Self>()
+            .add(DamperSchedulePlugin)
             .add(ContactPhysicsPlugin { scene: self.scene.clone(), settings: self.settings })
             .add(SceneSpawnPlugin { scene: self.scene.clone() })
             .add(FramePlugin)
@@ -131,7 +59,24 @@ impl PluginGroup for LpcDamperPlugins {
     }
 }
 
-/// Rapier with fixed steps, centimetre tolerances, no gravity and the restitution hook.
+/// The order of a step's phases, stated once: [`DamperSet`] chained in the lean [`DamperStep`]
+/// schedule, and around bevy_rapier's [`PhysicsSet`]s in the main schedules (plan and drive in
+/// `Update`, before `PostUpdate` where Rapier steps; feedback and recording after its
+/// writeback). Each plug-in below only puts its own systems into its sets, in both.
+pub struct DamperSchedulePlugin;
+
+impl Plugin for DamperSchedulePlugin {
+    fn build(&self, app: &mut App) {
+        use DamperSet::*;
+        app.init_schedule(DamperStep)
+            .configure_sets(DamperStep, (Plan, DriveFrame, Step, Feedback, Record).chain())
+            .configure_sets(Update, (Plan, DriveFrame).chain())
+            .configure_sets(PostUpdate, (Feedback, Record).chain().after(PhysicsSet::Writeback));
+    }
+}
+
+/// Rapier with fixed steps, centimetre tolerances, no gravity and the restitution hook; it
+/// plans each step and takes it.
 pub struct ContactPhysicsPlugin {
     /// For the speed scale of the prediction distance and the frame mass of the hook.
     pub scene: Scene,
@@ -154,21 +99,12 @@ impl Plugin for ContactPhysicsPlugin {
             ))
             .insert_resource(StepPlan { h: self.settings.dt, horizon: self.scene.horizon })
             .add_systems(Update, plan_step.in_set(DamperSet::Plan))
-            .configure_sets(Update, (DamperSet::Plan, DamperSet::DriveFrame).chain())
-            .configure_sets(
-                PostUpdate,
-                (DamperSet::Feedback, DamperSet::Record).chain().after(PhysicsSet::Writeback),
-            )
             .add_systems(
                 DamperStep,
                 (
-                    plan_step,
-                    drive_frame,
-                    bevy_rapier3d::plugin::systems::step_simulation::<RestitutionHooks>,
-                    feedback,
-                    record_samples,
-                )
-                    .chain(),
+                    plan_step.in_set(DamperSet::Plan),
+                    bevy_rapier3d::plugin::systems::step_simulation::<RestitutionHooks>.in_set(DamperSet::Step),
+                ),
             );
     }
 }
@@ -191,13 +127,6 @@ pub fn integration_parameters(scene: &Scene, settings: StepSettings) -> Integrat
         normalized_max_linear_velocity: f32::MAX,
         ..IntegrationParameters::default()
     }
-}
-
-/// The fastest speed the scene is expected to reach: the frame's initial peak speed and the
-/// balls' initial speeds, doubled for what impacts can add.
-pub fn speed_scale(scene: &Scene) -> f64 {
-    let frame = scene.frame.map_or(0.0, |f| (f.stiffness / f.mass).sqrt() * scene.initial_displacement.abs());
-    2.0 * scene.initial_velocities.iter().fold(frame, |m, v| m.max(v.abs()))
 }
 
 /// Spawns the frame (a kinematic body carrying both walls) and the balls.
@@ -276,7 +205,9 @@ pub struct FramePlugin;
 
 impl Plugin for FramePlugin {
     fn build(&self, app: &mut App) {
-        app.add_systems(Startup, init_frame).add_systems(Update, drive_frame.in_set(DamperSet::DriveFrame));
+        app.add_systems(Startup, init_frame)
+            .add_systems(Update, drive_frame.in_set(DamperSet::DriveFrame))
+            .add_systems(DamperStep, drive_frame.in_set(DamperSet::DriveFrame));
     }
 }
 
@@ -337,7 +268,8 @@ pub struct RecordPlugin;
 impl Plugin for RecordPlugin {
     fn build(&self, app: &mut App) {
         app.add_systems(Startup, init_recording)
-            .add_systems(PostUpdate, (feedback.in_set(DamperSet::Feedback), record_samples.in_set(DamperSet::Record)));
+            .add_systems(PostUpdate, (feedback.in_set(DamperSet::Feedback), record_samples.in_set(DamperSet::Record)))
+            .add_systems(DamperStep, (feedback.in_set(DamperSet::Feedback), record_samples.in_set(DamperSet::Record)));
     }
 }
 

@@ -7,69 +7,9 @@ use bevy_rapier3d::prelude::*;
 use bevy_rapier3d::rapier::dynamics::RigidBodyHandle;
 
 use super::hooks::RestitutionConfig;
-use super::plugin::{Bodies, DamperScene, FrameState, StepClock, StepSettings};
-use super::stepping::StepPlan;
-use crate::run::{Impact, Series};
+use super::resources::{Bodies, DamperScene, FrameState, Recording, StepClock, StepPlan, StepSettings};
+use crate::run::Impact;
 use crate::scene::{Body, Scene};
-
-/// What the contact model has recorded so far.
-#[derive(Resource, Debug, Clone)]
-pub struct Recording {
-    /// Samples every `sample_dt`.
-    pub series: Series,
-    /// Impacts, in time order.
-    pub impacts: Vec<Impact>,
-    /// Kinetic energy lost in contacts, J.
-    pub impact_loss: f64,
-    /// Ball positions and velocities at the start of the current step.
-    pub x: Vec<f64>,
-    /// See `x`.
-    pub v: Vec<f64>,
-    /// Ball positions and velocities at the start of the last step taken.
-    pub prev_x: Vec<f64>,
-    /// See `prev_x`.
-    pub prev_v: Vec<f64>,
-    /// Impulse across each pair in the last step (pair `p` between body `p-1` and body `p`).
-    pub last_impulse: Vec<f64>,
-    /// Index in `impacts` of each pair's latest impact.
-    pub last_impact: Vec<Option<usize>>,
-    /// Next sample to write.
-    pub next_sample: usize,
-    /// Number of samples over the horizon.
-    pub sample_count: usize,
-    /// Impulses below this are numerical noise (f32 velocities), N s.
-    pub impulse_floor: f64,
-    /// Why the run cannot go on (a ball pushed through a wall, contacts that gained energy),
-    /// when the self-check found it.
-    pub failure: Option<String>,
-    /// The scene's mechanical energy at t = 0, J.
-    pub initial_energy: f64,
-}
-
-impl Recording {
-    /// An empty recording for `scene`.
-    pub fn new(scene: &Scene) -> Self {
-        let n = scene.balls.len();
-        let samples = scene.sample_count();
-        let m_min = scene.balls.iter().map(|b| b.mass).fold(f64::INFINITY, f64::min);
-        Recording {
-            series: Series::with_capacity(n, samples),
-            impacts: Vec::new(),
-            impact_loss: 0.0,
-            x: scene.initial_positions.clone(),
-            v: scene.initial_velocities.clone(),
-            prev_x: scene.initial_positions.clone(),
-            prev_v: scene.initial_velocities.clone(),
-            last_impulse: vec![0.0; n + 1],
-            last_impact: vec![None; n + 1],
-            next_sample: 0,
-            sample_count: samples,
-            impulse_floor: 1e-6 * m_min * super::plugin::speed_scale(scene).max(1e-6),
-            failure: None,
-            initial_energy: scene.initial_energy(),
-        }
-    }
-}
 
 /// Impulses across the pairs from the balls' momentum changes `dp[i] = J[i] - J[i+1]`, where
 /// pairs that carried no contact have `J = 0`. A run of active pairs is integrated from its

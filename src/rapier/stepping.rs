@@ -11,18 +11,8 @@ use bevy_rapier3d::parry::query::{cast_shapes, ShapeCastOptions};
 use bevy_rapier3d::parry::shape::{Ball, HalfSpace};
 use bevy_rapier3d::prelude::*;
 
-use super::plugin::{DamperScene, FrameState, StepClock, StepSettings};
-use super::record::Recording;
+use super::resources::{DamperScene, FrameState, Recording, StepClock, StepPlan, StepSettings};
 use crate::scene::Stepping;
-
-/// The length of the step about to be taken, s.
-#[derive(Resource, Debug, Clone, Copy)]
-pub struct StepPlan {
-    /// Step length, s.
-    pub h: f64,
-    /// Time at which the run ends, s.
-    pub horizon: f64,
-}
 
 /// Shortest step: a contact found at time-of-impact `toi` ends a step of `toi + MIN_STEP`, so
 /// that it closes within the step.

@@ -5,8 +5,7 @@
 //! so every correction was undone one step later and the run drifted millimetres from the
 //! headless model within 0.2 s. The feedback now keeps the component equal to the body.
 
-use lpc_damper::rapier::plugin::StepClock;
-use lpc_damper::rapier::{collect, settings, simulate, LpcDamperPlugins};
+use lpc_damper::rapier::{collect, settings, simulate, LpcDamperPlugins, StepClock};
 use lpc_damper::scene::{load_scene, scenes_dir, Overrides};
 
 use bevy::prelude::*;

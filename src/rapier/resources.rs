@@ -1,0 +1,162 @@
+//! The resources the plug-ins share, in one place: the scene, its bodies, how steps are taken,
+//! the frame's exact state, the clock and the recording. Systems import these; nothing here
+//! imports a system, so the plug-in's modules form no cycle.
+
+use bevy::prelude::*;
+
+use crate::oscillator::Driven;
+use crate::run::{Impact, Series};
+use crate::scene::{Scene, Stepping};
+
+/// Rapier's length unit: the balls are centimetres, so are the tolerances.
+pub const LENGTH_UNIT: f32 = 0.01;
+
+/// How the contact model steps.
+#[derive(Resource, Debug, Clone, Copy, PartialEq)]
+pub struct StepSettings {
+    /// How steps are chosen.
+    pub stepping: Stepping,
+    /// Physics step (the longest one with aligned stepping), s.
+    pub dt: f64,
+    /// Rapier solver iterations per step.
+    pub solver_iterations: usize,
+    /// Rapier's swept CCD on the balls.
+    pub ccd: bool,
+    /// Contacts are predicted as far ahead as the scene's speed scale carries a ball in two
+    /// steps (the plug-in's choice), rather than Rapier's fixed 0.02 length units (only the
+    /// stability map turns this off, to show why it is needed).
+    pub speculative_margin: bool,
+    /// Stop with [`crate::model::ModelError::Unstable`] when a ball is pushed through a wall or
+    /// contacts gain energy, rather than return a wrong run (only the stability map turns this
+    /// off, to measure the raw behaviour).
+    pub self_check: bool,
+}
+
+impl StepSettings {
+    /// Fixed steps of `dt` with the plug-in's other defaults.
+    pub fn fixed(dt: f64, solver_iterations: usize) -> Self {
+        StepSettings { stepping: Stepping::Fixed, dt, solver_iterations, ccd: false, speculative_margin: true, self_check: true }
+    }
+}
+
+/// The scene being simulated.
+#[derive(Resource, Debug, Clone)]
+pub struct DamperScene(pub Scene);
+
+/// Entities of the scene, balls left to right.
+#[derive(Resource, Debug, Clone, Default)]
+pub struct Bodies {
+    /// The kinematic frame carrying the walls.
+    pub frame: Option<Entity>,
+    /// Left and right wall colliders.
+    pub walls: Option<(Entity, Entity)>,
+    /// Ball bodies (each is its own collider).
+    pub balls: Vec<Entity>,
+}
+
+/// Marks the frame's kinematic body.
+#[derive(Component, Debug)]
+pub struct FrameBody;
+
+/// The frame's exact state (f64), advanced in closed form; impacts arrive as velocity jumps.
+#[derive(Resource, Debug, Clone, Copy)]
+pub struct FrameState {
+    /// The bare frame's oscillator, with the scene's harmonic load.
+    pub motion: Driven,
+    /// Time at the start of the current step, s.
+    pub t_start: f64,
+    /// Displacement and velocity at the start of the current step.
+    pub start: (f64, f64),
+    /// Displacement and velocity at the end of the step, before the impact impulses.
+    pub before_impulses: (f64, f64),
+    /// Displacement and velocity now (end of the last step, impulses included).
+    pub now: (f64, f64),
+    /// Energy dissipated by `cs` so far, J.
+    pub damping_loss: f64,
+    /// Work done by the excitation so far, J.
+    pub forcing_work: f64,
+}
+
+/// Steps taken so far and the simulated time they cover.
+#[derive(Resource, Debug, Clone, Copy, Default)]
+pub struct StepClock {
+    /// Steps taken.
+    pub steps: u64,
+    /// Time at the end of the last step, s.
+    pub t: f64,
+}
+
+/// The fastest speed the scene is expected to reach: the frame's initial peak speed and the
+/// balls' initial speeds, doubled for what impacts can add.
+pub fn speed_scale(scene: &Scene) -> f64 {
+    let frame = scene.frame.map_or(0.0, |f| (f.stiffness / f.mass).sqrt() * scene.initial_displacement.abs());
+    2.0 * scene.initial_velocities.iter().fold(frame, |m, v| m.max(v.abs()))
+}
+
+/// The length of the step about to be taken, s.
+#[derive(Resource, Debug, Clone, Copy)]
+pub struct StepPlan {
+    /// Step length, s.
+    pub h: f64,
+    /// Time at which the run ends, s.
+    pub horizon: f64,
+}
+
+/// What the contact model has recorded so far.
+#[derive(Resource, Debug, Clone)]
+pub struct Recording {
+    /// Samples every `sample_dt`.
+    pub series: Series,
+    /// Impacts, in time order.
+    pub impacts: Vec<Impact>,
+    /// Kinetic energy lost in contacts, J.
+    pub impact_loss: f64,
+    /// Ball positions and velocities at the start of the current step.
+    pub x: Vec<f64>,
+    /// See `x`.
+    pub v: Vec<f64>,
+    /// Ball positions and velocities at the start of the last step taken.
+    pub prev_x: Vec<f64>,
+    /// See `prev_x`.
+    pub prev_v: Vec<f64>,
+    /// Impulse across each pair in the last step (pair `p` between body `p-1` and body `p`).
+    pub last_impulse: Vec<f64>,
+    /// Index in `impacts` of each pair's latest impact.
+    pub last_impact: Vec<Option<usize>>,
+    /// Next sample to write.
+    pub next_sample: usize,
+    /// Number of samples over the horizon.
+    pub sample_count: usize,
+    /// Impulses below this are numerical noise (f32 velocities), N s.
+    pub impulse_floor: f64,
+    /// Why the run cannot go on (a ball pushed through a wall, contacts that gained energy),
+    /// when the self-check found it.
+    pub failure: Option<String>,
+    /// The scene's mechanical energy at t = 0, J.
+    pub initial_energy: f64,
+}
+
+impl Recording {
+    /// An empty recording for `scene`.
+    pub fn new(scene: &Scene) -> Self {
+        let n = scene.balls.len();
+        let samples = scene.sample_count();
+        let m_min = scene.balls.iter().map(|b| b.mass).fold(f64::INFINITY, f64::min);
+        Recording {
+            series: Series::with_capacity(n, samples),
+            impacts: Vec::new(),
+            impact_loss: 0.0,
+            x: scene.initial_positions.clone(),
+            v: scene.initial_velocities.clone(),
+            prev_x: scene.initial_positions.clone(),
+            prev_v: scene.initial_velocities.clone(),
+            last_impulse: vec![0.0; n + 1],
+            last_impact: vec![None; n + 1],
+            next_sample: 0,
+            sample_count: samples,
+            impulse_floor: 1e-6 * m_min * speed_scale(scene).max(1e-6),
+            failure: None,
+            initial_energy: scene.initial_energy(),
+        }
+    }
+}
