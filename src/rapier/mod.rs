@@ -102,7 +102,7 @@ pub fn neighbour_mass_ratio(scene: &Scene) -> f64 {
 }
 
 /// Refuses scenes the kinematic-frame coupling cannot reproduce.
-pub fn check(scene: &Scene) -> Result<(), ModelError> {
+pub fn can_represent(scene: &Scene) -> Result<(), ModelError> {
     if let Some(f) = scene.frame {
         for (i, b) in scene.balls.iter().enumerate() {
             if hooks::wall_restitution(scene.restitution, f.mass, b.mass).is_none() {
@@ -139,7 +139,7 @@ pub fn simulate(scene: &Scene) -> Result<Run, ModelError> {
 
 /// Runs the contact model on `scene` with `settings` as given (no step bound applied).
 pub fn simulate_with(scene: &Scene, settings: StepSettings) -> Result<Run, ModelError> {
-    check(scene)?;
+    can_represent(scene)?;
     let start = Instant::now();
     let mut app = headless_app(scene, settings);
     // The first update spawns the scene, lets bevy_rapier create its bodies and takes the

@@ -541,7 +541,7 @@ impl Validator<'_> {
     fn run(&self, run: &format::RunFile, default_horizon: f64) -> Result<(f64, f64), SceneError> {
         let horizon = self.positive("run.horizon", run.horizon.unwrap_or(default_horizon))?;
         let dt = self.positive("run.sample_dt", run.sample_dt.unwrap_or(DEFAULT_SAMPLE_DT))?;
-        check_sample_dt(horizon, dt).map_err(|rule| self.err("run.sample_dt", &rule))?;
+        validate_sample_dt(horizon, dt).map_err(|rule| self.err("run.sample_dt", &rule))?;
         Ok((horizon, dt))
     }
 }
@@ -594,7 +594,7 @@ impl Overrides {
     }
     /// The Rapier flags alone against the file's rules (for commands that take lists of them
     /// before any scene is loaded); an error names the flag.
-    pub fn check_rapier(&self) -> Result<(), SceneError> {
+    pub fn validate_rapier(&self) -> Result<(), SceneError> {
         let flags = [("rapier.dt", "--dt"), ("rapier.solver_iterations", "--solver-iterations")];
         let v = Validator { file: "(command line)", flags: &flags };
         let r = format::RapierFile { stepping: self.stepping, dt: self.dt, solver_iterations: self.solver_iterations, ccd: Some(self.ccd) };
@@ -603,7 +603,7 @@ impl Overrides {
 }
 
 /// The rule an output step must keep: no longer than the horizon, at most [`MAX_SAMPLES`] samples.
-pub fn check_sample_dt(horizon: f64, dt: f64) -> Result<(), String> {
+pub fn validate_sample_dt(horizon: f64, dt: f64) -> Result<(), String> {
     if !(dt.is_finite() && dt > 0.0) {
         return Err(format!("must be a positive finite step (got {dt})"));
     }

@@ -129,7 +129,7 @@ pub fn cell(case: Case, config: Config, dt: f64, speed: f64) -> Cell {
         Err(e) => (format!("error: {e}"), f64::NAN),
         Ok(run) => {
             let err = (run.energy.final_ - reference.energy.final_) / e0;
-            match crate::studies::stress::check(Model::Rapier, &scene, &run) {
+            match crate::studies::stress::judge(Model::Rapier, &scene, &run) {
                 Err(f) => (f.check.to_string(), err),
                 Ok(()) if err.abs() > INACCURATE => ("inaccurate".to_string(), err),
                 Ok(()) => ("ok".to_string(), err),

@@ -126,7 +126,7 @@ pub enum Passed {
 }
 
 /// Runs `model` on `scene` and checks the run.
-pub fn check_run(model: Model, scene: &Scene) -> Result<Passed, Failure> {
+pub fn judge_run(model: Model, scene: &Scene) -> Result<Passed, Failure> {
     let outcome = catch_unwind(AssertUnwindSafe(|| model.simulate(scene)));
     let run = match outcome {
         Err(panic) => {
@@ -150,13 +150,13 @@ pub fn check_run(model: Model, scene: &Scene) -> Result<Passed, Failure> {
         }
         Ok(Ok(run)) => run,
     };
-    check(model, scene, &run)?;
+    judge(model, scene, &run)?;
     Ok(Passed::Run(Box::new(run)))
 }
 
 
 /// The checks of a run of `model` on `scene` (see the module docs).
-pub fn check(model: Model, scene: &Scene, run: &Run) -> Result<(), Failure> {
+pub fn judge(model: Model, scene: &Scene, run: &Run) -> Result<(), Failure> {
     let fail = |check, detail: String| Err(Failure { check, detail });
     let s = &run.series;
     let finite = |v: &[f64]| v.iter().all(|x| x.is_finite());
@@ -335,7 +335,7 @@ pub fn shrink(model: Model, file: &SceneFile, check_name: &str) -> SceneFile {
     'outer: for _ in 0..200 {
         for candidate in simplifications(&current) {
             if let Some(scene) = validate(&candidate) {
-                if matches!(check_run(model, &scene), Err(f) if f.check == check_name) {
+                if matches!(judge_run(model, &scene), Err(f) if f.check == check_name) {
                     current = candidate;
                     continue 'outer;
                 }
@@ -354,7 +354,7 @@ pub fn stress(model: Model, seed: u64, count: u64, max_horizon: f64, forced: boo
         .map(|s| {
             let file = random_scene_file(s, max_horizon, forced);
             let scene = validate(&file).expect("generated scenes are valid");
-            let (failure, refused, refused_during_run) = match check_run(model, &scene) {
+            let (failure, refused, refused_during_run) = match judge_run(model, &scene) {
                 Ok(Passed::Run(_)) => (None, None, false),
                 Ok(Passed::Refused { reason, during_run }) => (None, Some(reason), during_run),
                 Err(f) => (Some(f), None, false),

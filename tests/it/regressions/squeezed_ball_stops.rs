@@ -40,7 +40,7 @@ fn the_contact_model_stops_with_the_reason_instead_of_a_wrong_run() {
         other => panic!("expected the run to stop as unstable, got {:?}", other.map(|r| r.impacts.len())),
     }
     let reference = Model::Reference.simulate(&s).unwrap();
-    lpc_damper::studies::stress::check(Model::Reference, &s, &reference).unwrap();
+    lpc_damper::studies::stress::judge(Model::Reference, &s, &reference).unwrap();
 }
 
 #[test]
@@ -50,6 +50,6 @@ fn the_stability_map_still_sees_the_raw_behaviour() {
     let mut settings = lpc_damper::rapier::settings(&s);
     settings.self_check = false;
     let run = lpc_damper::rapier::simulate_with(&s, settings).unwrap();
-    let failure = lpc_damper::studies::stress::check(Model::Rapier, &s, &run).unwrap_err();
+    let failure = lpc_damper::studies::stress::judge(Model::Rapier, &s, &run).unwrap_err();
     assert_eq!(failure.check, "outside");
 }

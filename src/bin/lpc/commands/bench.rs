@@ -49,10 +49,10 @@ pub fn run(a: Args) -> Result<ExitStatus> {
         a.scenes.clone()
     };
     for &dt in &a.dt {
-        Overrides { dt: Some(dt), ..Overrides::default() }.check_rapier()?;
+        Overrides { dt: Some(dt), ..Overrides::default() }.validate_rapier()?;
     }
     for &it in &a.solver_iterations {
-        Overrides { solver_iterations: Some(it), ..Overrides::default() }.check_rapier()?;
+        Overrides { solver_iterations: Some(it), ..Overrides::default() }.validate_rapier()?;
     }
     let plan = lpc_damper::studies::bench::Plan {
         models: a.models.clone(),
