@@ -511,7 +511,7 @@ impl Validator<'_> {
         if x.is_finite() {
             Ok(x)
         } else {
-            Err(self.err(field, &format!("must be a finite number (got {x})")))
+            Err(self.err(field, &format!("must be a finite number (got {})", human(x))))
         }
     }
     fn positive(&self, field: &str, x: f64) -> Result<f64, SceneError> {
@@ -519,7 +519,7 @@ impl Validator<'_> {
         if x > 0.0 {
             Ok(x)
         } else {
-            Err(self.err(field, &format!("must be positive (got {x})")))
+            Err(self.err(field, &format!("must be positive (got {})", human(x))))
         }
     }
     fn non_negative(&self, field: &str, x: f64) -> Result<f64, SceneError> {
@@ -527,7 +527,7 @@ impl Validator<'_> {
         if x >= 0.0 {
             Ok(x)
         } else {
-            Err(self.err(field, &format!("must not be negative (got {x})")))
+            Err(self.err(field, &format!("must not be negative (got {})", human(x))))
         }
     }
     fn restitution(&self, field: &str, e: f64) -> Result<f64, SceneError> {
@@ -535,7 +535,7 @@ impl Validator<'_> {
         if (0.0..=1.0).contains(&e) {
             Ok(e)
         } else {
-            Err(self.err(field, &format!("is a coefficient of restitution and must lie in [0, 1] (got {e})")))
+            Err(self.err(field, &format!("is a coefficient of restitution and must lie in [0, 1] (got {})", human(e))))
         }
     }
     fn run(&self, run: &format::RunFile, default_horizon: f64) -> Result<(f64, f64), SceneError> {
@@ -605,18 +605,41 @@ impl Overrides {
 /// The rule an output step must keep: no longer than the horizon, at most [`MAX_SAMPLES`] samples.
 pub fn validate_sample_dt(horizon: f64, dt: f64) -> Result<(), String> {
     if !(dt.is_finite() && dt > 0.0) {
-        return Err(format!("must be a positive finite step (got {dt})"));
+        return Err(format!("must be a positive finite step (got {})", human(dt)));
     }
     if dt > horizon {
-        return Err(format!("({dt} s) is longer than the horizon ({horizon} s): no sample would be written"));
+        return Err(format!(
+            "({} s) is longer than the horizon ({} s): no sample would be written",
+            human(dt),
+            human(horizon)
+        ));
     }
     if horizon / dt > MAX_SAMPLES {
         return Err(format!(
-            "({dt} s) would write {:.0} samples over {horizon} s; at most {MAX_SAMPLES:.0} are allowed",
-            horizon / dt
+            "({} s) would write {} samples over {} s; at most {} are allowed",
+            human(dt),
+            human(horizon / dt),
+            human(horizon),
+            human(MAX_SAMPLES)
         ));
     }
     Ok(())
+}
+
+/// A number as a person reads it in a message: plain from 1e-4 to 1e7 (`0.001`, `25000`),
+/// in scientific notation with at most four significant digits beyond (`1e300`, `5.06e302`),
+/// never three hundred digits.
+pub fn human(x: f64) -> String {
+    let a = x.abs();
+    if x == 0.0 || !x.is_finite() || (1e-4..1e7).contains(&a) {
+        // Twelve significant digits: what was typed, not its binary expansion.
+        let rounded: f64 = format!("{x:.11e}").parse().unwrap_or(x);
+        return format!("{rounded}");
+    }
+    let text = format!("{x:.3e}");
+    let (mantissa, exponent) = text.split_once('e').unwrap_or((&text, "0"));
+    let mantissa = mantissa.trim_end_matches('0').trim_end_matches('.');
+    format!("{mantissa}e{exponent}")
 }
 
 fn build_damper(f: &SceneFile, name: &str, v: &Validator) -> Result<Scene, SceneError> {
@@ -867,4 +890,23 @@ pub fn load_scene(path: impl AsRef<Path>) -> Result<Scene, SceneError> {
 /// The scenes directory shipped with the crate, for tests and `lpc check`.
 pub fn scenes_dir() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes")
+}
+
+#[cfg(test)]
+mod tests {
+    use super::human;
+
+    #[test]
+    fn numbers_in_messages_read_as_typed() {
+        assert_eq!(human(0.001), "0.001");
+        assert_eq!(human(865.0), "865");
+        assert_eq!(human(0.1 + 0.2), "0.3");
+        assert_eq!(human(-2.5), "-2.5");
+        assert_eq!(human(1e300), "1e300");
+        assert_eq!(human(1e300 / 1.975e-3), "5.063e302");
+        assert_eq!(human(2e7), "2e7");
+        assert_eq!(human(1.5e-9), "1.5e-9");
+        assert_eq!(human(f64::NAN), "NaN");
+        assert_eq!(human(f64::INFINITY), "inf");
+    }
 }

@@ -88,6 +88,8 @@ fn non_positive_mass_density_horizon() {
     expect_error(&with("density", "0"), &[], "balls.density", "positive");
     expect_error(&with("horizon", "-5.0"), &[], "run.horizon", "positive");
     expect_error(GOOD, &["--horizon", "0"], "--horizon", "positive");
+    // Issue 19: numbers for people, not a 300-digit sample count.
+    expect_error(GOOD, &["--horizon", "1e300"], "run.sample_dt", "would write 1e303 samples over 1e300 s");
 }
 
 #[test]

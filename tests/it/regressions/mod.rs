@@ -7,4 +7,5 @@ mod loaded_contact_sinks;
 mod plugin_driven_by_app_update;
 mod squeezed_ball_stops;
 mod stale_impulse_bounce;
+mod stiff_frame_rapier_step;
 mod zero_time_event_loop;
