@@ -55,8 +55,10 @@ pub struct Scratch {
     shares: Vec<f64>,
 }
 
-/// The after-step system: velocity jumps, the restitution Rapier skipped, frame feedback,
-/// impacts and energy.
+/// The after-step system, in named phases: read the balls (projecting sunk ones back), find
+/// the pairs in contact and their impulses from `m dv`, restore the bounces Rapier skipped,
+/// feed the opposite momentum to the frame, book the step's loss and attribute impacts to
+/// their pairs, then check the run and roll the state forward.
 #[allow(clippy::too_many_arguments)]
 pub fn feedback(
     mut clock: ResMut<StepClock>,
@@ -84,40 +86,89 @@ pub fn feedback(
         handles.clear();
         handles.extend(bodies.balls.iter().map(|e| set.entity2body()[e]));
     }
-    x_new.clear();
-    v_new.clear();
-    for &h in handles.iter() {
-        let body = &set.bodies[h];
-        x_new.push(body.translation().x as f64);
-        v_new.push(body.linvel().x as f64);
-    }
-    // Rapier's contacts are soft: a ball pressed by an accelerating wall or a loaded chain
-    // sinks past the allowed error. Project it back (positions only: no energy changes).
+    read_balls(&set, handles, x_new, v_new);
     if let (Some(c), Some(f)) = (scene.container, frame.as_ref()) {
-        if project_inside(x_new, &scene.balls, f.before_impulses.0, c.length) {
-            for (i, &h) in handles.iter().enumerate() {
-                let body = &mut set.bodies[h];
-                let mut p = body.translation();
-                if p.x as f64 != x_new[i] {
-                    p.x = x_new[i] as f32;
-                    body.set_translation(p, false);
-                    x_new[i] = p.x as f64;
-                }
-            }
+        project_sunk_balls(&mut set, handles, x_new, scene, f.before_impulses.0, c.length);
+    }
+    mark_pairs_in_contact(sim, colliders, &set, &bodies, n, active);
+    step_impulses(scene, v_new, &rec.v, active, dp, j);
+
+    let (frame_start, frame_end) = frame.as_ref().map_or(((0.0, 0.0), (0.0, 0.0)), |f| (f.start, f.before_impulses));
+    let wall_v = (frame_end.0 - frame_start.0) / plan.h; // the kinematic velocity Rapier used
+    if restore_skipped_bounces(scene, &hook, rec, wall_v, j, v_new) {
+        write_velocities(&mut set, handles, &bodies.balls, &mut velocities, v_new);
+        step_impulses(scene, v_new, &rec.v, active, dp, j);
+    }
+
+    let forcing_work = frame.as_ref().map_or(0.0, |f| f.forcing_work);
+    let (frame_pre, frame_post) = match frame {
+        Some(mut f) => feed_frame(&mut f, scene, dp),
+        None => (0.0, 0.0),
+    };
+    let step = StepVelocities { before: &rec.v, after: v_new, frame_before: frame_pre, frame_after: frame_post };
+    rec.impact_loss += step.kinetic_energy_lost(scene);
+    let start = StepStart { t: t0, h: plan.h, frame_x: frame_start.0 };
+    let ledger = ImpactLedger {
+        impacts: &mut rec.impacts,
+        last_impact: &mut rec.last_impact,
+        last_impulse: &mut rec.last_impulse,
+        impulse_floor: rec.impulse_floor,
+    };
+    attribute_impacts(ledger, scene, &step, &start, &rec.x, active, j, shares);
+    if settings.self_check && rec.failure.is_none() {
+        rec.failure = self_check(scene, rec, x_new, v_new, frame_end.0, frame_post, forcing_work, t0 + plan.h);
+    }
+    std::mem::swap(&mut rec.prev_x, &mut rec.x);
+    std::mem::swap(&mut rec.prev_v, &mut rec.v);
+    rec.x.clone_from(x_new);
+    rec.v.clone_from(v_new);
+}
+
+/// Phase 1: the balls' positions and velocities as Rapier left them.
+fn read_balls(set: &RapierRigidBodySet, handles: &[RigidBodyHandle], x: &mut Vec<f64>, v: &mut Vec<f64>) {
+    x.clear();
+    v.clear();
+    for &h in handles {
+        let body = &set.bodies[h];
+        x.push(body.translation().x as f64);
+        v.push(body.linvel().x as f64);
+    }
+}
+
+/// Phase 1b: Rapier's contacts are soft, so a ball pressed by an accelerating wall or a loaded
+/// chain sinks past the allowed error. Project it back (positions only: no energy changes).
+fn project_sunk_balls(
+    set: &mut RapierRigidBodySet,
+    handles: &[RigidBodyHandle],
+    x: &mut [f64],
+    scene: &Scene,
+    frame_x: f64,
+    length: f64,
+) {
+    if !project_inside(x, &scene.balls, frame_x, length) {
+        return;
+    }
+    for (i, &h) in handles.iter().enumerate() {
+        let body = &mut set.bodies[h];
+        let mut p = body.translation();
+        if p.x as f64 != x[i] {
+            p.x = x[i] as f32;
+            body.set_translation(p, false);
+            x[i] = p.x as f64;
         }
     }
-    let mass = |i: usize| scene.balls[i].mass;
-    let impulses = |v_new: &[f64], v_old: &[f64], dp: &mut Vec<f64>, active: &[bool], j: &mut Vec<f64>| {
-        dp.clear();
-        dp.extend((0..n).map(|i| mass(i) * (v_new[i] - v_old[i])));
-        j.clear();
-        j.resize(n + 1, 0.0);
-        if n > 0 {
-            pair_impulses(dp, active, j);
-        }
-    };
+}
 
-    // Which pairs were in contact this step (only whether, not how hard).
+/// Phase 2: which pairs were in contact this step (only whether, not how hard). Pair `p` lies
+/// between body `p - 1` and body `p` (body `-1` the left wall, body `n` the right one).
+fn mark_pairs_in_contact(
+    sim: &RapierContextSimulation,
+    colliders: &RapierContextColliders,
+    set: &RapierRigidBodySet,
+    bodies: &Bodies,
+    n: usize,
+    active: &mut Vec<bool>,
+) {
     let collider = |body: isize| -> Option<Entity> {
         match (body, bodies.walls) {
             (-1, Some((l, _))) => Some(l),
@@ -131,26 +182,56 @@ pub fn feedback(
         let (Some(a), Some(b)) = (collider(p as isize - 1), collider(p as isize)) else {
             return false;
         };
-        sim.contact_pair(colliders, &set, a, b)
+        sim.contact_pair(colliders, set, a, b)
             .is_some_and(|pair| pair.manifolds().any(|m| m.points().any(|pt| pt.impulse() > 0.0)))
     }));
-    impulses(v_new, &rec.v, dp, active, j);
+}
 
-    // Rapier bounces a contact only when it carried no impulse the step before; rapier 0.35.0
-    // leaves a stale impulse on a pair that separates within the prediction distance, so a
-    // genuinely new contact can be solved plastically. Where a pair that carried no impulse
-    // last step (by m dv) approached and was not bounced, apply the bounce Rapier skipped.
-    let (frame_start, frame_end) = frame.as_ref().map_or(((0.0, 0.0), (0.0, 0.0)), |f| (f.start, f.before_impulses));
-    let wall_v = (frame_end.0 - frame_start.0) / plan.h; // the kinematic velocity Rapier used
-    let vel = |v: &[f64], vf: f64, body: isize| if body < 0 || body >= n as isize { vf } else { v[body as usize] };
+/// Phase 2b: the balls' momentum changes `dp` and the impulse across each pair `j` (m dv, not
+/// the impulses Rapier reports).
+fn step_impulses(scene: &Scene, v_new: &[f64], v_old: &[f64], active: &[bool], dp: &mut Vec<f64>, j: &mut Vec<f64>) {
+    let n = scene.balls.len();
+    dp.clear();
+    dp.extend((0..n).map(|i| scene.balls[i].mass * (v_new[i] - v_old[i])));
+    j.clear();
+    j.resize(n + 1, 0.0);
+    if n > 0 {
+        pair_impulses(dp, active, j);
+    }
+}
+
+/// Velocity of body `body` (a ball, or a wall moving at `frame_v`).
+fn body_velocity(v: &[f64], frame_v: f64, body: isize) -> f64 {
+    if body < 0 || body >= v.len() as isize {
+        frame_v
+    } else {
+        v[body as usize]
+    }
+}
+
+/// Phase 3: Rapier bounces a contact only when it carried no impulse the step before; rapier
+/// 0.35.0 leaves a stale impulse on a pair that separates within the prediction distance, so a
+/// genuinely new contact can be solved plastically. Where a pair that carried no impulse last
+/// step (by m dv) approached and was not bounced, apply the bounce Rapier skipped. Returns
+/// whether any velocity changed.
+fn restore_skipped_bounces(
+    scene: &Scene,
+    hook: &RestitutionConfig,
+    rec: &Recording,
+    wall_v: f64,
+    j: &[f64],
+    v_new: &mut [f64],
+) -> bool {
+    let n = scene.balls.len();
+    let mass = |i: usize| scene.balls[i].mass;
     let mut corrected = false;
     for p in 0..=n {
         let (a, b) = (p as isize - 1, p as isize);
-        let u = vel(&rec.v, wall_v, a) - vel(&rec.v, wall_v, b);
+        let u = body_velocity(&rec.v, wall_v, a) - body_velocity(&rec.v, wall_v, b);
         if !(j[p] > rec.impulse_floor && rec.last_impulse[p] <= rec.impulse_floor && u > 0.0) {
             continue;
         }
-        let u_after = vel(v_new, wall_v, a) - vel(v_new, wall_v, b);
+        let u_after = body_velocity(v_new, wall_v, a) - body_velocity(v_new, wall_v, b);
         let (inv_a, inv_b) = (
             if a >= 0 { 1.0 / mass(a as usize) } else { 0.0 },
             if b < n as isize { 1.0 / mass(b as usize) } else { 0.0 },
@@ -173,85 +254,140 @@ pub fn feedback(
             corrected = true;
         }
     }
-    if corrected {
-        for (i, &h) in handles.iter().enumerate() {
-            let body = &mut set.bodies[h];
-            let mut lin = body.linvel();
-            lin.x = v_new[i] as f32;
-            body.set_linvel(lin, true);
-            v_new[i] = lin.x as f64; // what Rapier will carry on with
-            // bevy_rapier wrote the step's velocity into the ball's `Velocity` before this
-            // system ran, and in an app driven by `app.update()` it copies a changed
-            // `Velocity` back into the body at the next step: it must hold the corrected one.
-            if let Ok(mut velocity) = velocities.get_mut(bodies.balls[i]) {
-                if velocity.linear != lin {
-                    velocity.linear = lin;
-                }
+    corrected
+}
+
+/// Phase 3b: the corrected velocities into Rapier's bodies (rounded to what Rapier carries on
+/// with) and into the balls' `Velocity` components.
+fn write_velocities(
+    set: &mut RapierRigidBodySet,
+    handles: &[RigidBodyHandle],
+    balls: &[Entity],
+    velocities: &mut Query<&mut Velocity>,
+    v_new: &mut [f64],
+) {
+    for (i, &h) in handles.iter().enumerate() {
+        let body = &mut set.bodies[h];
+        let mut lin = body.linvel();
+        lin.x = v_new[i] as f32;
+        body.set_linvel(lin, true);
+        v_new[i] = lin.x as f64; // what Rapier will carry on with
+        // bevy_rapier wrote the step's velocity into the ball's `Velocity` before this system
+        // ran, and in an app driven by `app.update()` it copies a changed `Velocity` back into
+        // the body at the next step: it must hold the corrected one.
+        if let Ok(mut velocity) = velocities.get_mut(balls[i]) {
+            if velocity.linear != lin {
+                velocity.linear = lin;
             }
         }
-        impulses(v_new, &rec.v, dp, active, j);
+    }
+}
+
+/// Phase 4: the frame takes the opposite of the balls' total momentum change. Returns its
+/// velocity before and after.
+fn feed_frame(frame: &mut FrameState, scene: &Scene, dp: &[f64]) -> (f64, f64) {
+    let (x, v) = frame.before_impulses;
+    let dv = -dp.iter().sum::<f64>() / scene.frame.expect("frame").mass;
+    frame.now = (x, v + dv);
+    (v, v + dv)
+}
+
+/// The velocities of the balls and the frame before and after one step's contacts.
+struct StepVelocities<'a> {
+    before: &'a [f64],
+    after: &'a [f64],
+    frame_before: f64,
+    frame_after: f64,
+}
+
+impl StepVelocities<'_> {
+    /// Kinetic energy the step's contacts took, J.
+    fn kinetic_energy_lost(&self, scene: &Scene) -> f64 {
+        let frame_mass = scene.frame.map_or(0.0, |f| f.mass);
+        let ke = |v: &[f64], vf: f64| {
+            0.5 * frame_mass * vf * vf + scene.balls.iter().zip(v).map(|(b, v)| 0.5 * b.mass * v * v).sum::<f64>()
+        };
+        ke(self.before, self.frame_before) - ke(self.after, self.frame_after)
     }
 
-    // The frame takes the opposite of the balls' total momentum change.
-    let forcing_work = frame.as_ref().map_or(0.0, |f| f.forcing_work);
-    let (frame_pre, frame_post) = match frame {
-        Some(mut f) => {
-            let (x, v) = f.before_impulses;
-            let dv = -dp.iter().sum::<f64>() / scene.frame.expect("frame").mass;
-            f.now = (x, v + dv);
-            (v, v + dv)
-        }
-        None => (0.0, 0.0),
-    };
-    let frame_mass = scene.frame.map_or(0.0, |f| f.mass);
-    let ke = |v: &[f64], vf: f64| {
-        0.5 * frame_mass * vf * vf + scene.balls.iter().zip(v).map(|(b, v)| 0.5 * b.mass * v * v).sum::<f64>()
-    };
-    let step_loss = ke(&rec.v, frame_pre) - ke(v_new, frame_post);
-    rec.impact_loss += step_loss;
+    /// Approach speed of pair `p` before and after the step.
+    fn approach(&self, p: usize) -> (f64, f64) {
+        let (a, b) = (p as isize - 1, p as isize);
+        (
+            body_velocity(self.before, self.frame_before, a) - body_velocity(self.before, self.frame_before, b),
+            body_velocity(self.after, self.frame_after, a) - body_velocity(self.after, self.frame_after, b),
+        )
+    }
+}
 
-    // Attribute: a pair whose impulse starts this step while approaching is a new impact,
-    // timed where the gap at the step's start closes at the approach speed.
+/// Where a step started: its time, length and the frame's displacement.
+struct StepStart {
+    t: f64,
+    h: f64,
+    frame_x: f64,
+}
+
+/// The part of the recording that impacts are booked in.
+struct ImpactLedger<'a> {
+    impacts: &'a mut Vec<Impact>,
+    last_impact: &'a mut [Option<usize>],
+    last_impulse: &'a mut [f64],
+    impulse_floor: f64,
+}
+
+/// Phase 5: attribute the step's loss to its pairs. A pair whose impulse starts this step
+/// while approaching is a new impact, timed where the gap at the step's start closes at the
+/// approach speed; a pair that keeps pushing adds to its latest impact.
+#[allow(clippy::too_many_arguments)]
+fn attribute_impacts(
+    ledger: ImpactLedger<'_>,
+    scene: &Scene,
+    step: &StepVelocities<'_>,
+    start: &StepStart,
+    x_before: &[f64],
+    active: &[bool],
+    j: &[f64],
+    shares: &mut Vec<f64>,
+) {
+    let n = scene.balls.len();
     let length = scene.container.map_or(0.0, |c| c.length);
     let edge = |body: isize, right: bool| -> f64 {
         if body < 0 {
-            frame_start.0
+            start.frame_x
         } else if body >= n as isize {
-            frame_start.0 + length
+            start.frame_x + length
         } else {
             let r = scene.balls[body as usize].radius;
-            rec.x[body as usize] + if right { r } else { -r }
+            x_before[body as usize] + if right { r } else { -r }
         }
     };
     // Each pair's share of the step's loss, `j (u + u') / 2`; the shares sum to the step's
     // loss. Rapier solves touching contacts together, and the split of one simultaneous solve
     // among its pairs is not physical (a pair can appear to gain while the step loses): when
     // the step loses energy, it is shared among the pairs that lost, in proportion.
-    let share = |p: usize| {
-        let (a, b) = (p as isize - 1, p as isize);
-        let u = vel(&rec.v, frame_pre, a) - vel(&rec.v, frame_pre, b);
-        let u_after = vel(v_new, frame_post, a) - vel(v_new, frame_post, b);
-        j[p] * 0.5 * (u + u_after)
-    };
     shares.clear();
-    shares.extend((0..=n).map(share));
+    shares.extend((0..=n).map(|p| {
+        let (u, u_after) = step.approach(p);
+        j[p] * 0.5 * (u + u_after)
+    }));
     let total: f64 = shares.iter().sum();
     let gross: f64 = shares.iter().filter(|x| **x > 0.0).sum();
     let split = total >= 0.0 && gross > 0.0 && shares.iter().any(|x| *x < 0.0);
+    let ImpactLedger { impacts, last_impact, last_impulse, impulse_floor } = ledger;
     for p in 0..=n {
         let (a, b) = (p as isize - 1, p as isize);
         if !active[p] && j[p] == 0.0 {
-            rec.last_impulse[p] = 0.0;
+            last_impulse[p] = 0.0;
             continue;
         }
-        let u = vel(&rec.v, frame_pre, a) - vel(&rec.v, frame_pre, b);
+        let (u, _) = step.approach(p);
         let lost = if split { shares[p].max(0.0) * total / gross } else { shares[p] };
-        let starts = j[p] > rec.impulse_floor && rec.last_impulse[p] <= rec.impulse_floor && u > 0.0;
+        let starts = j[p] > impulse_floor && last_impulse[p] <= impulse_floor && u > 0.0;
         if starts {
             let gap = edge(b, false) - edge(a, true);
-            rec.last_impact[p] = Some(rec.impacts.len());
-            rec.impacts.push(Impact {
-                t: t0 + (gap / u).clamp(0.0, plan.h),
+            last_impact[p] = Some(impacts.len());
+            impacts.push(Impact {
+                t: start.t + (gap / u).clamp(0.0, start.h),
                 a: body_of(a, n),
                 b: body_of(b, n),
                 approach_speed: u,
@@ -260,21 +396,14 @@ pub fn feedback(
                 peak_force: None,
                 contact_duration: None,
             });
-        } else if let Some(k) = rec.last_impact[p] {
-            rec.impacts[k].energy_lost += lost;
-            if j[p] > rec.impulse_floor {
-                rec.impacts[k].impulses += 1;
+        } else if let Some(k) = last_impact[p] {
+            impacts[k].energy_lost += lost;
+            if j[p] > impulse_floor {
+                impacts[k].impulses += 1;
             }
         }
-        rec.last_impulse[p] = j[p];
+        last_impulse[p] = j[p];
     }
-    if settings.self_check && rec.failure.is_none() {
-        rec.failure = self_check(scene, rec, x_new, v_new, frame_end.0, frame_post, forcing_work, t0 + plan.h);
-    }
-    std::mem::swap(&mut rec.prev_x, &mut rec.x);
-    std::mem::swap(&mut rec.prev_v, &mut rec.v);
-    rec.x.clone_from(x_new);
-    rec.v.clone_from(v_new);
 }
 
 /// What the contact model cannot have done, checked after every step: a ball deeper in a wall
