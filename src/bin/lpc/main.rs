@@ -9,6 +9,7 @@
 mod args;
 mod commands;
 mod exit;
+mod table;
 
 use std::process::ExitCode;
 
@@ -54,6 +55,7 @@ enum Command {
 }
 
 fn main() -> ExitCode {
+    restore_sigpipe();
     let cli = Cli::parse();
     let result = match cli.command {
         Command::Run(a) => commands::run::run(a),
@@ -75,4 +77,15 @@ fn main() -> ExitCode {
         e.status
     });
     ExitCode::from(status)
+}
+
+/// Rust starts programs with SIGPIPE ignored, so writing to a closed pipe (`lpc check | head`)
+/// makes `println!` panic. A command-line tool should end quietly instead, as Unix tools do.
+fn restore_sigpipe() {
+    #[cfg(unix)]
+    // SAFETY: called first thing in `main`, before any other thread exists; SIG_DFL is a valid
+    // disposition for SIGPIPE.
+    unsafe {
+        libc::signal(libc::SIGPIPE, libc::SIG_DFL);
+    }
 }

@@ -2,6 +2,7 @@
 //! went wrong; its module doc names the issue, the cause and the fix.
 
 mod check_bad_scene_exit_status;
+mod closed_pipe;
 mod forced_ball_through_wall;
 mod loaded_contact_sinks;
 mod plugin_driven_by_app_update;

@@ -7,6 +7,7 @@ use lpc_damper::scene::Overrides;
 use lpc_damper::Model;
 
 use crate::args::{load_scene, print_json, progress_bar, TableFormat};
+use crate::table::{right, Table};
 use crate::exit::{CommandError, ExitStatus, Result};
 
 #[derive(clap::Args)]
@@ -85,28 +86,38 @@ pub fn run(a: Args) -> Result<ExitStatus> {
         TableFormat::Json => print_json(&rows)?,
         TableFormat::Csv => print!("{}", String::from_utf8(csv_bytes)?),
         TableFormat::Text => {
-            println!(
-                "{:>14} {:>9} {:>8} {:>8} {:>4} {:>12} {:>10} {:>9} {:>11} {:>10} {:>9} {:>7}",
-                "scene", "model", "stepping", "dt", "it", "s per sim s", "steps/s", "rms mm", "early mm", "settle s", "loss %", "pareto"
-            );
+            let table = Table::new(vec![
+                right("scene", 14),
+                right("model", 9),
+                right("stepping", 8),
+                right("dt", 8),
+                right("it", 4),
+                right("s per sim s", 12),
+                right("steps/s", 10),
+                right("rms mm", 9),
+                right("early mm", 11),
+                right("settle s", 10),
+                right("loss %", 9),
+                right("pareto", 7),
+            ]);
+            table.print_header();
             for r in &rows {
                 let e = &r.errors;
-                println!(
-                    "{:>14} {:>9} {:>8} {:>8} {:>4} {:>12.5} {:>10.0} {:>9.4} {:>11.5} {:>10} {:>9.3} {:>7}",
-                    r.scene,
-                    r.model,
-                    r.settings.stepping,
+                table.print_row(&[
+                    r.scene.clone(),
+                    r.model.to_string(),
+                    r.settings.stepping.to_string(),
                     // The compliant model has no step to set: its column shows the tolerance.
                     r.settings.dt.map(|d| format!("{d}")).or(r.settings.tolerance.map(|t| format!("tol {t:e}"))).unwrap_or("-".into()),
                     r.settings.solver_iterations.map_or("-".into(), |i| i.to_string()),
-                    r.wall_s_per_sim_s,
-                    r.steps_per_sim_s,
-                    e.rms_xs * 1e3,
-                    e.max_xs_early * 1e3,
+                    format!("{:.5}", r.wall_s_per_sim_s),
+                    format!("{:.0}", r.steps_per_sim_s),
+                    format!("{:.4}", e.rms_xs * 1e3),
+                    format!("{:.5}", e.max_xs_early * 1e3),
                     e.settling_time_diff.map_or("n/a".into(), |d| format!("{d:+.3}")),
-                    e.impact_loss_diff * 100.0,
-                    if r.pareto { "*" } else { "" }
-                );
+                    format!("{:.3}", e.impact_loss_diff * 100.0),
+                    (if r.pareto { "*" } else { "" }).to_string(),
+                ]);
             }
             if let Some(dir) = &a.out {
                 println!("wrote bench.csv, bench.json, error_vs_cost.svg to {}", dir.display());

@@ -7,6 +7,7 @@ use lpc_damper::scene;
 use lpc_damper::Model;
 
 use crate::args::{invalid, override_scene, print_json, Format, RapierArgs};
+use crate::table::{right, Table};
 use crate::exit::{ExitStatus, Result};
 
 #[derive(clap::Args)]
@@ -36,9 +37,10 @@ pub fn run(a: Args) -> Result<ExitStatus> {
         Format::Json => print_json(&rows)?,
         Format::Text => {
             println!("kinetic energy ratio ({}): KE of all balls after / KE of the incident ball", a.model.name());
-            println!("{:>7} {:>7} {:>10}", "large", "small", "KER");
+            let table = Table::new(vec![right("large", 7), right("small", 7), right("KER", 10)]);
+            table.print_header();
             for r in &rows {
-                println!("{:>7} {:>7} {:>10.4}", r.large, r.small, r.ker);
+                table.print_row(&[r.large.to_string(), r.small.to_string(), format!("{:.4}", r.ker)]);
             }
         }
     }

@@ -5,6 +5,7 @@ use std::path::PathBuf;
 use lpc_damper::studies::check;
 use lpc_damper::Model;
 
+use crate::table::{left, right, Table};
 use crate::exit::{ExitStatus, Result};
 
 #[derive(clap::Args)]
@@ -37,18 +38,26 @@ pub fn run(a: Args) -> Result<ExitStatus> {
         rows.extend(check::compare(g, golden.as_ref()));
     }
     let fmt = |x: Option<f64>| x.map_or("-".to_string(), |v| format!("{v:.6e}"));
-    println!("{:<34} {:>9} {:<18} {:>14} {:>14} {:>10} {:>6}", "case", "model", "metric", "golden", "now", "tolerance", "");
+    let table = Table::new(vec![
+        left("case", 34),
+        right("model", 9),
+        left("metric", 18),
+        right("golden", 14),
+        right("now", 14),
+        right("tolerance", 10),
+        right("", 6),
+    ]);
+    table.print_header();
     for r in rows.iter().filter(|r| a.verbose || !r.ok) {
-        println!(
-            "{:<34} {:>9} {:<18} {:>14} {:>14} {:>10.1e} {:>6}",
-            r.case,
-            r.model,
-            r.metric,
+        table.print_row(&[
+            r.case.clone(),
+            r.model.to_string(),
+            r.metric.clone(),
             fmt(r.golden),
             fmt(r.now),
-            r.tolerance,
-            if r.ok { "ok" } else { "FAIL" }
-        );
+            format!("{:.1e}", r.tolerance),
+            (if r.ok { "ok" } else { "FAIL" }).to_string(),
+        ]);
     }
     let failed = rows.iter().filter(|r| !r.ok).count();
     println!("{} passed, {} failed", rows.len() - failed, failed);

@@ -9,6 +9,7 @@ use lpc_damper::output::{write_run_dir, RunSummary};
 use lpc_damper::Model;
 
 use crate::args::{load_scene, print_json, Format, RapierArgs};
+use crate::table::{right, Table};
 use crate::exit::{ExitStatus, Result};
 
 #[derive(clap::Args)]
@@ -74,17 +75,23 @@ pub fn run(a: Args) -> Result<ExitStatus> {
                 st.dt,
                 st.solver_iterations
             );
-            println!(
-                "{:>10} {:>10} {:>10} {:>12} {:>12} {:>12} {:>12} {:>14}",
-                "model", "wall ms", "x realtime", "rms xs mm", "early xs mm", "settle d s", "loss d %E0", "impacts (d)"
-            );
+            let table = Table::new(vec![
+                right("model", 10),
+                right("wall ms", 10),
+                right("x realtime", 10),
+                right("rms xs mm", 12),
+                right("early xs mm", 12),
+                right("settle d s", 12),
+                right("loss d %E0", 12),
+                right("impacts (d)", 14),
+            ]);
+            table.print_header();
             let row = |name: &str, s: &RunSummary, e: Option<&Errors>| {
                 let e = e.copied();
-                println!(
-                    "{:>10} {:>10.3} {:>10.0} {:>12} {:>12} {:>12} {:>12} {:>14}",
-                    name,
-                    s.wall_time_s * 1e3,
-                    s.horizon / s.wall_time_s,
+                table.print_row(&[
+                    name.to_string(),
+                    format!("{:.3}", s.wall_time_s * 1e3),
+                    format!("{:.0}", s.horizon / s.wall_time_s),
                     e.map_or("-".into(), |e| format!("{:.4}", e.rms_xs * 1e3)),
                     e.map_or("-".into(), |e| format!("{:.4}", e.max_xs_early * 1e3)),
                     e.map_or("-".into(), |e| e.settling_time_diff.map_or("n/a".into(), |d| format!("{d:+.3}"))),
@@ -92,8 +99,8 @@ pub fn run(a: Args) -> Result<ExitStatus> {
                     match e {
                         Some(e) => format!("{} ({:+})", s.impact_count, e.impact_count_diff),
                         None => s.impact_count.to_string(),
-                    }
-                );
+                    },
+                ]);
             };
             row("reference", &comparison.reference, None);
             for (name, m) in &comparison.models {

@@ -10,6 +10,7 @@ use lpc_damper::scene;
 use lpc_damper::Model;
 
 use crate::args::{invalid, load_scene, parse_range, print_json, progress_bar, Format, RapierArgs};
+use crate::table::{right, Table};
 use crate::exit::{CommandError, ExitStatus, Result};
 
 #[derive(clap::Args)]
@@ -112,25 +113,29 @@ pub fn run(a: Args) -> Result<ExitStatus> {
                 2 * points.len(),
                 elapsed
             );
-            println!(
-                "{:>10} {:>14} {:>14} {:>8} {:>16} {:>22}",
-                "f Hz", "amp mm", "no damper mm", "ratio", "impacts/period", "steady (with/without)"
-            );
+            let table = Table::new(vec![
+                right("f Hz", 10),
+                right("amp mm", 14),
+                right("no damper mm", 14),
+                right("ratio", 8),
+                right("impacts/period", 16),
+                right("steady (with/without)", 22),
+            ]);
+            table.print_header();
             let mm = |x: Option<f64>| x.map_or("failed".to_string(), |x| format!("{:.4}", x * 1e3));
             for p in &points {
                 let ratio = match (p.amplitude, p.amplitude_no_damper) {
                     (Some(a), Some(b)) => format!("{:.3}", a / b),
                     _ => "-".into(),
                 };
-                println!(
-                    "{:>10.4} {:>14} {:>14} {:>8} {:>16} {:>22}",
-                    p.frequency,
+                table.print_row(&[
+                    format!("{:.4}", p.frequency),
                     mm(p.amplitude),
                     mm(p.amplitude_no_damper),
                     ratio,
                     p.impacts_per_period.map_or("-".into(), |x| format!("{x:.2}")),
-                    format!("{}/{}", if p.steady { "yes" } else { "no" }, if p.steady_no_damper { "yes" } else { "no" })
-                );
+                    format!("{}/{}", if p.steady { "yes" } else { "no" }, if p.steady_no_damper { "yes" } else { "no" }),
+                ]);
             }
             for p in points.iter().filter(|p| p.error.is_some()) {
                 println!("{} Hz failed: {}", p.frequency, p.error.as_deref().unwrap_or_default());

@@ -10,6 +10,7 @@ use lpc_damper::scene;
 use lpc_damper::Model;
 
 use crate::args::{invalid, parse_range, print_json, progress_bar, Format};
+use crate::table::{left, right, Table};
 use crate::exit::{ExitStatus, Result};
 
 #[derive(clap::Args)]
@@ -111,15 +112,17 @@ pub fn run(a: Args) -> Result<ExitStatus> {
                 start.elapsed().as_secs_f64(),
                 search.infeasible
             );
-            println!("{:>12} {:>12} {:>22}  parameters", "arrangement", "clearance mm", unit);
+            // The parameters column is set off by a second space.
+            let table = Table::new(vec![right("arrangement", 12), right("clearance mm", 12), right(unit, 22), left(" parameters", 0)]);
+            table.print_header();
             for d in search.ranking.iter().take(a.top) {
                 let params = d.values.iter().map(|(p, v)| format!("{p}={v}")).collect::<Vec<_>>().join(" ");
-                println!(
-                    "{:>12} {:>12.3} {:>22}  {params}",
-                    d.arrangement,
-                    d.clearance * 1e3,
-                    d.objective.map_or("not settled".into(), |x| format!("{:.4}", x * scale))
-                );
+                table.print_row(&[
+                    d.arrangement.clone(),
+                    format!("{:.3}", d.clearance * 1e3),
+                    d.objective.map_or("not settled".into(), |x| format!("{:.4}", x * scale)),
+                    format!(" {params}"),
+                ]);
             }
             match &search.best {
                 Some(b) => println!("best: {} with {}", b.arrangement, b.values.iter().map(|(p, v)| format!("{p}={v}")).collect::<Vec<_>>().join(" ")),

@@ -1,6 +1,7 @@
 //! `lpc stability`: the contact model's stability map (step size x impact speed).
 
 use crate::args::{print_json, Format};
+use crate::table::{right, Table};
 use crate::exit::{ExitStatus, Result};
 
 #[derive(clap::Args)]
@@ -20,21 +21,20 @@ pub fn run(a: Args) -> Result<ExitStatus> {
             for case in Case::ALL {
                 for config in CONFIGS {
                     println!("\n{} / {}", case.name(), config.name);
-                    print!("{:>8}", "u \\ dt");
-                    for dt in DTS {
-                        print!(" {:>22}", format!("{dt:e}"));
-                    }
-                    println!();
+                    let mut columns = vec![right("u \\ dt", 8)];
+                    columns.extend(DTS.iter().map(|dt| right(format!("{dt:e}"), 22)));
+                    let table = Table::new(columns);
+                    table.print_header();
                     for speed in SPEEDS {
-                        print!("{speed:>8}");
+                        let mut row = vec![speed.to_string()];
                         for dt in DTS {
                             let c = cells
                                 .iter()
                                 .find(|c| c.case == case && c.config == config.name && c.dt == dt && c.speed == speed)
-                                .expect("cell");
-                            print!(" {:>22}", format!("{} {:+.1}", c.outcome, 100.0 * c.energy_error));
+                                .expect("the map has a cell for every case, setting, step and speed");
+                            row.push(format!("{} {:+.1}", c.outcome, 100.0 * c.energy_error));
                         }
-                        println!();
+                        table.print_row(&row);
                     }
                 }
             }

@@ -9,6 +9,7 @@ use lpc_damper::scene;
 use lpc_damper::Model;
 
 use crate::args::{invalid, override_scene, print_json, progress_bar, Format, RapierArgs};
+use crate::table::{right, Table};
 use crate::exit::{ExitStatus, Result};
 
 #[derive(clap::Args)]
@@ -101,24 +102,30 @@ pub fn run(a: Args) -> Result<ExitStatus> {
                 elapsed,
                 points.len() as f64 / elapsed
             );
-            let y_head = parameters.get(1).map_or(String::new(), |p| format!("{p:>12} "));
-            println!(
-                "{:>12} {y_head}{:>8} {:>12} {:>12} {:>10} {:>10} {:>9}",
-                parameters[0], "impacts", "peak xs mm", "peak a m/s2", "rms xs mm", "settle s", "E left %"
-            );
+            let mut columns: Vec<_> = parameters.iter().map(|p| right(p.as_str(), 12)).collect();
+            columns.extend([
+                right("impacts", 8),
+                right("peak xs mm", 12),
+                right("peak a m/s2", 12),
+                right("rms xs mm", 10),
+                right("settle s", 10),
+                right("E left %", 9),
+            ]);
+            let table = Table::new(columns);
+            table.print_header();
             for p in &points {
                 let m = &p.summary.metrics;
-                let y = p.value_y.map_or(String::new(), |v| format!("{v:>12} "));
-                println!(
-                    "{:>12} {y}{:>8} {:>12.4} {:>12.4} {:>10.4} {:>10} {:>9.3}",
-                    p.value,
-                    p.summary.impact_count,
-                    m.peak_displacement * 1e3,
-                    m.peak_acceleration,
-                    m.rms_displacement * 1e3,
+                let mut cells = vec![p.value.to_string()];
+                cells.extend(p.value_y.map(|v| v.to_string()));
+                cells.extend([
+                    p.summary.impact_count.to_string(),
+                    format!("{:.4}", m.peak_displacement * 1e3),
+                    format!("{:.4}", m.peak_acceleration),
+                    format!("{:.4}", m.rms_displacement * 1e3),
                     m.settling_time.map_or("-".into(), |t| format!("{t:.3}")),
-                    m.energy_remaining.unwrap_or(f64::NAN) * 100.0
-                );
+                    format!("{:.3}", m.energy_remaining.unwrap_or(f64::NAN) * 100.0),
+                ]);
+                table.print_row(&cells);
             }
             if let (Some(dir), 2) = (&a.out, axes.len()) {
                 println!("wrote sweep.json, sweep-map.png, sweep-map.svg to {}", dir.display());
