@@ -6,8 +6,9 @@ use crate::run::Run;
 use crate::scene::Scene;
 
 impl Model {
-    /// Runs the model on `scene`.
+    /// Runs the model on `scene`, after checking that its series fit in memory.
     pub fn simulate(self, scene: &Scene) -> Result<Run, ModelError> {
+        crate::run::check_memory(scene).map_err(ModelError::Refused)?;
         match self {
             Model::Reference => Ok(crate::reference::simulate(scene)?),
             Model::Rapier => crate::rapier::simulate(scene),

@@ -216,3 +216,81 @@ impl Run {
         }
     }
 }
+
+/// Bytes the series of a run of `scene` take in memory (and, as text, several times that in
+/// `series.csv`): each sample holds `t`, `xs`, `vs`, `a` and every ball's `x` and `v`, eight
+/// bytes each. Impacts add about 80 bytes each, which no scene's series comes near.
+pub fn series_bytes(scene: &Scene) -> f64 {
+    scene.sample_count() as f64 * (4.0 + 2.0 * scene.balls.len() as f64) * 8.0
+}
+
+/// Share of the memory available that a run's series may take: the rest is the model's own
+/// state, the impacts and the outputs being written.
+pub const MEMORY_SHARE: f64 = 0.8;
+
+/// Memory this process can still take, bytes: the least of the machine's available memory,
+/// what its control group's limit leaves, and what its address-space limit (`ulimit -v`)
+/// leaves; `None` where none of them can be read (the check is then skipped).
+pub fn available_memory() -> Option<f64> {
+    let read = |path: &str| std::fs::read_to_string(path).ok();
+    let field = |text: &str, key: &str| -> Option<f64> {
+        let line = text.lines().find(|l| l.starts_with(key))?;
+        line[key.len()..].split_whitespace().next()?.parse::<f64>().ok().map(|kb| kb * 1024.0)
+    };
+    let mut limits = vec![];
+    if let Some(meminfo) = read("/proc/meminfo") {
+        limits.extend(field(&meminfo, "MemAvailable:"));
+    }
+    if let (Some(max), Some(current)) = (read("/sys/fs/cgroup/memory.max"), read("/sys/fs/cgroup/memory.current")) {
+        if let (Ok(max), Ok(current)) = (max.trim().parse::<f64>(), current.trim().parse::<f64>()) {
+            limits.push((max - current).max(0.0));
+        }
+    }
+    #[cfg(unix)]
+    {
+        let mut limit = libc::rlimit { rlim_cur: 0, rlim_max: 0 };
+        // SAFETY: getrlimit writes into the struct it is given and reads nothing else.
+        if unsafe { libc::getrlimit(libc::RLIMIT_AS, &mut limit) } == 0 && limit.rlim_cur != libc::RLIM_INFINITY {
+            let used = read("/proc/self/status").and_then(|s| field(&s, "VmSize:")).unwrap_or(0.0);
+            limits.push((limit.rlim_cur as f64 - used).max(0.0));
+        }
+    }
+    limits.into_iter().reduce(f64::min)
+}
+
+/// Refuses, with the numbers, a run whose series would not fit in the memory left
+/// ([`MEMORY_SHARE`] of [`available_memory`]), before anything is allocated: otherwise the
+/// allocator aborts or the kernel kills the process without a word.
+pub fn check_memory(scene: &Scene) -> Result<(), String> {
+    let need = series_bytes(scene);
+    // Below this every machine the tool runs on has room, and the many short runs of a study
+    // skip reading /proc.
+    if need < 1e8 {
+        return Ok(());
+    }
+    let Some(available) = available_memory() else { return Ok(()) };
+    if need <= MEMORY_SHARE * available {
+        return Ok(());
+    }
+    Err(format!(
+        "scene `{}`: its series would take {} of memory ({} samples x {} balls, {} bytes each), more than {:.0} % \
+         of the {} this process can still use; raise run.sample_dt, shorten the horizon or use fewer balls",
+        scene.name,
+        bytes_for_people(need),
+        crate::scene::human(scene.sample_count() as f64),
+        scene.balls.len(),
+        (4 + 2 * scene.balls.len()) * 8,
+        100.0 * MEMORY_SHARE,
+        bytes_for_people(available)
+    ))
+}
+
+/// `3.2 GB`, `512 MB`, `40 kB`.
+fn bytes_for_people(b: f64) -> String {
+    match b {
+        b if b >= 1e12 => format!("{:.1} TB", b / 1e12),
+        b if b >= 1e9 => format!("{:.1} GB", b / 1e9),
+        b if b >= 1e6 => format!("{:.0} MB", b / 1e6),
+        b => format!("{:.0} kB", b / 1e3),
+    }
+}

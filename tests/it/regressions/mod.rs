@@ -6,6 +6,7 @@ mod closed_pipe;
 mod forced_ball_through_wall;
 mod loaded_contact_sinks;
 mod plugin_driven_by_app_update;
+mod series_beyond_memory;
 mod squeezed_ball_stops;
 mod stale_impulse_bounce;
 mod stiff_frame_rapier_step;
