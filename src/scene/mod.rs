@@ -564,6 +564,12 @@ pub struct Overrides {
     pub solver_iterations: Option<u32>,
     /// `--ccd`: Rapier's swept CCD on the balls.
     pub ccd: bool,
+    /// `--kind`: force or base motion (a scene without `[forcing]` gets one).
+    pub forcing_kind: Option<ForcingKind>,
+    /// `--amplitude`: the forcing's amplitude, N or m.
+    pub forcing_amplitude: Option<f64>,
+    /// The forcing frequency, Hz (a study that sweeps it gives where it starts).
+    pub forcing_frequency: Option<f64>,
 }
 
 impl Overrides {
@@ -575,6 +581,8 @@ impl Overrides {
             ("run.sample_dt", "--sample-dt", self.sample_dt.is_some()),
             ("rapier.dt", "--dt", self.dt.is_some()),
             ("rapier.solver_iterations", "--solver-iterations", self.solver_iterations.is_some()),
+            ("forcing.amplitude", "--amplitude", self.forcing_amplitude.is_some()),
+            ("forcing.frequency", "--freq", self.forcing_frequency.is_some()),
         ];
         let flags: Vec<_> = given.iter().filter(|g| g.2).map(|&(field, flag, _)| (field, flag)).collect();
         let v = Validator { file, flags: &flags };
@@ -590,7 +598,24 @@ impl Overrides {
             },
             &v,
         )?;
-        Ok(Scene { horizon, sample_dt, rapier, ..scene })
+        let given = self.forcing_kind.is_some() || self.forcing_amplitude.is_some() || self.forcing_frequency.is_some();
+        let forcing = match (given, scene.frame) {
+            (false, _) => scene.forcing,
+            (true, None) => {
+                let flag = if self.forcing_kind.is_some() { "--kind" } else { "--amplitude" };
+                return Err(v.err(flag, "needs a damper scene (one with a [frame] to force)"));
+            }
+            (true, Some(frame)) => {
+                let old = scene.forcing;
+                let g = format::ForcingFile {
+                    kind: self.forcing_kind.or(old.map(|g| g.kind)).unwrap_or(ForcingKind::Force),
+                    amplitude: self.forcing_amplitude.or(old.map(|g| g.amplitude)).unwrap_or(0.0),
+                    frequency: self.forcing_frequency.or(old.map(|g| g.frequency)).unwrap_or(1.0),
+                };
+                Some(forcing(&g, &frame, &v)?)
+            }
+        };
+        Ok(Scene { horizon, sample_dt, rapier, forcing, ..scene })
     }
     /// The Rapier flags alone against the file's rules (for commands that take lists of them
     /// before any scene is loaded); an error names the flag.

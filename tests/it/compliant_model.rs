@@ -9,6 +9,7 @@
 //! scales (its Hertz length and speed); an impact takes about 10^2 steps, so quantities set
 //! by one impact are good to about 1e-7 relative and are checked at 1e-6.
 
+use crate::common;
 use lpc_damper::studies::compare::errors;
 use lpc_damper::compliant::{self, contact, Options, DEFAULT_TOLERANCE};
 use lpc_damper::reference::impact_law;
@@ -35,29 +36,10 @@ fn hertz(r1: f64, r2: Option<f64>) -> f64 {
 
 /// Free balls on a line: `masses` left to right, `gap` apart, the first moving right at `v`.
 fn free_balls(masses: &[f64], gap: f64, v: f64, e: f64, horizon: f64) -> Scene {
-    let balls: Vec<Ball> = masses.iter().map(|&m| ball(m)).collect();
-    let mut positions = vec![0.0];
-    for i in 1..balls.len() {
-        positions.push(positions[i - 1] + balls[i - 1].radius + gap + balls[i].radius);
-    }
-    let mut velocities = vec![0.0; balls.len()];
-    velocities[0] = v;
-    Scene {
-        name: "free-balls".into(),
-        frame: None,
-        container: None,
-        reference_radius: balls[0].radius,
-        balls,
-        restitution: e,
-        initial_displacement: 0.0,
-        initial_positions: positions,
-        initial_velocities: velocities,
-        horizon,
-        sample_dt: horizon / 10.0,
-        rapier: RapierSettings::default(),
-        compliant: CompliantSettings::default(),
-        forcing: None,
-    }
+    let mut speeds = vec![0.0; masses.len()];
+    speeds[0] = v;
+    let gaps = vec![gap; masses.len().saturating_sub(1)];
+    common::free_chain(masses.iter().map(|&m| ball(m)).collect(), &gaps, &speeds, e, horizon, horizon / 10.0)
 }
 
 /// One ball of mass `m` in a container on `frame`, `clearance` from the wall it moves towards

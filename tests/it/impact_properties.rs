@@ -4,7 +4,7 @@
 use crate::common;
 
 use lpc_damper::reference::{impact_law, simulate};
-use lpc_damper::scene::{ball_radius, Ball, BallKind, RapierSettings, Scene};
+use lpc_damper::scene::{ball_radius, Ball, BallKind, Scene};
 use proptest::prelude::*;
 
 proptest! {
@@ -28,33 +28,8 @@ proptest! {
 }
 
 fn free_chain(masses: &[f64], gaps: &[f64], speeds: &[f64], e: f64) -> Scene {
-    let balls: Vec<Ball> =
-        masses.iter().map(|&m| Ball { mass: m, radius: ball_radius(m, 8000.0), kind: BallKind::Custom }).collect();
-    let mut x = 0.0;
-    let mut positions = Vec::new();
-    for (i, b) in balls.iter().enumerate() {
-        if i > 0 {
-            x += gaps[i - 1] + b.radius;
-        }
-        positions.push(x);
-        x += b.radius;
-    }
-    Scene {
-        name: "random-chain".into(),
-        frame: None,
-        container: None,
-        balls,
-        restitution: e,
-        initial_displacement: 0.0,
-        initial_positions: positions,
-        initial_velocities: speeds.to_vec(),
-        horizon: 1.0,
-        sample_dt: 1e-2,
-        rapier: RapierSettings::default(),
-        compliant: Default::default(),
-        forcing: None,
-        reference_radius: 0.01,
-    }
+    let balls = masses.iter().map(|&m| Ball { mass: m, radius: ball_radius(m, 8000.0), kind: BallKind::Custom }).collect();
+    common::free_chain(balls, gaps, speeds, e, 1.0, 1e-2)
 }
 
 proptest! {

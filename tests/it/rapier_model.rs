@@ -8,7 +8,7 @@ use lpc_damper::studies::compare::errors;
 use lpc_damper::output::files::{impacts_csv, series_csv};
 use lpc_damper::output::RunSummary;
 use lpc_damper::reference::impact_law;
-use lpc_damper::scene::{ball_radius, load_scene, scenes_dir, Ball, BallKind, Frame, RapierSettings, Scene};
+use lpc_damper::scene::{ball_radius, load_scene, scenes_dir, Ball, BallKind, Frame, Scene};
 use lpc_damper::Model;
 
 /// Ball velocities live in f32 inside Rapier: a few roundings of 6e-8 each, plus the solver's
@@ -36,23 +36,7 @@ fn two_balls(v0: f64, gap: f64) -> Scene {
         Ball { mass: 0.11, radius: ball_radius(0.11, 8000.0), kind: BallKind::Large },
         Ball { mass: 0.011, radius: ball_radius(0.011, 8000.0), kind: BallKind::Small },
     ];
-    let x2 = balls[0].radius + gap + balls[1].radius;
-    Scene {
-        name: "two-balls".into(),
-        frame: None,
-        container: None,
-        balls,
-        restitution: 0.9,
-        initial_displacement: 0.0,
-        initial_positions: vec![0.0, x2],
-        initial_velocities: vec![v0, 0.0],
-        horizon: 0.02,
-        sample_dt: 1e-3,
-        rapier: RapierSettings::default(),
-        compliant: Default::default(),
-        forcing: None,
-        reference_radius: 0.0149,
-    }
+    common::free_chain(balls, &[gap], &[v0, 0.0], 0.9, 0.02, 1e-3)
 }
 
 #[test]

@@ -53,6 +53,7 @@ impl RapierArgs {
             dt: self.dt,
             solver_iterations: self.solver_iterations,
             ccd: self.ccd,
+            ..Overrides::default()
         }
     }
 }

@@ -61,6 +61,31 @@ pub fn damper(frame: Frame, xs0: f64, masses: &[f64], e: f64, gap: f64, clearanc
     }
 }
 
+/// Free balls on a line (no frame): `balls` left to right, `gaps[i]` between ball `i` and
+/// ball `i + 1`, the first centred at 0, moving at `speeds`.
+pub fn free_chain(balls: Vec<Ball>, gaps: &[f64], speeds: &[f64], e: f64, horizon: f64, sample_dt: f64) -> Scene {
+    let mut positions: Vec<f64> = Vec::with_capacity(balls.len());
+    for (i, b) in balls.iter().enumerate() {
+        positions.push(if i == 0 { 0.0 } else { positions[i - 1] + balls[i - 1].radius + gaps[i - 1] + b.radius });
+    }
+    Scene {
+        name: "free-chain".into(),
+        frame: None,
+        container: None,
+        reference_radius: balls.first().map_or(0.0, |b| b.radius),
+        balls,
+        restitution: e,
+        initial_displacement: 0.0,
+        initial_positions: positions,
+        initial_velocities: speeds.to_vec(),
+        horizon,
+        sample_dt,
+        rapier: RapierSettings::default(),
+        compliant: Default::default(),
+        forcing: None,
+    }
+}
+
 /// Every scene file shipped in `scenes/`, expanded: damper scenes, every sweep value and every
 /// chain case.
 pub fn all_paper_scenes() -> Vec<Scene> {

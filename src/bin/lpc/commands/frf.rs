@@ -6,7 +6,7 @@ use anyhow::Context;
 use clap::ValueEnum;
 
 use lpc_damper::output::write_atomic;
-use lpc_damper::scene;
+use lpc_damper::scene::{self, Overrides};
 use lpc_damper::Model;
 
 use crate::args::{invalid, load_scene, parse_range, print_json, progress_bar, Format, RapierArgs};
@@ -50,27 +50,22 @@ enum ForcingKindArg {
 }
 
 pub fn run(a: Args) -> Result<ExitStatus> {
-    let mut scene = load_scene(&a.scene, a.rapier.overrides(None, None))?;
+    let scene = load_scene(&a.scene, a.rapier.overrides(None, None))?;
     let (from, to) = parse_range(&a.freq, &a.scene, "--freq")?;
     let invalid = |field: &str, rule: String| invalid(&a.scene, field, rule);
     if a.steps == 0 || a.steps > 10_000 {
         return Err(invalid("--steps", format!("must lie in 1..=10000 (got {})", a.steps)).into());
     }
-    if a.kind.is_some() || a.amplitude.is_some() {
-        let g = scene.forcing.get_or_insert(scene::Forcing { kind: scene::ForcingKind::Force, amplitude: 0.0, frequency: from });
-        if let Some(k) = a.kind {
-            g.kind = match k {
-                ForcingKindArg::Force => scene::ForcingKind::Force,
-                ForcingKindArg::Base => scene::ForcingKind::Base,
-            };
-        }
-        if let Some(x) = a.amplitude {
-            if !(x.is_finite() && x > 0.0) {
-                return Err(invalid("--amplitude", format!("must be a positive number (got {x})")).into());
-            }
-            g.amplitude = x;
-        }
-    }
+    let forcing = Overrides {
+        forcing_kind: a.kind.map(|k| match k {
+            ForcingKindArg::Force => scene::ForcingKind::Force,
+            ForcingKindArg::Base => scene::ForcingKind::Base,
+        }),
+        forcing_amplitude: a.amplitude,
+        forcing_frequency: (a.kind.is_some() || a.amplitude.is_some()).then_some(from),
+        ..Overrides::default()
+    };
+    let scene = forcing.apply(scene, &a.scene.display().to_string())?;
     let Some(g) = scene.forcing else {
         return Err(invalid("forcing", "is missing: give the scene a [forcing] table, or --kind and --amplitude".into()).into());
     };
