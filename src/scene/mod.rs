@@ -76,6 +76,18 @@ impl Frame {
     pub fn energy(&self, xs: f64, vs: f64) -> f64 {
         0.5 * self.mass * vs * vs + 0.5 * self.stiffness * xs * xs
     }
+    /// The natural frequency (Hz) at which driving this frame has no steady state: an undamped
+    /// frame's, when it lies in `[from, to]` Hz (within 1e-12 relative, the round-off of
+    /// `ks - ms w^2`); `None` otherwise. The one statement of that rule, for a scene's forcing
+    /// (`from == to`) and a frequency sweep alike.
+    pub fn resonance_without_steady_state(&self, from: f64, to: f64) -> Option<f64> {
+        if self.damping != 0.0 || self.stiffness <= 0.0 {
+            return None;
+        }
+        let natural = (self.stiffness / self.mass).sqrt() / (2.0 * PI);
+        let slack = 0.5e-12 * natural;
+        (from - slack <= natural && natural <= to + slack).then_some(natural)
+    }
     /// `T = 2 pi / omega_d`, or 0 when the bare frame does not oscillate.
     pub fn damped_period(&self) -> f64 {
         self.damped_omega().map_or(0.0, |w| 2.0 * PI / w)
@@ -779,9 +791,7 @@ fn forcing(g: &format::ForcingFile, frame: &Frame, v: &Validator) -> Result<Forc
     let frequency = v.positive("forcing.frequency", g.frequency)?;
     let forcing = Forcing { kind: g.kind, amplitude, frequency };
     // An undamped frame driven exactly at resonance has no bounded particular solution.
-    let w = forcing.omega();
-    let detuning = frame.stiffness - frame.mass * w * w;
-    if frame.damping == 0.0 && detuning.abs() <= 1e-12 * frame.stiffness {
+    if frame.resonance_without_steady_state(frequency, frequency).is_some() {
         return Err(v.err(
             "forcing.frequency",
             &format!("({frequency} Hz) drives an undamped frame exactly at resonance: its amplitude grows without bound"),

@@ -160,4 +160,12 @@ fn the_frf_command_writes_its_table_and_plot() {
     let (code, _, stderr) = lpc(&["frf", bare.to_str().unwrap(), "--freq", "5..3", "--amplitude", "1"]);
     assert_eq!(code, 2, "{stderr}");
     assert!(stderr.contains("--freq"), "{stderr}");
+    // An undamped frame has no steady state at its natural frequency (4.0 Hz): a sweep over
+    // it is refused by the same rule as a scene forced there.
+    let dir = tempfile::tempdir().unwrap();
+    let undamped = dir.path().join("undamped.toml");
+    std::fs::write(&undamped, std::fs::read_to_string(&bare).unwrap().replace("damping = 1.092", "damping = 0.0")).unwrap();
+    let (code, _, stderr) = lpc(&["frf", undamped.to_str().unwrap(), "--freq", "3..5", "--amplitude", "1"]);
+    assert_eq!(code, 2, "{stderr}");
+    assert!(stderr.contains("--freq") && stderr.contains("resonance"), "{stderr}");
 }

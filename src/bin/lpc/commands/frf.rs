@@ -72,12 +72,12 @@ pub fn run(a: Args) -> Result<ExitStatus> {
     if g.amplitude == 0.0 {
         return Err(invalid("forcing.amplitude", "is 0: give --amplitude".into()).into());
     }
-    if let Some(f) = scene.frame {
-        // An undamped frame driven at resonance has no steady state (scene validation's rule).
-        let w0 = (f.stiffness / f.mass).sqrt() / (2.0 * std::f64::consts::PI);
-        if f.damping == 0.0 && from <= w0 && w0 <= to {
-            return Err(invalid("--freq", format!("{from}..{to} Hz contains the undamped frame's resonance {w0:.6} Hz, where no steady state exists")).into());
-        }
+    if let Some(natural) = scene.frame.and_then(|f| f.resonance_without_steady_state(from, to)) {
+        return Err(invalid(
+            "--freq",
+            format!("{from}..{to} Hz contains the undamped frame's resonance {natural:.6} Hz, where no steady state exists"),
+        )
+        .into());
     }
     let freqs = lpc_damper::studies::frf::frequencies(from, to, a.steps);
     let bar = progress_bar(2 * freqs.len(), "frf");
