@@ -29,7 +29,7 @@ pub fn frame_delay(fps: f64) -> u16 {
 pub fn write_gif(frames: &[PathBuf], fps: f64, out: &Path) -> Result<(), RenderError> {
     let err = |path: &Path, reason: String| RenderError::Write { path: path.display().to_string(), reason };
     let Some(first) = frames.first() else { return Ok(()) };
-    let (width, height, _) = read_rgb(first).map_err(|reason| err(first, reason))?;
+    let (width, height, first_rgb) = read_rgb(first).map_err(|reason| err(first, reason))?;
     let (Ok(w), Ok(h)) = (u16::try_from(width), u16::try_from(height)) else {
         return Err(err(out, format!("a {width}x{height} frame is larger than a GIF can hold (65535x65535)")));
     };
@@ -38,8 +38,10 @@ pub fn write_gif(frames: &[PathBuf], fps: f64, out: &Path) -> Result<(), RenderE
     let file = File::create(&tmp).map_err(|e| err(&tmp, e.to_string()))?;
     let mut encoder = gif::Encoder::new(BufWriter::new(file), w, h, &[]).map_err(gif_err)?;
     encoder.set_repeat(gif::Repeat::Infinite).map_err(gif_err)?;
-    for path in frames {
-        let (fw, fh, rgb) = read_rgb(path).map_err(|reason| err(path, reason))?;
+    // The first frame is decoded once: it gave the size and is the animation's first image.
+    let rest = frames[1..].iter().map(|path| read_rgb(path).map(|f| (path, f)).map_err(|reason| err(path, reason)));
+    for decoded in std::iter::once(Ok((first, (width, height, first_rgb)))).chain(rest) {
+        let (path, (fw, fh, rgb)) = decoded?;
         if (fw, fh) != (width, height) {
             return Err(err(path, format!("is {fw}x{fh}, the first frame {width}x{height}")));
         }
