@@ -9,7 +9,7 @@ use crate::common::lpc;
 fn a_very_stiff_frame_runs_in_the_contact_model() {
     for stiffness in ["1e10", "1e12"] {
         let dir = tempfile::tempdir().unwrap();
-        let text = std::fs::read_to_string(std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/lpc-lsl.toml"))
+        let text = std::fs::read_to_string(lpc_damper::scene::scenes_dir().join("lpc-lsl.toml"))
             .unwrap()
             .replace("stiffness = 865.0", &format!("stiffness = {stiffness}"));
         assert!(text.contains(stiffness), "the scene file sets the stiffness");
