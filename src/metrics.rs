@@ -1,7 +1,10 @@
-//! Headline metrics of docs/MODEL.md §7, computed from a [`Run`]'s samples once, the same way for
-//! every model: peaks after one bare period, RMS, settling time, energy remaining.
+//! Headline metrics of docs/MODEL.md §7, the same way for every model: peaks after one bare
+//! period, RMS, settling time, energy remaining, dissipation times. Those that read the sampled
+//! motion are tallied sample by sample as a model runs ([`SampleTally`]), so a run that keeps no
+//! series (an ensemble member) has exactly the metrics of one that does.
 
 use crate::run::Run;
+use crate::scene::Scene;
 
 /// Fraction of `|xs0|` that counts as settled.
 pub const SETTLING_FRACTION: f64 = 0.05;
@@ -19,6 +22,13 @@ pub struct Metrics {
     pub settling_time: Option<f64>,
     /// Mechanical energy at the horizon / initial energy (`None` when the initial energy is 0).
     pub energy_remaining: Option<f64>,
+    /// First sampled time at which the mechanical energy has fallen to 10 % of its initial
+    /// value (`None` when forced, when the initial energy is 0, or not reached).
+    #[serde(default)]
+    pub dissipation_time_90: Option<f64>,
+    /// The same for 1 %.
+    #[serde(default)]
+    pub dissipation_time_99: Option<f64>,
     /// Largest contact force over all impacts, N (`None` for impulse models).
     #[serde(default)]
     pub peak_contact_force: Option<f64>,
@@ -70,13 +80,22 @@ pub struct Noise {
     pub peak_force: Option<Spread>,
 }
 
+/// Impacts per simulated second of `run` (0 for a run of no time).
+pub fn impact_rate(run: &Run) -> f64 {
+    if run.horizon > 0.0 {
+        run.impacts.len() as f64 / run.horizon
+    } else {
+        0.0
+    }
+}
+
 /// The noise proxy of `run`.
 pub fn noise(run: &Run) -> Noise {
     use crate::scene::Body;
     let i = &run.impacts;
     let on_wall = |b: Body| matches!(b, Body::LeftWall | Body::RightWall);
     Noise {
-        impact_rate: if run.horizon > 0.0 { i.len() as f64 / run.horizon } else { 0.0 },
+        impact_rate: impact_rate(run),
         energy_lost: Spread::of(i.iter().map(|x| x.energy_lost).collect()),
         wall_energy_lost: Spread::of(i.iter().filter(|x| on_wall(x.a) || on_wall(x.b)).map(|x| x.energy_lost).collect()),
         approach_speed: Spread::of(i.iter().map(|x| x.approach_speed).collect()),
@@ -86,29 +105,93 @@ pub fn noise(run: &Run) -> Noise {
 
 /// Computes the metrics of `run`.
 pub fn metrics(run: &Run) -> Metrics {
-    let s = &run.series;
-    let after_period = s.t.partition_point(|&t| t < run.damped_period);
-    let peak = |v: &[f64]| v[after_period.min(v.len())..].iter().fold(0.0f64, |m, x| m.max(x.abs()));
-    let rms = if s.is_empty() { 0.0 } else { (s.xs.iter().map(|x| x * x).sum::<f64>() / s.len() as f64).sqrt() };
+    let t = &run.tally;
     Metrics {
-        peak_displacement: peak(&s.xs),
-        peak_acceleration: peak(&s.a),
-        rms_displacement: rms,
-        settling_time: settling_time(&s.t, &s.xs, run.initial_displacement),
+        peak_displacement: t.peak_displacement,
+        peak_acceleration: t.peak_acceleration,
+        rms_displacement: if t.samples == 0 { 0.0 } else { (t.sum_sq / t.samples as f64).sqrt() },
+        settling_time: t.settling_time(),
         energy_remaining: (run.energy.initial != 0.0).then(|| run.energy.final_ / run.energy.initial),
+        dissipation_time_90: t.dissipated[0],
+        dissipation_time_99: t.dissipated[1],
         peak_contact_force: run.impacts.iter().filter_map(|i| i.peak_force).reduce(f64::max),
         peak_true_acceleration: run.peak_true_acceleration,
     }
 }
 
-/// The last sampled time at which `|xs| >= 5 % |xs0|`, or `None` if the last sample still is
-/// (not settled within the horizon). A series that never reaches the band settles at 0.
-pub fn settling_time(t: &[f64], xs: &[f64], xs0: f64) -> Option<f64> {
-    let band = SETTLING_FRACTION * xs0.abs();
-    match xs.iter().rposition(|x| x.abs() >= band) {
-        None => Some(0.0),
-        Some(i) if i + 1 == xs.len() => None,
-        Some(i) => Some(t[i]),
+/// Energy fractions left at which the dissipation times are read: 10 % and 1 %.
+pub const DISSIPATION_LEVELS: [f64; 2] = [0.1, 0.01];
+
+/// The metrics that read the sampled motion, accumulated sample by sample in time order:
+/// peaks of `|xs|` and `|a|` from one bare period on, the sum of `xs^2`, the last sample
+/// outside the settling band and the first samples at which the energy fell to each of
+/// [`DISSIPATION_LEVELS`].
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct SampleTally {
+    /// Peaks count from this time on (the bare frame's damped period), s.
+    from: f64,
+    /// `|xs|` at or above this is outside the settling band, m.
+    band: f64,
+    /// Initial mechanical energy when the dissipation times are watched (free vibration with
+    /// energy), else 0.
+    initial_energy: f64,
+    peak_displacement: f64,
+    peak_acceleration: f64,
+    sum_sq: f64,
+    samples: usize,
+    last_outside: Option<f64>,
+    last_is_outside: bool,
+    dissipated: [Option<f64>; 2],
+}
+
+impl SampleTally {
+    /// An empty tally for a run of `scene`.
+    pub fn new(scene: &Scene) -> Self {
+        let initial_energy = scene.initial_energy();
+        SampleTally {
+            from: scene.frame.map_or(0.0, |f| f.damped_period()),
+            band: SETTLING_FRACTION * scene.initial_displacement.abs(),
+            // Energy only falls in free vibration: a forced run has no dissipation time.
+            initial_energy: if scene.forcing.is_none() && initial_energy > 0.0 { initial_energy } else { 0.0 },
+            ..Default::default()
+        }
+    }
+    /// Whether the next sample's mechanical energy is still needed (a dissipation time is
+    /// still to be found): computing it costs a pass over the balls.
+    #[inline]
+    pub fn wants_energy(&self) -> bool {
+        self.initial_energy > 0.0 && self.dissipated[1].is_none()
+    }
+    /// Adds the sample at `t`: the frame's displacement and acceleration, and the mechanical
+    /// energy when [`SampleTally::wants_energy`] (ignored otherwise).
+    #[inline]
+    pub fn add(&mut self, t: f64, xs: f64, a: f64, energy: f64) {
+        if t >= self.from {
+            self.peak_displacement = self.peak_displacement.max(xs.abs());
+            self.peak_acceleration = self.peak_acceleration.max(a.abs());
+        }
+        self.sum_sq += xs * xs;
+        self.samples += 1;
+        self.last_is_outside = xs.abs() >= self.band;
+        if self.last_is_outside {
+            self.last_outside = Some(t);
+        }
+        if self.wants_energy() {
+            for (level, time) in DISSIPATION_LEVELS.iter().zip(&mut self.dissipated) {
+                if time.is_none() && energy <= level * self.initial_energy {
+                    *time = Some(t);
+                }
+            }
+        }
+    }
+    /// The last sampled time at which `|xs| >= 5 % |xs0|`, or `None` if the last sample still
+    /// is (not settled within the horizon). A series that never reaches the band settles at 0.
+    pub fn settling_time(&self) -> Option<f64> {
+        match self.last_outside {
+            None => Some(0.0),
+            Some(_) if self.last_is_outside => None,
+            t => t,
+        }
     }
 }
 
@@ -116,12 +199,28 @@ pub fn settling_time(t: &[f64], xs: &[f64], xs0: f64) -> Option<f64> {
 mod tests {
     use super::*;
 
+    fn settling_time(xs: &[f64]) -> Option<f64> {
+        let mut tally = SampleTally { band: SETTLING_FRACTION, ..Default::default() };
+        for (k, &x) in xs.iter().enumerate() {
+            tally.add(k as f64, x, 0.0, 0.0);
+        }
+        tally.settling_time()
+    }
+
     #[test]
     fn settling_is_last_time_outside_the_band() {
-        let t = [0.0, 1.0, 2.0, 3.0];
-        assert_eq!(settling_time(&t, &[1.0, -0.5, 0.01, 0.0], 1.0), Some(1.0));
-        assert_eq!(settling_time(&t, &[1.0, 0.0, 0.0, 0.06], 1.0), None);
-        assert_eq!(settling_time(&t, &[0.01, 0.0, 0.0, 0.0], 1.0), Some(0.0));
+        assert_eq!(settling_time(&[1.0, -0.5, 0.01, 0.0]), Some(1.0));
+        assert_eq!(settling_time(&[1.0, 0.0, 0.0, 0.06]), None);
+        assert_eq!(settling_time(&[0.01, 0.0, 0.0, 0.0]), Some(0.0));
+    }
+
+    #[test]
+    fn dissipation_times_are_the_first_samples_below_each_level() {
+        let mut tally = SampleTally { initial_energy: 1.0, ..Default::default() };
+        for (k, e) in [1.0, 0.5, 0.1, 0.2, 0.05, 0.01, 0.001].into_iter().enumerate() {
+            tally.add(k as f64, 0.0, 0.0, e);
+        }
+        assert_eq!(tally.dissipated, [Some(2.0), Some(5.0)]);
     }
 
     #[test]

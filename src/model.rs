@@ -2,17 +2,25 @@
 //! (the label [`Model`] itself lives with the outputs in `run`, which every model writes).
 
 pub use crate::run::Model;
-use crate::run::Run;
+use crate::run::{Record, Run};
 use crate::scene::Scene;
 
 impl Model {
     /// Runs the model on `scene`, after checking that its series fit in memory.
     pub fn simulate(self, scene: &Scene) -> Result<Run, ModelError> {
-        crate::run::check_memory(scene).map_err(ModelError::Refused)?;
+        self.simulate_recording(scene, Record::Series)
+    }
+
+    /// Runs the model on `scene`, keeping what `record` asks for (the series are checked
+    /// against the memory left only when kept).
+    pub fn simulate_recording(self, scene: &Scene, record: Record) -> Result<Run, ModelError> {
+        if record == Record::Series {
+            crate::run::check_memory(scene).map_err(ModelError::Refused)?;
+        }
         match self {
-            Model::Reference => Ok(crate::reference::simulate(scene)?),
-            Model::Rapier => crate::rapier::simulate(scene),
-            Model::Compliant => Ok(crate::compliant::simulate(scene)?),
+            Model::Reference => Ok(crate::reference::simulate_recording(scene, record)?),
+            Model::Rapier => crate::rapier::simulate_recording(scene, record),
+            Model::Compliant => Ok(crate::compliant::simulate_recording(scene, record)?),
         }
     }
 }

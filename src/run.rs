@@ -1,6 +1,7 @@
 //! The common output of every model: sampled series, impact list, energy account and wall
 //! time. Metrics, comparison and output read only this type, so models stay interchangeable.
 
+use crate::metrics::SampleTally;
 use crate::scene::{Body, Scene};
 
 /// A model of the damper.
@@ -76,14 +77,6 @@ impl Series {
             v: (0..balls).map(|_| Vec::with_capacity(samples)).collect(),
         }
     }
-    /// Appends the frame's part of the sample at `t` (the acceleration as every model reports
-    /// it, [`Scene::frame_acceleration`]); the caller appends each ball's.
-    pub fn push_frame(&mut self, scene: &Scene, t: f64, xs: f64, vs: f64) {
-        self.t.push(t);
-        self.xs.push(xs);
-        self.vs.push(vs);
-        self.a.push(scene.frame_acceleration(t, xs, vs));
-    }
     /// Number of samples.
     pub fn len(&self) -> usize {
         self.t.len()
@@ -91,6 +84,69 @@ impl Series {
     /// True when no sample was taken.
     pub fn is_empty(&self) -> bool {
         self.t.is_empty()
+    }
+}
+
+/// What a run keeps of its motion besides the metrics.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum Record {
+    /// The sampled series (`series.csv`, plots, comparisons of trajectories).
+    #[default]
+    Series,
+    /// Nothing but the metrics: a run that feeds only statistics (an ensemble member) builds
+    /// no series, so it needs no memory per sample.
+    MetricsOnly,
+}
+
+/// Where a model writes each sample: into the series when they are kept, and always into the
+/// [`SampleTally`], so that [`crate::metrics::metrics`] is the same, bit for bit, whether the
+/// series was kept or not.
+#[derive(Debug, Clone)]
+pub struct Recorder {
+    series: Option<Series>,
+    tally: SampleTally,
+    masses: Vec<f64>,
+}
+
+impl Recorder {
+    /// A recorder for a run of `scene` that keeps what `record` asks for.
+    pub fn new(scene: &Scene, record: Record) -> Self {
+        Recorder {
+            series: (record == Record::Series).then(|| Series::with_capacity(scene.balls.len(), scene.sample_count())),
+            tally: SampleTally::new(scene),
+            masses: scene.balls.iter().map(|b| b.mass).collect(),
+        }
+    }
+    /// The sample at `t`: the frame's state, and each ball's `(x, v)` from `ball(i)`. The
+    /// acceleration is the one every model reports, [`Scene::frame_acceleration`].
+    #[inline]
+    pub fn sample(&mut self, scene: &Scene, t: f64, xs: f64, vs: f64, ball: impl Fn(usize) -> (f64, f64)) {
+        let a = scene.frame_acceleration(t, xs, vs);
+        let wants_energy = self.tally.wants_energy();
+        let mut kinetic = 0.0;
+        if let Some(s) = &mut self.series {
+            s.t.push(t);
+            s.xs.push(xs);
+            s.vs.push(vs);
+            s.a.push(a);
+            for (i, m) in self.masses.iter().enumerate() {
+                let (x, v) = ball(i);
+                s.x[i].push(x);
+                s.v[i].push(v);
+                kinetic += 0.5 * m * v * v;
+            }
+        } else if wants_energy {
+            for (i, m) in self.masses.iter().enumerate() {
+                let v = ball(i).1;
+                kinetic += 0.5 * m * v * v;
+            }
+        }
+        let energy = if wants_energy { scene.frame_energy(t, xs, vs) + kinetic } else { 0.0 };
+        self.tally.add(t, xs, a, energy);
+    }
+    /// The series (empty when not kept) and the tally.
+    pub fn finish(self) -> (Series, SampleTally) {
+        (self.series.unwrap_or_default(), self.tally)
     }
 }
 
@@ -170,8 +226,10 @@ pub struct Run {
     pub initial_displacement: f64,
     /// Bare frame's damped period, s (0 when it does not oscillate).
     pub damped_period: f64,
-    /// Sampled motion.
+    /// Sampled motion (empty when the run kept only its metrics, [`Record::MetricsOnly`]).
     pub series: Series,
+    /// The metrics of the sampled motion, tallied as it was sampled.
+    pub tally: SampleTally,
     /// Every impact, in time order.
     pub impacts: Vec<Impact>,
     /// Energy account.
@@ -207,6 +265,7 @@ impl Run {
             initial_displacement: 0.0,
             damped_period: 0.0,
             series: Series::default(),
+            tally: SampleTally::default(),
             impacts: vec![],
             energy: EnergyAccount::default(),
             events: 0,

@@ -48,7 +48,7 @@ pub mod integrator;
 
 use std::time::Instant;
 
-use crate::run::{EnergyAccount, Impact, Run, Series};
+use crate::run::{EnergyAccount, Impact, Record, Recorder, Run};
 use crate::scene::{Body, Scene};
 use integrator::{bracketed_root, next_step, Dopri5};
 
@@ -73,11 +73,13 @@ pub struct Options {
     pub tolerance: f64,
     /// Most steps before the run is declared stalled.
     pub max_steps: u64,
+    /// What the run keeps besides its metrics.
+    pub record: Record,
 }
 
 impl Default for Options {
     fn default() -> Self {
-        Options { tolerance: DEFAULT_TOLERANCE, max_steps: MAX_STEPS }
+        Options { tolerance: DEFAULT_TOLERANCE, max_steps: MAX_STEPS, record: Record::Series }
     }
 }
 
@@ -122,6 +124,11 @@ pub enum CompliantError {
 /// Runs the compliant model on `scene` with the default options.
 pub fn simulate(scene: &Scene) -> Result<Run, CompliantError> {
     simulate_with(scene, Options::default())
+}
+
+/// [`simulate`], keeping what `record` asks for.
+pub fn simulate_recording(scene: &Scene, record: Record) -> Result<Run, CompliantError> {
+    simulate_with(scene, Options { record, ..Options::default() })
 }
 
 /// Runs the compliant model on `scene` with `options`.
@@ -407,7 +414,7 @@ struct Driver<'s, 'a> {
     /// Scratch state for samples.
     buf: Vec<f64>,
     impacts: Vec<Impact>,
-    series: Series,
+    recorder: Recorder,
     next_sample: usize,
     sample_count: usize,
     steps: u64,
@@ -441,7 +448,7 @@ impl<'s, 'a> Driver<'s, 'a> {
             contacts: vec![None; sys.pairs.len()],
             v_max: vec![0.0; sys.pairs.len()],
             impacts: Vec::new(),
-            series: Series::with_capacity(sys.n, samples),
+            recorder: Recorder::new(sys.scene, options.record),
             next_sample: 0,
             sample_count: samples,
             steps: 0,
@@ -692,12 +699,7 @@ impl<'s, 'a> Driver<'s, 'a> {
                 &buf
             };
             let (xs, vs) = if sys.has_frame() { (state[XS], state[VS]) } else { (0.0, 0.0) };
-            let s = &mut self.series;
-            s.push_frame(sys.scene, ts, xs, vs);
-            for i in 0..sys.n {
-                s.x[i].push(state[sys.x(i)]);
-                s.v[i].push(state[sys.v(i)]);
-            }
+            self.recorder.sample(sys.scene, ts, xs, vs, |i| (state[sys.x(i)], state[sys.v(i)]));
             self.next_sample += 1;
         }
         self.buf = buf;
@@ -794,6 +796,7 @@ impl<'s, 'a> Driver<'s, 'a> {
             self.y[sys.forcing_work()],
         );
         let final_velocities = (0..sys.n).map(|i| self.y[sys.v(i)]).collect();
+        let (series, tally) = self.recorder.finish();
         Ok(Run {
             scene: scene.name.clone(),
             model: crate::run::Model::Compliant,
@@ -801,7 +804,8 @@ impl<'s, 'a> Driver<'s, 'a> {
             sample_dt: scene.sample_dt,
             initial_displacement: scene.initial_displacement,
             damped_period: scene.frame.map_or(0.0, |f| f.damped_period()),
-            series: self.series,
+            series,
+            tally,
             impacts: self.impacts,
             energy,
             events: self.accepted,

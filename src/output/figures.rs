@@ -349,6 +349,53 @@ pub fn frf_chart(points: &[crate::studies::frf::FrfPoint], scene: &str, model: &
     }
 }
 
+/// Frequency response over an ensemble: the median and 5-95 % band of the per-period peaks,
+/// with and without the damper.
+pub fn frf_band_chart(bands: &[crate::studies::frf::FrfBand], scene: &str, model: &str) -> Figure {
+    use crate::studies::ensemble::Stats;
+    let curve = |label: String, stats: fn(&crate::studies::frf::FrfBand) -> &Stats, pick: fn(&Stats) -> Option<f64>| {
+        let known: Vec<(f64, f64)> = bands.iter().filter_map(|b| pick(stats(b)).map(|a| (b.frequency, a * 1e3))).collect();
+        Curve { label, x: known.iter().map(|k| k.0).collect(), y: known.iter().map(|k| k.1).collect() }
+    };
+    let mut curves = vec![];
+    type Pick = fn(&crate::studies::frf::FrfBand) -> &Stats;
+    let sides: [(&str, Pick); 2] = [("with damper", |b| &b.amplitude), ("without damper", |b| &b.amplitude_no_damper)];
+    for (what, stats) in sides {
+        curves.push(curve(format!("{what}: median"), stats, |s| s.median));
+        curves.push(curve(format!("{what}: 5 %"), stats, |s| s.p05));
+        curves.push(curve(format!("{what}: 95 %"), stats, |s| s.p95));
+    }
+    let members = bands.first().map_or(0, |b| b.members);
+    Figure {
+        name: "frf".into(),
+        title: format!("{scene}: per-period peaks over {members} members ({model})"),
+        x_desc: "forcing frequency (Hz)".into(),
+        y_desc: "peak of |xs| per period (mm)".into(),
+        curves,
+        points: true,
+    }
+}
+
+/// An ensemble's band of the frame displacement (5 %, median, 95 % of the members at each
+/// sample) over the nominal run.
+pub fn band_chart(nominal: &Run, band: &[[f64; 5]]) -> Figure {
+    let column = |j: usize| band.iter().map(|r| r[j] * if j == 0 { 1.0 } else { 1e3 }).collect::<Vec<f64>>();
+    let t = column(0);
+    Figure {
+        name: "band".into(),
+        title: format!("{}: frame displacement, nominal and the members' 5-95 % band ({})", nominal.scene, nominal.model),
+        x_desc: "t (s)".into(),
+        y_desc: "xs (mm)".into(),
+        curves: vec![
+            Curve { label: "nominal".into(), x: nominal.series.t.clone(), y: nominal.series.xs.iter().map(|x| x * 1e3).collect() },
+            Curve { label: "members: 5 %".into(), x: t.clone(), y: column(1) },
+            Curve { label: "members: median".into(), x: t.clone(), y: column(2) },
+            Curve { label: "members: 95 %".into(), x: t, y: column(3) },
+        ],
+        points: false,
+    }
+}
+
 /// Fig. 5: kinetic energy ratio against the number of large balls, with and without small
 /// balls between them.
 pub fn ker_chart(rows: &[KerRow], model: &str) -> Figure {
@@ -411,4 +458,27 @@ pub fn read_series_csv(path: &Path) -> Result<Series, FigureError> {
         }
     }
     Ok(s)
+}
+
+/// Reads the `band.csv` of `lpc run --ensemble --out` (`t, xs_p05, xs_median, xs_p95, env_p95`).
+pub fn read_band_csv(path: &Path) -> Result<Vec<[f64; 5]>, FigureError> {
+    let fail = |reason: String| FigureError { path: path.display().to_string(), reason };
+    let mut r = csv::Reader::from_path(path).map_err(|e| fail(e.to_string()))?;
+    let header = r.headers().map_err(|e| fail(e.to_string()))?.clone();
+    if header.iter().collect::<Vec<_>>() != ["t", "xs_p05", "xs_median", "xs_p95", "env_p95"] {
+        return Err(fail("is not a band.csv (expected columns t, xs_p05, xs_median, xs_p95, env_p95)".into()));
+    }
+    let mut rows = vec![];
+    for (line, rec) in r.records().enumerate() {
+        let rec = rec.map_err(|e| fail(e.to_string()))?;
+        let mut row = [0.0; 5];
+        for (k, x) in row.iter_mut().enumerate() {
+            *x = rec
+                .get(k)
+                .and_then(|v| v.parse::<f64>().ok())
+                .ok_or_else(|| fail(format!("row {}: column `{}` is not a number", line + 2, &header[k])))?;
+        }
+        rows.push(row);
+    }
+    Ok(rows)
 }

@@ -67,6 +67,16 @@ pub fn impacts_csv(run: &Run) -> Vec<u8> {
     w.into_inner().expect("writing to memory")
 }
 
+/// A CSV table of numbers under `header`; an undefined value (`None`) is an empty cell.
+pub fn table_csv(header: &[String], rows: impl IntoIterator<Item = Vec<Option<f64>>>) -> Vec<u8> {
+    let mut w = csv::Writer::from_writer(Vec::new());
+    w.write_record(header).expect("writing to memory");
+    for row in rows {
+        w.write_record(row.iter().map(|x| x.map_or(String::new(), |x| x.to_string()))).expect("writing to memory");
+    }
+    w.into_inner().expect("writing to memory")
+}
+
 /// Writes `series.csv`, `impacts.csv` and `summary.json` of `run` into `dir`.
 pub fn write_run_dir(run: &Run, dir: &Path) -> std::io::Result<()> {
     std::fs::create_dir_all(dir)?;

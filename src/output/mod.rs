@@ -11,7 +11,7 @@ use crate::metrics::{metrics, noise, Metrics, Noise};
 use crate::run::Run;
 use crate::scene::Scene;
 
-pub use files::{write_atomic, write_run_dir};
+pub use files::{table_csv, write_atomic, write_run_dir};
 
 /// One impact as in the JSON contract.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -108,6 +108,81 @@ impl RunSummary {
             wall_time_s: run.wall_time_s,
         }
     }
+}
+
+/// Every number of a run's summary that studies tabulate, map and draw distributions of.
+pub const SUMMARY_METRICS: &[&str] = &[
+    "peak_displacement",
+    "peak_acceleration",
+    "rms_displacement",
+    "settling_time",
+    "energy_remaining",
+    "dissipation_time_90",
+    "dissipation_time_99",
+    "peak_contact_force",
+    "peak_true_acceleration",
+    "impact_count",
+    "impact_loss",
+    "impact_rate",
+];
+
+/// The numbers of a run that studies tabulate, map and draw distributions of: its metrics and
+/// its impact totals ([`SUMMARY_METRICS`]).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Headline {
+    /// The metrics.
+    pub metrics: Metrics,
+    /// Number of impacts.
+    pub impact_count: usize,
+    /// Energy lost in impacts, J.
+    pub impact_loss: f64,
+    /// Impacts per simulated second.
+    pub impact_rate: f64,
+}
+
+impl Headline {
+    /// The headline of `run`, without building its summary (an ensemble member's).
+    pub fn of_run(run: &Run) -> Self {
+        Headline {
+            metrics: metrics(run),
+            impact_count: run.impacts.len(),
+            impact_loss: run.energy.impact_loss,
+            impact_rate: crate::metrics::impact_rate(run),
+        }
+    }
+    /// The headline of a run's summary.
+    pub fn of_summary(s: &RunSummary) -> Self {
+        Headline { metrics: s.metrics, impact_count: s.impact_count, impact_loss: s.energy.impact_loss, impact_rate: s.noise.impact_rate }
+    }
+    /// The value of metric `name` (one of [`SUMMARY_METRICS`]); `None` when the run has none
+    /// (not settled, no contact forces) or the name is unknown.
+    pub fn value(&self, name: &str) -> Option<f64> {
+        let m = &self.metrics;
+        match name {
+            "peak_displacement" => Some(m.peak_displacement),
+            "peak_acceleration" => Some(m.peak_acceleration),
+            "rms_displacement" => Some(m.rms_displacement),
+            "settling_time" => m.settling_time,
+            "energy_remaining" => m.energy_remaining,
+            "dissipation_time_90" => m.dissipation_time_90,
+            "dissipation_time_99" => m.dissipation_time_99,
+            "peak_contact_force" => m.peak_contact_force,
+            "peak_true_acceleration" => m.peak_true_acceleration,
+            "impact_count" => Some(self.impact_count as f64),
+            "impact_loss" => Some(self.impact_loss),
+            "impact_rate" => Some(self.impact_rate),
+            _ => None,
+        }
+    }
+    /// Every metric, in [`SUMMARY_METRICS`] order.
+    pub fn values(&self) -> Vec<Option<f64>> {
+        SUMMARY_METRICS.iter().map(|name| self.value(name)).collect()
+    }
+}
+
+/// The value of metric `name` (one of [`SUMMARY_METRICS`]) in `summary`.
+pub fn metric_value(summary: &RunSummary, name: &str) -> Option<f64> {
+    Headline::of_summary(summary).value(name)
 }
 
 fn noise_line(n: &Noise) -> String {

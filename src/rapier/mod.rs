@@ -24,10 +24,10 @@ use std::time::Instant;
 use bevy::prelude::*;
 
 use crate::model::ModelError;
-use crate::run::{EnergyAccount, Run};
+use crate::run::{EnergyAccount, Record, Run};
 use crate::scene::{Body, Scene};
 pub use plugin::{DamperSet, DamperStep, LpcDamperPlugins};
-pub use resources::{Bodies, DamperScene, FrameState, Recording, StepClock, StepPlan, StepSettings};
+pub use resources::{Bodies, DamperScene, FrameState, Keep, Recording, StepClock, StepPlan, StepSettings};
 pub use crate::scene::Stepping;
 
 /// Default stepping (from the accuracy study in docs/BENCHMARKS.md).
@@ -139,9 +139,19 @@ pub fn simulate(scene: &Scene) -> Result<Run, ModelError> {
 
 /// Runs the contact model on `scene` with `settings` as given (no step bound applied).
 pub fn simulate_with(scene: &Scene, settings: StepSettings) -> Result<Run, ModelError> {
+    run_app(scene, settings, Record::Series)
+}
+
+/// Runs the contact model on `scene`, keeping what `record` asks for.
+pub fn simulate_recording(scene: &Scene, record: Record) -> Result<Run, ModelError> {
+    run_app(scene, settings(scene), record)
+}
+
+fn run_app(scene: &Scene, settings: StepSettings, record: Record) -> Result<Run, ModelError> {
     can_represent(scene)?;
     let start = Instant::now();
     let mut app = headless_app(scene, settings);
+    app.insert_resource(Keep(record));
     // The first update spawns the scene, lets bevy_rapier create its bodies and takes the
     // first step; the rest run the lean step schedule alone.
     app.update();
@@ -176,6 +186,7 @@ pub fn collect(world: &mut World, scene: &Scene, steps: u64) -> Run {
         rec.impact_loss,
         frame.map_or(0.0, |f| f.forcing_work),
     );
+    let (series, tally) = rec.recorder.finish();
     Run {
         scene: scene.name.clone(),
         model: crate::run::Model::Rapier,
@@ -183,7 +194,8 @@ pub fn collect(world: &mut World, scene: &Scene, steps: u64) -> Run {
         sample_dt: scene.sample_dt,
         initial_displacement: scene.initial_displacement,
         damped_period: f.map_or(0.0, |f| f.damped_period()),
-        series: rec.series,
+        series,
+        tally,
         impacts: rec.impacts,
         energy,
         events: steps,

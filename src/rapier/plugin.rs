@@ -13,6 +13,7 @@ use super::record::{feedback, record_samples};
 use super::resources::*;
 use super::stepping::plan_step;
 use crate::oscillator::{gauss_legendre, Driven, Oscillator};
+use crate::run::Record;
 use crate::scene::Scene;
 
 /// A lean schedule holding one physics step and nothing else: the plug-in's systems and
@@ -273,7 +274,7 @@ impl Plugin for RecordPlugin {
     }
 }
 
-fn init_recording(mut commands: Commands, scene: Res<DamperScene>) {
+fn init_recording(mut commands: Commands, scene: Res<DamperScene>, keep: Option<Res<Keep>>) {
     commands.insert_resource(StepClock::default());
-    commands.insert_resource(Recording::new(&scene.0));
+    commands.insert_resource(Recording::new(&scene.0, keep.map_or(Record::Series, |k| k.0)));
 }

@@ -519,7 +519,6 @@ pub fn record_samples(
     mut rec: ResMut<Recording>,
 ) {
     let scene = &scene.0;
-    let n = scene.balls.len();
     let dt = plan.h;
     let t1 = clock.t;
     let t0 = t1 - dt;
@@ -538,21 +537,18 @@ pub fn record_samples(
             Some(fr) => fr.motion.state(fr.start.0, fr.start.1, fr.t_start, ts.max(fr.t_start)),
             None => (0.0, 0.0),
         };
-        let s = &mut rec.series;
-        s.push_frame(scene, ts, xs, vs);
-        for i in 0..n {
-            let (x, v) = if k == 0 {
+        let (x, v, prev_x, prev_v) = (&rec.x, &rec.v, &rec.prev_x, &rec.prev_v);
+        rec.recorder.sample(scene, ts, xs, vs, |i| {
+            if k == 0 {
                 (scene.initial_positions[i], scene.initial_velocities[i])
             } else if at_end {
-                (rec.x[i], rec.v[i])
+                (x[i], v[i])
             } else {
                 // Impulses land at the step's end: inside it, balls keep their old velocity.
                 let w = ((ts - t0) / dt).clamp(0.0, 1.0);
-                (rec.prev_x[i] + w * (rec.x[i] - rec.prev_x[i]), rec.prev_v[i])
-            };
-            rec.series.x[i].push(x);
-            rec.series.v[i].push(v);
-        }
+                (prev_x[i] + w * (x[i] - prev_x[i]), prev_v[i])
+            }
+        });
         rec.next_sample += 1;
     }
 }

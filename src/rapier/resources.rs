@@ -5,7 +5,7 @@
 use bevy::prelude::*;
 
 use crate::oscillator::Driven;
-use crate::run::{Impact, Series};
+use crate::run::{Impact, Record, Recorder};
 use crate::scene::{Scene, Stepping};
 
 /// Rapier's length unit: the balls are centimetres, so are the tolerances.
@@ -102,11 +102,15 @@ pub struct StepPlan {
     pub horizon: f64,
 }
 
+/// What a run keeps besides its metrics (the series unless told otherwise).
+#[derive(Resource, Debug, Clone, Copy, Default)]
+pub struct Keep(pub Record);
+
 /// What the contact model has recorded so far.
 #[derive(Resource, Debug, Clone)]
 pub struct Recording {
     /// Samples every `sample_dt`.
-    pub series: Series,
+    pub recorder: Recorder,
     /// Impacts, in time order.
     pub impacts: Vec<Impact>,
     /// Kinetic energy lost in contacts, J.
@@ -137,13 +141,13 @@ pub struct Recording {
 }
 
 impl Recording {
-    /// An empty recording for `scene`.
-    pub fn new(scene: &Scene) -> Self {
+    /// An empty recording for `scene` that keeps what `record` asks for.
+    pub fn new(scene: &Scene, record: Record) -> Self {
         let n = scene.balls.len();
         let samples = scene.sample_count();
         let m_min = scene.balls.iter().map(|b| b.mass).fold(f64::INFINITY, f64::min);
         Recording {
-            series: Series::with_capacity(n, samples),
+            recorder: Recorder::new(scene, record),
             impacts: Vec::new(),
             impact_loss: 0.0,
             x: scene.initial_positions.clone(),

@@ -38,7 +38,7 @@ use segment::*;
 
 use std::time::Instant;
 
-use crate::run::{EnergyAccount, Impact, Run, Series};
+use crate::run::{EnergyAccount, Impact, Record, Recorder, Run};
 use crate::scene::{Body, Scene};
 pub use impact_law::impact_law;
 pub use crate::oscillator::Oscillator;
@@ -115,8 +115,13 @@ const STICK_TIME: f64 = 1e-7;
 
 /// Runs the reference model on `scene`.
 pub fn simulate(scene: &Scene) -> Result<Run, ReferenceError> {
+    simulate_recording(scene, Record::Series)
+}
+
+/// [`simulate`], keeping what `record` asks for.
+pub fn simulate_recording(scene: &Scene, record: Record) -> Result<Run, ReferenceError> {
     let start = Instant::now();
-    let mut solver = Solver::new(scene);
+    let mut solver = Solver::new(scene, record);
     solver.run()?;
     let mut run = solver.finish();
     run.wall_time_s = start.elapsed().as_secs_f64();
@@ -191,14 +196,14 @@ struct Solver<'a> {
     impacts: Vec<Impact>,
     last_impact: Vec<Option<usize>>,
     events: u64,
-    series: Series,
+    recorder: Recorder,
     next_sample: usize,
     sample_count: usize,
     cursor: SampleCursor,
 }
 
 impl<'a> Solver<'a> {
-    fn new(scene: &'a Scene) -> Self {
+    fn new(scene: &'a Scene, record: Record) -> Self {
         let n = scene.balls.len();
         let (frame_mass, damping, stiffness) =
             scene.frame.map_or((f64::INFINITY, 0.0, 0.0), |f| (f.mass, f.damping, f.stiffness));
@@ -273,7 +278,7 @@ impl<'a> Solver<'a> {
             impacts: Vec::new(),
             last_impact: vec![None; n + 1],
             events: 0,
-            series: Series::with_capacity(n, samples),
+            recorder: Recorder::new(scene, record),
             next_sample: 0,
             sample_count: samples,
             cursor: SampleCursor { seg_t0: f64::NAN, k: 0, x: 0.0, v: 0.0, steps: 0, mass: f64::NAN, transition: [[0.0; 2]; 2] },

@@ -29,16 +29,11 @@ impl Solver<'_> {
             }
             let has_frame = self.has_frame();
             let (xs, vs) = if has_frame { self.frame_sample(ts) } else { (0.0, 0.0) };
-            let s = &mut self.series;
-            s.push_frame(self.scene, ts, xs, vs);
-            for i in 0..self.n {
-                let (x, v) = match self.hold[i] {
-                    Hold::Free => (self.x[i] + self.v[i] * (ts - self.t), self.v[i]),
-                    _ => (xs + self.offset[i], vs),
-                };
-                s.x[i].push(x);
-                s.v[i].push(v);
-            }
+            let (hold, x, v, offset, t) = (&self.hold, &self.x, &self.v, &self.offset, self.t);
+            self.recorder.sample(self.scene, ts, xs, vs, |i| match hold[i] {
+                Hold::Free => (x[i] + v[i] * (ts - t), v[i]),
+                _ => (xs + offset[i], vs),
+            });
             self.next_sample += 1;
         }
     }
@@ -95,6 +90,7 @@ impl Solver<'_> {
             self.impact_loss,
             self.forcing_work,
         );
+        let (series, tally) = self.recorder.finish();
         Run {
             scene: self.scene.name.clone(),
             model: crate::run::Model::Reference,
@@ -102,7 +98,8 @@ impl Solver<'_> {
             sample_dt: self.scene.sample_dt,
             initial_displacement: self.scene.initial_displacement,
             damped_period: self.scene.frame.map_or(0.0, |f| f.damped_period()),
-            series: self.series,
+            series,
+            tally,
             impacts: self.impacts,
             energy,
             events: self.events,

@@ -30,6 +30,77 @@ pub struct SceneFile {
     pub sweep: Option<SweepFile>,
     /// The chain experiment (KER), instead of a damper.
     pub chain: Option<ChainFile>,
+    /// Manufacturing tolerances: how an ensemble's members scatter about this scene.
+    pub tolerances: Option<TolerancesFile>,
+}
+
+/// `[tolerances]`: the spread of each parameter an ensemble draws (the `[sweep]` parameters),
+/// a half-width in the parameter's unit (lengths may be `"0.02 Rr"`), or the standard
+/// deviation when `distribution = "normal"`.
+#[derive(Debug, Clone, Deserialize, Serialize, Default)]
+#[serde(deny_unknown_fields)]
+pub struct TolerancesFile {
+    /// Each ball's initial gap, drawn independently; the container length is held (the
+    /// clearance takes up the sum).
+    pub gap: Option<Length>,
+    /// `Lc`.
+    pub clearance: Option<Length>,
+    /// `xs0`.
+    pub initial_displacement: Option<Length>,
+    /// `e`, one per member.
+    pub restitution: Option<Length>,
+    /// `m_L / m_S`.
+    pub mass_ratio: Option<Length>,
+    /// `m_L`, kg.
+    pub large_mass: Option<Length>,
+    /// kg/m^3.
+    pub density: Option<Length>,
+    /// `ms`, kg.
+    pub frame_mass: Option<Length>,
+    /// `ks`, N/m.
+    pub stiffness: Option<Length>,
+    /// `cs`, N s/m.
+    pub damping: Option<Length>,
+    /// Forcing amplitude, in its unit.
+    pub forcing_amplitude: Option<Length>,
+    /// Forcing frequency, Hz.
+    pub forcing_frequency: Option<Length>,
+    /// `"uniform"` (default; the value is the half-width) or `"normal"` (the standard deviation).
+    #[serde(default)]
+    pub distribution: Distribution,
+    /// Seed of the draws (default 1); `--seed` overrides it.
+    pub seed: Option<u64>,
+}
+
+impl TolerancesFile {
+    /// Each parameter with its spread as written, in [`crate::scene::SWEEP_PARAMETERS`] order.
+    pub fn spreads(&self) -> Vec<(&'static str, Option<Length>)> {
+        vec![
+            ("clearance", self.clearance),
+            ("gap", self.gap),
+            ("mass_ratio", self.mass_ratio),
+            ("restitution", self.restitution),
+            ("large_mass", self.large_mass),
+            ("density", self.density),
+            ("frame_mass", self.frame_mass),
+            ("stiffness", self.stiffness),
+            ("damping", self.damping),
+            ("initial_displacement", self.initial_displacement),
+            ("forcing_amplitude", self.forcing_amplitude),
+            ("forcing_frequency", self.forcing_frequency),
+        ]
+    }
+}
+
+/// How a tolerance spreads a parameter.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize, Serialize, Default)]
+#[serde(rename_all = "lowercase")]
+pub enum Distribution {
+    /// Uniform over nominal +- the value.
+    #[default]
+    Uniform,
+    /// Normal about the nominal with the value as standard deviation.
+    Normal,
 }
 
 /// `[frame]`: the spring-damped primary structure.

@@ -6,7 +6,7 @@ pub mod format;
 use std::f64::consts::PI;
 use std::path::{Path, PathBuf};
 
-pub use format::{Arrangement, ForcingKind, Length, SceneFile, Stepping};
+pub use format::{Arrangement, Distribution, ForcingKind, Length, SceneFile, Stepping};
 
 /// Default simulated time, s (docs/MODEL.md §8).
 pub const DEFAULT_HORIZON: f64 = 5.0;
@@ -363,6 +363,40 @@ pub struct Loaded {
     pub scene: Option<Scene>,
     /// The chain experiment, when the file has `[chain]`.
     pub chain: Option<Vec<ChainCase>>,
+    /// The damper's manufacturing tolerances, when the file has `[tolerances]`.
+    pub tolerances: Option<Tolerances>,
+}
+
+/// The validated `[tolerances]` of a damper scene: what an ensemble draws.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Tolerances {
+    /// Each parameter given, in [`SWEEP_PARAMETERS`] order, with its spread in the parameter's
+    /// unit (lengths in metres): the half-width, or the standard deviation when normal.
+    pub spreads: Vec<(&'static str, f64)>,
+    /// How the spreads are drawn.
+    pub distribution: Distribution,
+    /// Seed of the draws.
+    pub seed: u64,
+}
+
+/// Parameters measured in metres (a value or a spread may be written `"<k> Rr"`).
+pub const LENGTH_PARAMETERS: &[&str] = &["clearance", "gap", "initial_displacement"];
+
+fn tolerances(t: &format::TolerancesFile, parsed: &SceneFile, scene: &Scene, v: &Validator) -> Result<Tolerances, SceneError> {
+    let mut spreads = vec![];
+    for (name, spread) in t.spreads() {
+        let Some(spread) = spread else { continue };
+        let field = format!("tolerances.{name}");
+        let x = match spread {
+            Length::Rr(k) if LENGTH_PARAMETERS.contains(&name) => k * scene.reference_radius,
+            Length::Rr(_) => return Err(v.err(&field, &format!("is not a length: `{name}`'s spread must be a plain number"))),
+            Length::Metres(x) => x,
+        };
+        v.non_negative(&field, x)?;
+        apply_sweep_value(parsed, name, Length::Metres(0.0)).map_err(|rule| v.err(&field, &rule))?;
+        spreads.push((name, x));
+    }
+    Ok(Tolerances { spreads, distribution: t.distribution, seed: t.seed.unwrap_or(1) })
 }
 
 /// One chain of the KER experiment.
@@ -440,7 +474,12 @@ pub fn from_file(parsed: SceneFile, file: &str, default_name: &str) -> Result<Lo
     } else if parsed.sweep.is_some() {
         return Err(v.err("sweep", "needs a damper scene ([frame] and [balls])"));
     }
-    Ok(Loaded { file: parsed, path: file.to_string(), scene, chain })
+    let tolerances = match (&parsed.tolerances, &scene) {
+        (Some(t), Some(s)) => Some(tolerances(t, &parsed, s, &v)?),
+        (Some(_), None) => return Err(v.err("tolerances", "needs a damper scene ([frame] and [balls])")),
+        (None, _) => None,
+    };
+    Ok(Loaded { file: parsed, path: file.to_string(), scene, chain, tolerances })
 }
 
 /// Parameters a `[sweep]` may vary.
@@ -636,6 +675,19 @@ impl Overrides {
         let v = Validator { file: "(command line)", flags: &flags };
         let r = format::RapierFile { stepping: self.stepping, dt: self.dt, solver_iterations: self.solver_iterations, ccd: Some(self.ccd) };
         rapier_settings(&r, &v).map(drop)
+    }
+}
+
+/// `file` with the run, Rapier and forcing settings of `scene` (built from it, perhaps with
+/// [`Overrides`]): what a study that varies the file's other parameters rebuilds from, so that
+/// the command line's settings hold for every variant.
+pub fn with_settings_of(file: &SceneFile, scene: &Scene) -> SceneFile {
+    let r = scene.rapier;
+    SceneFile {
+        run: format::RunFile { horizon: Some(scene.horizon), sample_dt: Some(scene.sample_dt) },
+        rapier: format::RapierFile { stepping: r.stepping, dt: r.dt, solver_iterations: r.solver_iterations, ccd: r.ccd },
+        forcing: scene.forcing.map(|g| format::ForcingFile { kind: g.kind, amplitude: g.amplitude, frequency: g.frequency }),
+        ..file.clone()
     }
 }
 
@@ -914,12 +966,18 @@ fn build_chain(c: &format::ChainFile, run: &format::RunFile, name: &str, v: &Val
 /// Loads a file that must describe a damper scene.
 pub fn load_scene(path: impl AsRef<Path>) -> Result<Scene, SceneError> {
     let loaded = load(path)?;
-    let file = loaded.path.clone();
-    loaded.scene.ok_or(SceneError::Invalid {
-        file,
-        field: "frame".into(),
-        rule: "is missing: this command needs a damper scene, not a chain experiment".into(),
-    })
+    loaded.damper().cloned()
+}
+
+impl Loaded {
+    /// The damper scene, or an error saying the file describes a chain experiment.
+    pub fn damper(&self) -> Result<&Scene, SceneError> {
+        self.scene.as_ref().ok_or(SceneError::Invalid {
+            file: self.path.clone(),
+            field: "frame".into(),
+            rule: "is missing: this command needs a damper scene, not a chain experiment".into(),
+        })
+    }
 }
 
 /// The scenes directory shipped with the crate, for tests and `lpc check`.

@@ -19,6 +19,7 @@ use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
 use crate::model::{Model, ModelError};
+use crate::studies::ensemble::{Member, Stats};
 use crate::run::Run;
 use crate::scene::Scene;
 
@@ -66,15 +67,8 @@ pub struct SteadyState {
 
 /// Reads the steady amplitude of `run`, forced with period `period`.
 pub fn steady_state(run: &Run, period: f64) -> SteadyState {
-    let s = &run.series;
-    let periods = (run.horizon / period).floor() as usize;
-    let mut peaks = vec![0.0f64; periods];
-    for (t, x) in s.t.iter().zip(&s.xs) {
-        let k = (t / period) as usize;
-        if k < periods {
-            peaks[k] = peaks[k].max(x.abs());
-        }
-    }
+    let peaks = period_peaks(run, period);
+    let periods = peaks.len();
     // The measuring window: the last block, or every period when there are too few.
     let window = periods.min(BLOCK_PERIODS);
     let from = (periods - window) as f64 * period;
@@ -113,17 +107,103 @@ pub fn forced_at(scene: &Scene, frequency: f64) -> Scene {
 /// Runs `scene` with `model` until its response is steady (or the horizon has doubled
 /// [`MAX_DOUBLINGS`] times); returns the reading and the horizon used.
 pub fn steady_run(scene: &Scene, model: Model) -> Result<(SteadyState, f64), ModelError> {
+    steady_peaks(scene, model).map(|(reading, horizon, _)| (reading, horizon))
+}
+
+/// [`steady_run`], with the per-period peaks of the last two blocks of the last run.
+pub fn steady_peaks(scene: &Scene, model: Model) -> Result<(SteadyState, f64, Vec<f64>), ModelError> {
     let period = 1.0 / scene.forcing.expect("a forced scene").frequency;
     let mut s = scene.clone();
     for doubling in 0..=MAX_DOUBLINGS {
         let run = model.simulate(&s)?;
         let reading = steady_state(&run, period);
         if reading.steady || doubling == MAX_DOUBLINGS {
-            return Ok((reading, s.horizon));
+            let peaks = period_peaks(&run, period);
+            let last = peaks[peaks.len().saturating_sub(2 * BLOCK_PERIODS)..].to_vec();
+            return Ok((reading, s.horizon, last));
         }
         s.horizon *= 2.0;
     }
     unreachable!("the loop returns on its last pass")
+}
+
+/// The peak of `|xs|` in each whole forcing period of `run`.
+pub fn period_peaks(run: &Run, period: f64) -> Vec<f64> {
+    let s = &run.series;
+    let periods = (run.horizon / period).floor() as usize;
+    let mut peaks = vec![0.0f64; periods];
+    for (t, x) in s.t.iter().zip(&s.xs) {
+        let k = (t / period) as usize;
+        if k < periods {
+            peaks[k] = peaks[k].max(x.abs());
+        }
+    }
+    peaks
+}
+
+/// One frequency of an ensemble's frequency response (`lpc frf --ensemble`): the distribution
+/// of the per-period peaks of `|xs|` over the last two blocks of every member, with and
+/// without the damper. A response that never settles is described by its spread, not by one
+/// peak.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct FrfBand {
+    /// Hz.
+    pub frequency: f64,
+    /// Members.
+    pub members: usize,
+    /// Per-period peaks with the damper, m.
+    pub amplitude: Stats,
+    /// Per-period peaks of the bare frame, m.
+    pub amplitude_no_damper: Stats,
+    /// Members whose response with the damper was steady.
+    pub steady_members: usize,
+    /// Impacts per forcing period over the members' last blocks.
+    pub impacts_per_period: Stats,
+    /// The first member run that failed (its frequency then has no distribution).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub error: Option<String>,
+}
+
+/// The frequency response over `members`: each run per frequency with and without the damper,
+/// as [`frf`] runs the nominal scene (the horizon doubling until steady, or to its limit),
+/// every run in parallel.
+pub fn frf_ensemble(members: &[Member], frequencies: &[f64], model: Model, progress: &(dyn Fn() + Sync)) -> Vec<FrfBand> {
+    let jobs: Vec<(usize, usize, bool)> = (0..frequencies.len())
+        .flat_map(|k| (0..members.len()).flat_map(move |m| [(k, m, true), (k, m, false)]))
+        .collect();
+    let results: Vec<Result<(Vec<f64>, SteadyState), ModelError>> = jobs
+        .par_iter()
+        .map(|&(k, m, damper)| {
+            let scene = &members[m].scene;
+            let base = if damper { scene.clone() } else { scene.without_damper() };
+            let r = steady_peaks(&forced_at(&base, frequencies[k]), model).map(|(reading, _, peaks)| (peaks, reading));
+            progress();
+            r
+        })
+        .collect();
+    let per_frequency = 2 * members.len();
+    frequencies
+        .iter()
+        .enumerate()
+        .map(|(k, &frequency)| {
+            let runs = &results[k * per_frequency..(k + 1) * per_frequency];
+            let error = runs.iter().find_map(|r| r.as_ref().err()).map(|e| e.to_string());
+            let ok = |damper: bool| runs.iter().skip(if damper { 0 } else { 1 }).step_by(2).filter_map(|r| r.as_ref().ok());
+            let pooled = |damper: bool| match error {
+                Some(_) => Stats::default(),
+                None => Stats::of(ok(damper).flat_map(|(peaks, _)| peaks.iter().map(|&p| Some(p)))),
+            };
+            FrfBand {
+                frequency,
+                members: members.len(),
+                amplitude: pooled(true),
+                amplitude_no_damper: pooled(false),
+                steady_members: ok(true).filter(|(_, r)| r.steady).count(),
+                impacts_per_period: Stats::of(ok(true).map(|(_, r)| Some(r.impacts_per_period))),
+                error,
+            }
+        })
+        .collect()
 }
 
 /// `steps` frequencies evenly spaced from `from` to `to` (just `from` when `steps` is 1).

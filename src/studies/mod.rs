@@ -5,6 +5,7 @@ pub mod bench;
 pub mod chain;
 pub mod check;
 pub mod compare;
+pub mod ensemble;
 pub mod frf;
 pub mod optimize;
 pub mod stability;

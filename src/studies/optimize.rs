@@ -13,7 +13,9 @@ use serde::{Deserialize, Serialize};
 use super::StudyError;
 use crate::studies::frf;
 use crate::model::Model;
-use crate::scene::{self, Arrangement, Length, Loaded, SceneError};
+use crate::run::Record;
+use crate::scene::{self, Arrangement, Length, Loaded, Scene, SceneError};
+use crate::studies::ensemble;
 use crate::studies::sweep::Axis;
 
 /// Points per axis in each refinement.
@@ -44,8 +46,16 @@ pub struct Design {
     pub values: Vec<(String, f64)>,
     /// Clearance that follows from the container length, m.
     pub clearance: f64,
-    /// Objective (s or m); `None` when not settled.
+    /// Objective (s or m); `None` when not settled. Over an ensemble: the chosen quantile of
+    /// the members' objectives (a member that never settled counts as infinitely long).
     pub objective: Option<f64>,
+    /// Over an ensemble: the 5-95 % band of that quantile by bootstrap (given for the best
+    /// design and the runner-up).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub band: Option<(f64, f64)>,
+    /// Over an ensemble: each member's objective (infinite when not settled).
+    #[serde(skip)]
+    pub member_objectives: Vec<f64>,
 }
 
 /// The outcome of a search.
@@ -57,6 +67,22 @@ pub struct Search {
     pub ranking: Vec<Design>,
     /// Designs whose balls do not fit the container (or are otherwise invalid).
     pub infeasible: usize,
+    /// Over an ensemble: whether the best design is told apart from the runner-up (their
+    /// bootstrap bands do not overlap); `null` without an ensemble or a runner-up.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub distinguishable: Option<bool>,
+}
+
+/// Designs judged over ensembles: every design's members drawn under the scene's
+/// `[tolerances]`, ranked by a quantile of their objectives.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Robust {
+    /// Members per design.
+    pub members: usize,
+    /// Seed of the draws (default: the scene's).
+    pub seed: Option<u64>,
+    /// The quantile ranked by.
+    pub quantile: f64,
 }
 
 
@@ -70,6 +96,7 @@ pub fn optimize(
     objective: Objective,
     model: Model,
     refinements: u32,
+    robust: Option<Robust>,
     progress: &(dyn Fn() + Sync),
 ) -> Result<Search, StudyError> {
     let invalid = |field: &str, rule: String| SceneError::Invalid { file: loaded.path.clone(), field: field.into(), rule };
@@ -93,7 +120,7 @@ pub fn optimize(
         file.balls.as_mut().expect("checked").arrangement = Arrangement::Letters(arrangement.clone());
         let mut grid: Vec<Vec<Length>> = axes.iter().map(|a| a.values.clone()).collect();
         for pass in 0..=refinements {
-            let (designs, bad) = evaluate(loaded, &file, arrangement, axes, &grid, objective, model, progress)?;
+            let (designs, bad) = evaluate(loaded, &file, arrangement, axes, &grid, objective, model, robust, progress)?;
             infeasible += bad;
             let best = designs.iter().filter(|d| d.objective.is_some()).min_by(|a, b| cmp(a, b)).cloned();
             all.extend(designs);
@@ -133,7 +160,17 @@ pub fn optimize(
         })
     });
     all.dedup_by(|a, b| same(a, b));
-    Ok(Search { best: all.first().filter(|d| d.objective.is_some()).cloned(), ranking: all, infeasible })
+    let mut distinguishable = None;
+    if let Some(r) = robust {
+        let seed = r.seed.unwrap_or(ensemble::DEFAULT_SEED);
+        for d in all.iter_mut().take(2).filter(|d| d.objective.is_some()) {
+            d.band = ensemble::bootstrap_band(&d.member_objectives, r.quantile, seed);
+        }
+        if let [Some((_, best_hi)), Some((runner_lo, _))] = [all.first().and_then(|d| d.band), all.get(1).and_then(|d| d.band)] {
+            distinguishable = Some(best_hi < runner_lo);
+        }
+    }
+    Ok(Search { best: all.first().filter(|d| d.objective.is_some()).cloned(), ranking: all, infeasible, distinguishable })
 }
 
 /// Lower objective first; unsettled last.
@@ -151,6 +188,7 @@ fn evaluate(
     grid: &[Vec<Length>],
     objective: Objective,
     model: Model,
+    robust: Option<Robust>,
     progress: &(dyn Fn() + Sync),
 ) -> Result<(Vec<Design>, usize), StudyError> {
     let mut points: Vec<Vec<Length>> = vec![vec![]];
@@ -167,20 +205,40 @@ fn evaluate(
                     .map_err(|rule| SceneError::Invalid { file: loaded.path.clone(), field: axis.parameter.clone(), rule })?;
             }
             // A design whose balls do not fit is infeasible, not an error.
-            let Ok(valid) = scene::from_file(f, &loaded.path, &name) else {
+            let Ok(valid) = scene::from_file(f.clone(), &loaded.path, &name) else {
                 progress();
                 return Ok(None);
             };
-            let scene = valid.scene.expect("a damper scene");
-            let value = match objective {
-                Objective::SettlingTime => crate::metrics::metrics(&model.simulate(&scene)?).settling_time,
-                Objective::ResonantAmplitude { from, to, steps } => {
-                    let mut worst: f64 = 0.0;
-                    for f in frf::frequencies(from, to, steps) {
-                        let (reading, _) = frf::steady_run(&frf::forced_at(&scene, f), model)?;
-                        worst = worst.max(reading.amplitude);
+            let Some(scene) = valid.scene else {
+                progress();
+                return Ok(None);
+            };
+            let objective_of = |scene: &Scene| -> Result<Option<f64>, StudyError> {
+                Ok(match objective {
+                    Objective::SettlingTime => {
+                        crate::metrics::metrics(&model.simulate_recording(scene, Record::MetricsOnly)?).settling_time
                     }
-                    Some(worst)
+                    Objective::ResonantAmplitude { from, to, steps } => {
+                        let mut worst: f64 = 0.0;
+                        for f in frf::frequencies(from, to, steps) {
+                            let (reading, _) = frf::steady_run(&frf::forced_at(scene, f), model)?;
+                            worst = worst.max(reading.amplitude);
+                        }
+                        Some(worst)
+                    }
+                })
+            };
+            let (value, member_objectives) = match robust {
+                None => (objective_of(&scene)?, vec![]),
+                Some(r) => {
+                    let members = ensemble::draw(&f, &loaded.path, &scene, loaded.tolerances.as_ref(), r.members, r.seed)?;
+                    let values = ensemble::map_members(&members.members, |m| objective_of(&m.scene), &|| {})?;
+                    let mut values: Vec<f64> = values.into_iter().map(|v| v.unwrap_or(f64::INFINITY)).collect();
+                    let mut sorted = values.clone();
+                    sorted.sort_by(f64::total_cmp);
+                    let q = ensemble::quantile(&sorted, r.quantile);
+                    values.shrink_to_fit();
+                    (q.is_finite().then_some(q), values)
                 }
             };
             progress();
@@ -189,6 +247,8 @@ fn evaluate(
                 values: axes.iter().zip(point).map(|(a, v)| (a.parameter.clone(), v.raw())).collect(),
                 clearance: scene.container.map_or(0.0, |c| c.clearance),
                 objective: value,
+                band: None,
+                member_objectives,
             }))
         })
         .collect::<Result<_, StudyError>>()?;

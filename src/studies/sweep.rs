@@ -26,6 +26,31 @@ pub struct SweepPoint {
     pub summary: RunSummary,
 }
 
+/// One value of a sweep whose every point is an ensemble (`lpc sweep --ensemble`).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct EnsemblePoint {
+    /// Parameter name.
+    pub parameter: String,
+    /// Its value as written.
+    pub value: f64,
+    /// The second parameter of a grid.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub parameter_y: Option<String>,
+    /// Its value.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub value_y: Option<f64>,
+    /// Members.
+    pub members: usize,
+    /// Draws thrown away as invalid.
+    pub redraws: u64,
+    /// Each metric's distribution.
+    pub metrics: std::collections::BTreeMap<String, crate::studies::ensemble::Stats>,
+    /// The quantile the map and rankings read.
+    pub quantile: f64,
+    /// Each metric at that quantile.
+    pub at_quantile: std::collections::BTreeMap<String, Option<f64>>,
+}
+
 /// One swept parameter and its values.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Axis {
@@ -117,6 +142,8 @@ pub struct GridScene {
     pub values: Vec<f64>,
     /// The scene.
     pub scene: Scene,
+    /// The file it was built from (what an ensemble about it varies).
+    pub file: scene::SceneFile,
 }
 
 /// The scenes of a sweep over `axes` (the first varies fastest), each validated; an invalid
@@ -144,7 +171,7 @@ pub fn grid_scenes(loaded: &Loaded, axes: &[Axis]) -> Result<Vec<GridScene>, Sce
         .into_iter()
         .map(|(coords, file)| {
             let label = axes.iter().zip(&coords).map(|(ax, (_, v))| format!("{}={}", ax.parameter, v.raw())).collect::<Vec<_>>().join(",");
-            let mut s = scene::from_file(file, &loaded.path, &base)
+            let mut s = scene::from_file(file.clone(), &loaded.path, &base)
                 .map_err(|e| match e {
                     SceneError::Invalid { file, field, rule } => {
                         SceneError::Invalid { file, field: format!("sweep point {label} (as {field})"), rule }
@@ -154,7 +181,7 @@ pub fn grid_scenes(loaded: &Loaded, axes: &[Axis]) -> Result<Vec<GridScene>, Sce
                 .scene
                 .expect("damper scene");
             s.name = format!("{base}[{label}]");
-            Ok(GridScene { values: coords.iter().map(|(_, v)| v.raw()).collect(), scene: s })
+            Ok(GridScene { values: coords.iter().map(|(_, v)| v.raw()).collect(), scene: s, file })
         })
         .collect()
 }
@@ -173,7 +200,8 @@ pub fn run_sweep(
     progress: &(dyn Fn() + Sync),
 ) -> Result<Vec<SweepPoint>, ModelError> {
     let axes = [parameter.to_string()];
-    let grid: Vec<GridScene> = scenes.iter().map(|(v, s)| GridScene { values: vec![*v], scene: s.clone() }).collect();
+    let grid: Vec<GridScene> =
+        scenes.iter().map(|(v, s)| GridScene { values: vec![*v], scene: s.clone(), file: Default::default() }).collect();
     run_grid(&axes, &grid, model, progress)
 }
 
@@ -199,21 +227,5 @@ pub fn run_grid(
         .collect()
 }
 
-/// Metrics a design map can show.
-pub const MAP_METRICS: &[&str] =
-    &["settling_time", "energy_remaining", "peak_contact_force", "peak_displacement", "peak_acceleration", "rms_displacement", "impact_count"];
-
-/// The value of metric `name` in `summary` (`None` when the run has none, e.g. not settled).
-pub fn metric_value(summary: &RunSummary, name: &str) -> Option<f64> {
-    let m = &summary.metrics;
-    match name {
-        "settling_time" => m.settling_time,
-        "energy_remaining" => m.energy_remaining,
-        "peak_contact_force" => m.peak_contact_force,
-        "peak_displacement" => Some(m.peak_displacement),
-        "peak_acceleration" => Some(m.peak_acceleration),
-        "rms_displacement" => Some(m.rms_displacement),
-        "impact_count" => Some(summary.impact_count as f64),
-        _ => None,
-    }
-}
+/// Metrics a design map can show: every metric of a run's summary.
+pub use crate::output::{metric_value, SUMMARY_METRICS as MAP_METRICS};

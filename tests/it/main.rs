@@ -14,6 +14,7 @@ mod compliant_model;
 mod design_maps;
 mod determinism;
 mod energy_balance;
+mod ensembles;
 mod figures;
 mod forcing;
 mod fuzz_scene_files;

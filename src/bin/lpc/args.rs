@@ -6,7 +6,8 @@ use std::path::Path;
 use clap::ValueEnum;
 use indicatif::{ProgressBar, ProgressStyle};
 
-use lpc_damper::scene::{self, Overrides, Scene, SceneError, Stepping};
+use lpc_damper::scene::{self, Overrides, Scene, SceneError, SceneFile, Stepping, Tolerances};
+use lpc_damper::studies::ensemble::{self, Ensemble};
 
 use crate::exit::Result;
 
@@ -61,6 +62,61 @@ impl RapierArgs {
 /// The scene at `path` with `overrides` applied (and validated) by the scene module.
 pub fn load_scene(path: &Path, overrides: Overrides) -> std::result::Result<Scene, SceneError> {
     overrides.apply(scene::load_scene(path)?, &path.display().to_string())
+}
+
+/// `--ensemble N [--seed S]`: answer with distributions over members drawn under the scene's
+/// `[tolerances]`.
+#[derive(clap::Args, Clone, Copy, Default)]
+pub struct EnsembleArgs {
+    /// Run N members drawn under the scene's [tolerances] (in parallel) and report each
+    /// metric's distribution instead of one trajectory's value.
+    #[arg(long, value_name = "N")]
+    pub ensemble: Option<usize>,
+    /// Seed of the members' draws (default: the scene's tolerances.seed, else 1); member k's
+    /// draws depend only on (seed, k).
+    #[arg(long, requires = "ensemble")]
+    pub seed: Option<u64>,
+}
+
+/// `--quantile Q` of a study over ensembles (default the median), checked.
+pub fn quantile_arg(q: Option<f64>, path: &Path) -> std::result::Result<f64, SceneError> {
+    ensemble::check_quantile(q.unwrap_or(0.5)).map_err(|rule| invalid(path, "--quantile", rule))
+}
+
+/// A scene file with its nominal scene (`overrides` applied) and what an ensemble draws from.
+pub struct Nominal {
+    pub path: String,
+    pub file: SceneFile,
+    pub tolerances: Option<Tolerances>,
+    pub scene: Scene,
+}
+
+impl Nominal {
+    /// The members `e` asks for, drawn about `scene` (this nominal scene or one varied from
+    /// its file, as a sweep's point, with `file` the varied file); `None` without `--ensemble`.
+    pub fn ensemble_of(&self, e: EnsembleArgs, file: &SceneFile, scene: &Scene) -> std::result::Result<Option<Ensemble>, SceneError> {
+        e.ensemble
+            .map(|n| {
+                static NOTED: std::sync::Once = std::sync::Once::new();
+                if self.tolerances.is_none() {
+                    NOTED.call_once(|| eprintln!("note: {} has no [tolerances]: every member is the nominal scene", self.path));
+                }
+                ensemble::draw(file, &self.path, scene, self.tolerances.as_ref(), n, e.seed)
+            })
+            .transpose()
+    }
+    /// The members `e` asks for about the nominal scene.
+    pub fn ensemble(&self, e: EnsembleArgs) -> std::result::Result<Option<Ensemble>, SceneError> {
+        self.ensemble_of(e, &self.file, &self.scene)
+    }
+}
+
+/// The damper scene at `path` with `overrides` applied, with its file and tolerances.
+pub fn load_nominal(path: &Path, overrides: Overrides) -> std::result::Result<Nominal, SceneError> {
+    let loaded = scene::load(path)?;
+    let name = path.display().to_string();
+    let scene = overrides.apply(loaded.damper()?.clone(), &name)?;
+    Ok(Nominal { path: name, file: loaded.file, tolerances: loaded.tolerances, scene })
 }
 
 /// Replaces `scene` (one of a sweep's or a chain's) by itself with `overrides` applied and

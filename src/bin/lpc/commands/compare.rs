@@ -1,5 +1,6 @@
 //! `lpc compare`: several models on one scene, each with its errors against the reference.
 
+use std::collections::BTreeMap;
 use std::path::PathBuf;
 
 use anyhow::Context;
@@ -8,8 +9,11 @@ use lpc_damper::studies::compare::{errors, Errors};
 use lpc_damper::output::{write_run_dir, RunSummary};
 use lpc_damper::Model;
 
-use crate::args::{load_scene, print_json, Format, RapierArgs};
-use crate::table::{right, Table};
+use lpc_damper::output::SUMMARY_METRICS;
+use lpc_damper::studies::ensemble::{self, Agreement, Ensemble, Stats};
+
+use crate::args::{load_nominal, print_json, progress_bar, EnsembleArgs, Format, RapierArgs};
+use crate::table::{left, right, Table};
 use crate::exit::{ExitStatus, Result};
 
 #[derive(clap::Args)]
@@ -30,6 +34,8 @@ pub struct Args {
     /// Write each model's series.csv, impacts.csv and summary.json into DIR/MODEL/.
     #[arg(long)]
     out: Option<PathBuf>,
+    #[command(flatten)]
+    ensemble: EnsembleArgs,
 }
 
 /// One model's entry in `lpc compare`'s JSON.
@@ -48,7 +54,11 @@ struct Comparison {
 }
 
 pub fn run(a: Args) -> Result<ExitStatus> {
-    let scene = load_scene(&a.scene, a.rapier.overrides(a.horizon, None))?;
+    let nominal = load_nominal(&a.scene, a.rapier.overrides(a.horizon, None))?;
+    if let Some(members) = nominal.ensemble(a.ensemble)? {
+        return compare_ensembles(&a, &nominal.scene.name, &members);
+    }
+    let scene = nominal.scene;
     let reference = Model::Reference.simulate(&scene)?;
     let mut models = std::collections::BTreeMap::new();
     let mut runs = vec![];
@@ -108,6 +118,97 @@ pub fn run(a: Args) -> Result<ExitStatus> {
             }
             if let Some(dir) = &a.out {
                 println!("wrote every model's series to {}/MODEL/", dir.display());
+            }
+        }
+    }
+    Ok(ExitStatus::Success)
+}
+
+/// One model's distributions in `lpc compare --ensemble`'s JSON.
+#[derive(serde::Serialize)]
+struct ModelDistributions {
+    metrics: BTreeMap<String, Stats>,
+    /// Against the reference's distribution, per metric.
+    agreement: BTreeMap<String, Agreement>,
+    wall_time_s: f64,
+}
+
+/// `lpc compare --ensemble`'s JSON.
+#[derive(serde::Serialize)]
+struct EnsembleComparison {
+    scene: String,
+    members: usize,
+    seed: u64,
+    redraws: u64,
+    reference: ModelDistributions,
+    models: BTreeMap<String, ModelDistributions>,
+}
+
+/// Every model on the same members; each model's distributions against the reference's.
+fn compare_ensembles(a: &Args, scene: &str, members: &Ensemble) -> Result<ExitStatus> {
+    let mut runs = BTreeMap::new();
+    for &m in std::iter::once(&Model::Reference).chain(a.models.iter().filter(|m| **m != Model::Reference)) {
+        let bar = progress_bar(members.members.len(), m.name());
+        let start = std::time::Instant::now();
+        let r = ensemble::run_members(members, m, false, &|| bar.inc(1))?;
+        bar.finish_and_clear();
+        runs.insert(m, (r.metrics, start.elapsed().as_secs_f64()));
+    }
+    let reference = &runs[&Model::Reference].0;
+    let distributions = |m: Model| {
+        let (metrics, wall) = &runs[&m];
+        ModelDistributions {
+            metrics: ensemble::metric_stats(metrics),
+            agreement: ensemble::agreement(metrics, reference),
+            wall_time_s: *wall,
+        }
+    };
+    let comparison = EnsembleComparison {
+        scene: scene.to_string(),
+        members: members.members.len(),
+        seed: members.seed,
+        redraws: members.redraws,
+        reference: distributions(Model::Reference),
+        models: runs.keys().filter(|m| **m != Model::Reference).map(|&m| (m.name().to_string(), distributions(m))).collect(),
+    };
+    match a.format {
+        Format::Json => print_json(&comparison)?,
+        Format::Text => {
+            println!(
+                "scene {} | {} members (seed {}, {} redraws): each model's median against the reference's 5-95 % band",
+                comparison.scene, comparison.members, comparison.seed, comparison.redraws
+            );
+            let table = Table::new(vec![
+                left("metric", 22),
+                left("model", 10),
+                right("median", 12),
+                right("p05", 12),
+                right("p95", 12),
+                right("d median", 12),
+                right("in band", 8),
+                right("KS", 6),
+            ]);
+            table.print_header();
+            let cell = |x: Option<f64>| x.map_or("-".into(), |x| format!("{x:.5}"));
+            for name in SUMMARY_METRICS {
+                let mut rows = vec![("reference", &comparison.reference)];
+                rows.extend(comparison.models.iter().map(|(n, d)| (n.as_str(), d)));
+                for (model, d) in rows {
+                    let (s, g) = (&d.metrics[*name], &d.agreement[*name]);
+                    if s.median.is_none() {
+                        continue;
+                    }
+                    table.print_row(&[
+                        name.to_string(),
+                        model.to_string(),
+                        cell(s.median),
+                        cell(s.p05),
+                        cell(s.p95),
+                        if model == "reference" { "-".into() } else { g.median_diff.map_or("-".into(), |x| format!("{x:+.5}")) },
+                        g.median_inside_reference_band.map_or("-".into(), |b| if b { "yes" } else { "no" }.into()),
+                        g.ks.map_or("-".into(), |k| format!("{k:.2}")),
+                    ]);
+                }
             }
         }
     }

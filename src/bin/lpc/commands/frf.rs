@@ -9,7 +9,7 @@ use lpc_damper::output::write_atomic;
 use lpc_damper::scene::{self, Overrides};
 use lpc_damper::Model;
 
-use crate::args::{invalid, load_scene, parse_range, print_json, progress_bar, Format, RapierArgs};
+use crate::args::{invalid, load_nominal, parse_range, print_json, progress_bar, EnsembleArgs, Format, RapierArgs};
 use crate::table::{right, Table};
 use crate::exit::{CommandError, ExitStatus, Result};
 
@@ -41,6 +41,8 @@ pub struct Args {
     out: Option<PathBuf>,
     #[command(flatten)]
     rapier: RapierArgs,
+    #[command(flatten)]
+    ensemble: EnsembleArgs,
 }
 
 #[derive(Clone, Copy, ValueEnum)]
@@ -50,7 +52,8 @@ enum ForcingKindArg {
 }
 
 pub fn run(a: Args) -> Result<ExitStatus> {
-    let scene = load_scene(&a.scene, a.rapier.overrides(None, None))?;
+    let nominal = load_nominal(&a.scene, a.rapier.overrides(None, None))?;
+    let scene = nominal.scene.clone();
     let (from, to) = parse_range(&a.freq, &a.scene, "--freq")?;
     let invalid = |field: &str, rule: String| invalid(&a.scene, field, rule);
     if a.steps == 0 || a.steps > 10_000 {
@@ -80,6 +83,9 @@ pub fn run(a: Args) -> Result<ExitStatus> {
         .into());
     }
     let freqs = lpc_damper::studies::frf::frequencies(from, to, a.steps);
+    if let Some(members) = nominal.ensemble_of(a.ensemble, &nominal.file, &scene)? {
+        return frf_ensemble(&a, &scene, &members, &freqs);
+    }
     let bar = progress_bar(2 * freqs.len(), "frf");
     let start = std::time::Instant::now();
     let points = lpc_damper::studies::frf::frf(&scene, &freqs, a.model, &|| bar.inc(1));
@@ -143,6 +149,62 @@ pub fn run(a: Args) -> Result<ExitStatus> {
     let failed = points.iter().filter(|p| p.error.is_some()).count();
     if failed > 0 {
         return Err(CommandError::failure(anyhow::anyhow!("{failed} of {} frequencies failed (see above)", points.len())));
+    }
+    Ok(ExitStatus::Success)
+}
+
+/// The response over an ensemble: per frequency the distribution of the per-period peaks.
+fn frf_ensemble(a: &Args, scene: &scene::Scene, members: &lpc_damper::studies::ensemble::Ensemble, freqs: &[f64]) -> Result<ExitStatus> {
+    let bar = progress_bar(2 * freqs.len() * members.members.len(), "frf");
+    let start = std::time::Instant::now();
+    let bands = lpc_damper::studies::frf::frf_ensemble(&members.members, freqs, a.model, &|| bar.inc(1));
+    bar.finish_and_clear();
+    let elapsed = start.elapsed().as_secs_f64();
+    if let Some(dir) = &a.out {
+        write_atomic(&dir.join("frf.json"), &serde_json::to_vec_pretty(&bands)?).with_context(|| format!("writing {}", dir.display()))?;
+        let fig = lpc_damper::output::figures::frf_band_chart(&bands, &scene.name, a.model.name());
+        lpc_damper::output::figures::write(&fig, dir, (900, 560))?;
+    }
+    match a.format {
+        Format::Json => print_json(&bands)?,
+        Format::Text => {
+            println!(
+                "frequency response of {} over {} members ({}; {} runs in {:.2} s): per-period peaks of the last {} periods",
+                scene.name,
+                members.members.len(),
+                a.model.name(),
+                2 * freqs.len() * members.members.len(),
+                elapsed,
+                2 * lpc_damper::studies::frf::BLOCK_PERIODS
+            );
+            let table = Table::new(vec![
+                right("f Hz", 10),
+                right("median mm", 12),
+                right("5-95 % mm", 20),
+                right("no damper mm", 14),
+                right("5-95 % mm", 20),
+                right("steady members", 16),
+            ]);
+            table.print_header();
+            let mm = |x: Option<f64>| x.map_or("-".to_string(), |x| format!("{:.4}", x * 1e3));
+            for b in &bands {
+                table.print_row(&[
+                    format!("{:.4}", b.frequency),
+                    mm(b.amplitude.median),
+                    format!("{}-{}", mm(b.amplitude.p05), mm(b.amplitude.p95)),
+                    mm(b.amplitude_no_damper.median),
+                    format!("{}-{}", mm(b.amplitude_no_damper.p05), mm(b.amplitude_no_damper.p95)),
+                    format!("{}/{}", b.steady_members, b.members),
+                ]);
+            }
+            for b in bands.iter().filter(|b| b.error.is_some()) {
+                println!("{} Hz failed: {}", b.frequency, b.error.as_deref().unwrap_or_default());
+            }
+        }
+    }
+    let failed = bands.iter().filter(|b| b.error.is_some()).count();
+    if failed > 0 {
+        return Err(CommandError::failure(anyhow::anyhow!("{failed} of {} frequencies failed (see above)", bands.len())));
     }
     Ok(ExitStatus::Success)
 }

@@ -9,7 +9,7 @@ use indicatif::ProgressStyle;
 use lpc_damper::scene;
 use lpc_damper::Model;
 
-use crate::args::{invalid, parse_range, print_json, progress_bar, Format};
+use crate::args::{invalid, parse_range, print_json, progress_bar, quantile_arg, EnsembleArgs, Format};
 use crate::table::{left, right, Table};
 use crate::exit::{ExitStatus, Result};
 
@@ -47,6 +47,12 @@ pub struct Args {
     /// Output format on standard output.
     #[arg(long, value_enum, default_value_t = Format::Text)]
     format: Format,
+    #[command(flatten)]
+    ensemble: EnsembleArgs,
+    /// With --ensemble: rank designs by this quantile of their members' objectives (default
+    /// 0.5, the median; 0.9 asks for a design that is good on nine dampers out of ten).
+    #[arg(long, requires = "ensemble")]
+    quantile: Option<f64>,
 }
 
 #[derive(Clone, Copy, ValueEnum)]
@@ -93,10 +99,18 @@ pub fn run(a: Args) -> Result<ExitStatus> {
             Objective::ResonantAmplitude { from, to, steps: a.steps.max(1) }
         }
     };
+    let robust = match a.ensemble.ensemble {
+        Some(members) => Some(lpc_damper::studies::optimize::Robust {
+            members,
+            seed: a.ensemble.seed,
+            quantile: quantile_arg(a.quantile, &a.scene)?,
+        }),
+        None => None,
+    };
     let bar = progress_bar(usize::MAX >> 1, "designs");
     bar.set_style(ProgressStyle::with_template("{msg} {pos} ({elapsed})").expect("valid template"));
     let start = std::time::Instant::now();
-    let search = optimize(&loaded, &axes, &arrangements, length, objective, a.model, a.refinements, &|| bar.inc(1))?;
+    let search = optimize(&loaded, &axes, &arrangements, length, objective, a.model, a.refinements, robust, &|| bar.inc(1))?;
     bar.finish_and_clear();
     match a.format {
         Format::Json => print_json(&search)?,
@@ -113,7 +127,17 @@ pub fn run(a: Args) -> Result<ExitStatus> {
                 search.infeasible
             );
             // The parameters column is set off by a second space.
-            let table = Table::new(vec![right("arrangement", 12), right("clearance mm", 12), right(unit, 22), left(" parameters", 0)]);
+            let unit = match robust {
+                Some(r) => format!("{unit} (q {})", r.quantile),
+                None => unit.to_string(),
+            };
+            let table = Table::new(vec![
+                right("arrangement", 12),
+                right("clearance mm", 12),
+                right(unit, 28),
+                right("5-95 % band", 20),
+                left(" parameters", 0),
+            ]);
             table.print_header();
             for d in search.ranking.iter().take(a.top) {
                 let params = d.values.iter().map(|(p, v)| format!("{p}={v}")).collect::<Vec<_>>().join(" ");
@@ -121,12 +145,20 @@ pub fn run(a: Args) -> Result<ExitStatus> {
                     d.arrangement.clone(),
                     format!("{:.3}", d.clearance * 1e3),
                     d.objective.map_or("not settled".into(), |x| format!("{:.4}", x * scale)),
+                    d.band.map_or("-".into(), |(lo, hi)| format!("{:.4}-{:.4}", lo * scale, hi * scale)),
                     format!(" {params}"),
                 ]);
             }
             match &search.best {
                 Some(b) => println!("best: {} with {}", b.arrangement, b.values.iter().map(|(p, v)| format!("{p}={v}")).collect::<Vec<_>>().join(" ")),
                 None => println!("no feasible design settled"),
+            }
+            match search.distinguishable {
+                Some(true) => println!("the best is distinguishable from the runner-up: their bootstrap 5-95 % bands do not overlap"),
+                Some(false) => println!(
+                    "the best is NOT distinguishable from the runner-up: their bootstrap 5-95 % bands overlap (more members, or call them equal)"
+                ),
+                None => {}
             }
         }
     }

@@ -12,7 +12,8 @@ use crate::exit::{ExitStatus, Result};
 #[derive(clap::Args)]
 pub struct Args {
     /// A scene file (damper: Figs. 8-12; [sweep]: Figs. 13-16; [chain]: Fig. 5), a directory
-    /// written by `lpc run --out` (its series), or one written by `lpc compare --out` (overlay).
+    /// written by `lpc run --out` (its series; with `--ensemble`, also the members' band over
+    /// the nominal run), or one written by `lpc compare --out` (overlay).
     input: PathBuf,
     /// Directory for the figures.
     #[arg(long)]
@@ -46,6 +47,11 @@ pub fn run(a: Args) -> Result<ExitStatus> {
             run.series = s;
             figs.extend(figures::time_histories(&run, None));
             figs.push(figures::ball_positions(&run, None));
+            // `lpc run --ensemble --out`: the members' band over the nominal run.
+            let band = a.input.join("band.csv");
+            if band.is_file() {
+                figs.push(figures::band_chart(&run, &figures::read_band_csv(&band)?));
+            }
         } else {
             let mut models = vec![];
             let mut entries: Vec<PathBuf> =

@@ -8,7 +8,10 @@ use lpc_damper::output::write_atomic;
 use lpc_damper::scene;
 use lpc_damper::Model;
 
-use crate::args::{invalid, override_scene, print_json, progress_bar, Format, RapierArgs};
+use lpc_damper::studies::ensemble;
+use lpc_damper::studies::sweep::{Axis, EnsemblePoint, GridScene};
+
+use crate::args::{invalid, override_scene, print_json, progress_bar, quantile_arg, EnsembleArgs, Format, Nominal, RapierArgs};
 use crate::table::{right, Table};
 use crate::exit::{ExitStatus, Result};
 
@@ -42,6 +45,12 @@ pub struct Args {
     metric: String,
     #[command(flatten)]
     rapier: RapierArgs,
+    #[command(flatten)]
+    ensemble: EnsembleArgs,
+    /// With --ensemble: the quantile of each cell's distribution that the map shows (default
+    /// 0.5, the median).
+    #[arg(long, requires = "ensemble")]
+    quantile: Option<f64>,
 }
 
 pub fn run(a: Args) -> Result<ExitStatus> {
@@ -67,6 +76,16 @@ pub fn run(a: Args) -> Result<ExitStatus> {
         override_scene(&mut g.scene, a.rapier.overrides(a.horizon, None), &a.scene)?;
     }
     let parameters: Vec<String> = axes.iter().map(|x| x.parameter.clone()).collect();
+    if a.ensemble.ensemble.is_some() {
+        let q = quantile_arg(a.quantile, &a.scene)?;
+        let nominal = Nominal {
+            path: a.scene.display().to_string(),
+            file: loaded.file.clone(),
+            tolerances: loaded.tolerances.clone(),
+            scene: loaded.damper()?.clone(),
+        };
+        return sweep_ensembles(&a, &nominal, &axes, &parameters, &grid, q);
+    }
     let parameter = parameters.join(" x ");
     let bar = progress_bar(grid.len(), "sweep");
     let start = std::time::Instant::now();
@@ -77,19 +96,10 @@ pub fn run(a: Args) -> Result<ExitStatus> {
         write_atomic(&dir.join("sweep.json"), &serde_json::to_vec_pretty(&points)?)
             .with_context(|| format!("writing {}", dir.display()))?;
         if axes.len() == 2 {
-            let (nx, ny) = (axes[0].values.len(), axes[1].values.len());
-            let z = (0..ny)
-                .map(|r| (0..nx).map(|c| lpc_damper::studies::sweep::metric_value(&points[r * nx + c].summary, &a.metric)).collect())
-                .collect();
-            let map = lpc_damper::output::figures::HeatMap {
-                name: "sweep-map".into(),
-                title: format!("{}: {} ({})", loaded.scene.as_ref().map_or("", |s| s.name.as_str()), a.metric, a.model.name()),
-                x: (axis_title(&axes[0]), axes[0].values.iter().map(|v| v.raw()).collect()),
-                y: (axis_title(&axes[1]), axes[1].values.iter().map(|v| v.raw()).collect()),
-                z,
-                z_desc: a.metric.clone(),
-            };
-            lpc_damper::output::figures::write_heat_map(&map, dir, (900, 640))?;
+            let cells: Vec<Option<f64>> =
+                points.iter().map(|p| lpc_damper::studies::sweep::metric_value(&p.summary, &a.metric)).collect();
+            let title = format!("{}: {} ({})", loaded.scene.as_ref().map_or("", |s| s.name.as_str()), a.metric, a.model.name());
+            write_map(dir, &axes, &cells, title, a.metric.clone())?;
         }
     }
     match a.format {
@@ -143,4 +153,80 @@ fn axis_title(axis: &lpc_damper::studies::sweep::Axis) -> String {
     } else {
         axis.parameter.clone()
     }
+}
+
+/// The design map of a grid: `cells` in grid order (first axis fastest).
+fn write_map(dir: &std::path::Path, axes: &[Axis], cells: &[Option<f64>], title: String, z_desc: String) -> anyhow::Result<()> {
+    let (nx, ny) = (axes[0].values.len(), axes[1].values.len());
+    let map = lpc_damper::output::figures::HeatMap {
+        name: "sweep-map".into(),
+        title,
+        x: (axis_title(&axes[0]), axes[0].values.iter().map(|v| v.raw()).collect()),
+        y: (axis_title(&axes[1]), axes[1].values.iter().map(|v| v.raw()).collect()),
+        z: (0..ny).map(|r| cells[r * nx..(r + 1) * nx].to_vec()).collect(),
+        z_desc,
+    };
+    lpc_damper::output::figures::write_heat_map(&map, dir, (900, 640))?;
+    Ok(())
+}
+
+/// Every point of the sweep an ensemble about it: each cell a distribution, the map its
+/// `q` quantile.
+fn sweep_ensembles(a: &Args, nominal: &Nominal, axes: &[Axis], parameters: &[String], grid: &[GridScene], q: f64) -> Result<ExitStatus> {
+    let per_point = a.ensemble.ensemble.unwrap_or(1);
+    let bar = progress_bar(grid.len() * per_point, "sweep");
+    let start = std::time::Instant::now();
+    let mut points = vec![];
+    for g in grid {
+        let Some(members) = nominal.ensemble_of(a.ensemble, &g.file, &g.scene)? else { continue };
+        let runs = ensemble::run_members(&members, a.model, false, &|| bar.inc(1))?;
+        points.push(EnsemblePoint {
+            parameter: parameters[0].clone(),
+            value: g.values[0],
+            parameter_y: parameters.get(1).cloned(),
+            value_y: g.values.get(1).copied(),
+            members: members.members.len(),
+            redraws: members.redraws,
+            metrics: ensemble::metric_stats(&runs.metrics),
+            quantile: q,
+            at_quantile: ensemble::metric_quantiles(&runs.metrics, q),
+        });
+    }
+    bar.finish_and_clear();
+    let elapsed = start.elapsed().as_secs_f64();
+    if let Some(dir) = &a.out {
+        write_atomic(&dir.join("sweep.json"), &serde_json::to_vec_pretty(&points)?)
+            .with_context(|| format!("writing {}", dir.display()))?;
+        if axes.len() == 2 {
+            let cells: Vec<Option<f64>> = points.iter().map(|p| p.at_quantile[&a.metric]).collect();
+            let title = format!("{}: {} at quantile {q} of {per_point} members ({})", nominal.scene.name, a.metric, a.model.name());
+            write_map(dir, axes, &cells, title, format!("{} (q {q})", a.metric))?;
+        }
+    }
+    match a.format {
+        Format::Json => print_json(&points)?,
+        Format::Text => {
+            println!(
+                "sweep of `{}` ({}, {} points x {per_point} members in {:.3} s): `{}` over the members",
+                parameters.join(" x "),
+                a.model.name(),
+                points.len(),
+                elapsed,
+                a.metric
+            );
+            let mut columns: Vec<_> = parameters.iter().map(|p| right(p.as_str(), 12)).collect();
+            columns.extend([right("median", 12), right("p05", 12), right("p95", 12), right(format!("q {q}"), 12), right("undefined", 10)]);
+            let table = Table::new(columns);
+            table.print_header();
+            let cell = |x: Option<f64>| x.map_or("-".into(), |x| format!("{x:.5}"));
+            for p in &points {
+                let s = &p.metrics[&a.metric];
+                let mut cells = vec![p.value.to_string()];
+                cells.extend(p.value_y.map(|v| v.to_string()));
+                cells.extend([cell(s.median), cell(s.p05), cell(s.p95), cell(p.at_quantile[&a.metric]), s.undefined.to_string()]);
+                table.print_row(&cells);
+            }
+        }
+    }
+    Ok(ExitStatus::Success)
 }

@@ -1,0 +1,593 @@
+//! Ensembles: members of a scene drawn under its `[tolerances]`, run in parallel, and their
+//! metrics as distributions (docs/MODEL.md §12). Every study that takes `--ensemble` draws and
+//! runs its members here. Member k's draws depend only on `(seed, k)` and members are
+//! collected in order, so the same seed gives the same bytes at any thread count.
+
+use std::collections::BTreeMap;
+
+use rand::{Rng, SeedableRng};
+use rand_distr::{Distribution as _, Normal};
+use rand_pcg::Pcg64;
+use rayon::prelude::*;
+use serde::{Deserialize, Serialize};
+
+use crate::model::{Model, ModelError};
+use crate::output::{Headline, SUMMARY_METRICS};
+use crate::run::Record;
+use crate::scene::{self, Distribution, Length, Scene, SceneError, SceneFile, Tolerances};
+
+/// Draws one member may take before its tolerances are declared too wide for it.
+pub const MAX_DRAWS_PER_MEMBER: u32 = 100;
+
+/// Most members an ensemble may have.
+pub const MAX_MEMBERS: usize = 1_000_000;
+
+/// Seed of the draws when neither the scene nor the command line gives one.
+pub const DEFAULT_SEED: u64 = 1;
+
+/// One member: its index, the values drawn for it (in [`Ensemble::columns`] order, in the
+/// parameters' units, lengths in metres) and its validated scene.
+#[derive(Debug, Clone)]
+pub struct Member {
+    /// `k`, from 0.
+    pub index: usize,
+    /// Drawn values.
+    pub drawn: Vec<f64>,
+    /// The scene.
+    pub scene: Scene,
+}
+
+/// The members of an ensemble.
+#[derive(Debug, Clone)]
+pub struct Ensemble {
+    /// Names of the drawn values: each toleranced parameter, `gap1 ... gapN` for the gaps.
+    pub columns: Vec<String>,
+    /// Members, in order.
+    pub members: Vec<Member>,
+    /// Draws thrown away because they made an invalid scene (overlapping bodies, a parameter
+    /// out of its range).
+    pub redraws: u64,
+    /// Seed of the draws.
+    pub seed: u64,
+}
+
+/// Member `k`'s random numbers, which depend on `(seed, k)` and nothing else (not on the
+/// threads, nor on which members are drawn first): a generator seeded from the seed's first
+/// number XOR `k` (distinct for every `k`), each step through `seed_from_u64`'s mixing.
+/// PCG's streams (one increment per member from one state) are not used: across 400 streams
+/// the first numbers kept away from the ends of [0, 1) (largest 0.987 and 0.990 for two
+/// seeds, where 0.9975 is expected), and spread more evenly than independent draws do.
+pub fn member_rng(seed: u64, k: usize) -> Pcg64 {
+    Pcg64::seed_from_u64(Pcg64::seed_from_u64(seed).random::<u64>() ^ k as u64)
+}
+
+/// A draw that made no valid scene: the parameter to blame and why.
+struct Failure {
+    parameter: &'static str,
+    rule: String,
+}
+
+/// Draws `count` members of `nominal` (built from `file`, perhaps with command-line
+/// overrides) under `tolerances`. Without tolerances every member is the nominal scene.
+/// A tolerance so wide that a member finds no valid scene in [`MAX_DRAWS_PER_MEMBER`] draws,
+/// or that more draws fail than succeed, is an error naming it.
+pub fn draw(
+    file: &SceneFile,
+    path: &str,
+    nominal: &Scene,
+    tolerances: Option<&Tolerances>,
+    count: usize,
+    seed: Option<u64>,
+) -> Result<Ensemble, SceneError> {
+    let invalid = |field: &str, rule: String| SceneError::Invalid { file: path.into(), field: field.into(), rule };
+    if count == 0 || count > MAX_MEMBERS {
+        return Err(invalid("--ensemble", format!("must lie in 1..={MAX_MEMBERS} (got {count})")));
+    }
+    let spreads: &[(&'static str, f64)] = tolerances.map_or(&[], |t| &t.spreads);
+    let normal = tolerances.is_some_and(|t| t.distribution == Distribution::Normal);
+    let seed = seed.or(tolerances.map(|t| t.seed)).unwrap_or(DEFAULT_SEED);
+    let n = nominal.balls.len();
+    let columns = spreads
+        .iter()
+        .flat_map(|&(p, _)| if p == "gap" { (1..=n).map(|i| format!("gap{i}")).collect() } else { vec![p.to_string()] })
+        .collect();
+    let mut base = scene::with_settings_of(file, nominal);
+    base.sweep = None;
+    base.tolerances = None;
+    let drawer = Drawer { base, path, nominal, spreads, normal };
+    let drawn: Vec<(Member, u32, Vec<Failure>)> =
+        (0..count).into_par_iter().map(|k| drawer.member(seed, k)).collect::<Result<_, _>>()?;
+    let redraws: u64 = drawn.iter().map(|d| d.1 as u64).sum();
+    if redraws > count as u64 {
+        let mut blame: BTreeMap<&str, (usize, &str)> = BTreeMap::new();
+        for f in drawn.iter().flat_map(|d| &d.2) {
+            let e = blame.entry(f.parameter).or_insert((0, &f.rule));
+            e.0 += 1;
+        }
+        let (parameter, (times, rule)) = blame.into_iter().max_by_key(|b| b.1 .0).unwrap_or(("gap", (0, "")));
+        return Err(invalid(
+            &format!("tolerances.{parameter}"),
+            format!(
+                "is too wide: {redraws} of {} draws made an invalid scene ({times} by this parameter, e.g. {rule}); narrow it",
+                redraws + count as u64
+            ),
+        ));
+    }
+    Ok(Ensemble { columns, members: drawn.into_iter().map(|d| d.0).collect(), redraws, seed })
+}
+
+struct Drawer<'a> {
+    base: SceneFile,
+    path: &'a str,
+    nominal: &'a Scene,
+    spreads: &'a [(&'static str, f64)],
+    normal: bool,
+}
+
+impl Drawer<'_> {
+    /// Member `k`: its first valid draw, the number of draws thrown away and why.
+    fn member(&self, seed: u64, k: usize) -> Result<(Member, u32, Vec<Failure>), SceneError> {
+        let mut rng = member_rng(seed, k);
+        let mut failures = vec![];
+        for _ in 0..MAX_DRAWS_PER_MEMBER {
+            match self.attempt(&mut rng, k) {
+                Ok(member) => return Ok((member, failures.len() as u32, failures)),
+                Err(f) => failures.push(f),
+            }
+        }
+        let last = failures.pop().unwrap_or(Failure { parameter: "gap", rule: String::new() });
+        Err(SceneError::Invalid {
+            file: self.path.into(),
+            field: format!("tolerances.{}", last.parameter),
+            rule: format!(
+                "is too wide: {MAX_DRAWS_PER_MEMBER} draws in a row for member {k} made an invalid scene (the last: {}); narrow it",
+                last.rule
+            ),
+        })
+    }
+
+    fn deviation(&self, rng: &mut Pcg64, spread: f64) -> f64 {
+        if self.normal {
+            Normal::new(0.0, spread).map_or(0.0, |d| d.sample(rng))
+        } else {
+            // Uniform on [-w, w) without forming the range's width (a huge w cannot overflow).
+            spread * (2.0 * rng.random::<f64>() - 1.0)
+        }
+    }
+
+    fn nominal_value(&self, parameter: &str) -> f64 {
+        let s = self.nominal;
+        let balls = self.base.balls.as_ref();
+        let frame = s.frame;
+        let forcing = s.forcing;
+        let value = match parameter {
+            "clearance" => s.container.map(|c| c.clearance),
+            "initial_displacement" => Some(s.initial_displacement),
+            "restitution" => Some(s.restitution),
+            "mass_ratio" => balls.map(|b| b.mass_ratio),
+            "large_mass" => balls.map(|b| b.large_mass),
+            "density" => balls.map(|b| b.density),
+            "frame_mass" => frame.map(|f| f.mass),
+            "stiffness" => frame.map(|f| f.stiffness),
+            "damping" => frame.map(|f| f.damping),
+            "forcing_amplitude" => forcing.map(|g| g.amplitude),
+            "forcing_frequency" => forcing.map(|g| g.frequency),
+            _ => None,
+        };
+        value.unwrap_or(f64::NAN)
+    }
+
+    fn attempt(&self, rng: &mut Pcg64, k: usize) -> Result<Member, Failure> {
+        let n = self.nominal.balls.len();
+        // Every deviation is drawn first, in a fixed order, so a member's numbers never
+        // depend on which of its draws fail.
+        let deviations: Vec<Vec<f64>> = self
+            .spreads
+            .iter()
+            .map(|&(p, w)| (0..if p == "gap" { n } else { 1 }).map(|_| self.deviation(rng, w)).collect())
+            .collect();
+        let mut file: Option<SceneFile> = None;
+        let mut values = vec![];
+        for (&(p, _), d) in self.spreads.iter().zip(&deviations) {
+            if p == "gap" {
+                continue;
+            }
+            let value = self.nominal_value(p) + d[0];
+            values.push(value);
+            let f = file.as_ref().unwrap_or(&self.base);
+            file = Some(
+                scene::apply_sweep_value(f, p, Length::Metres(value)).map_err(|rule| Failure { parameter: p, rule })?,
+            );
+        }
+        let name = format!("{}#{k}", self.nominal.name);
+        let mut scene = match file {
+            None => self.nominal.clone(),
+            Some(f) => scene::from_file(f, self.path, &name)
+                .map_err(|e| match e {
+                    SceneError::Invalid { field, rule, .. } => {
+                        Failure { parameter: parameter_of(&field).unwrap_or(self.spreads[0].0), rule: format!("{field} {rule}") }
+                    }
+                    other => Failure { parameter: self.spreads[0].0, rule: other.to_string() },
+                })?
+                .scene
+                .ok_or(Failure { parameter: self.spreads[0].0, rule: "no damper scene".into() })?,
+        };
+        scene.name = name;
+        let mut drawn = vec![];
+        let mut values = values.into_iter();
+        for (&(p, _), d) in self.spreads.iter().zip(&deviations) {
+            if p == "gap" {
+                drawn.extend(shift_gaps(&mut scene, d)?);
+            } else {
+                drawn.extend(values.next());
+            }
+        }
+        Ok(Member { index: k, drawn, scene })
+    }
+}
+
+/// Moves ball `i`'s gap to its left neighbour (a wall for the first) by `deviation[i]`, the
+/// container held: the balls right of it shift with it and the clearance takes up the sum.
+/// Returns the gaps, or the failure when bodies would overlap.
+fn shift_gaps(scene: &mut Scene, deviation: &[f64]) -> Result<Vec<f64>, Failure> {
+    let Some(container) = scene.container.as_mut() else { return Ok(vec![]) };
+    let gaps: Vec<f64> = deviation.iter().map(|d| container.gap + d).collect();
+    let clearance = container.clearance - deviation.iter().sum::<f64>();
+    if let Some((i, g)) = gaps.iter().enumerate().find(|(_, g)| **g < 0.0) {
+        return Err(Failure { parameter: "gap", rule: format!("gap {} of {} m overlaps its neighbours", i + 1, scene::human(*g)) });
+    }
+    if clearance < 0.0 {
+        return Err(Failure {
+            parameter: "gap",
+            rule: format!("the gaps leave a clearance of {} m: the last ball overlaps the wall", scene::human(clearance)),
+        });
+    }
+    container.clearance = clearance;
+    let mut shift = 0.0;
+    for (x, d) in scene.initial_positions.iter_mut().zip(deviation) {
+        shift += d;
+        *x += shift;
+    }
+    Ok(gaps)
+}
+
+/// The `[tolerances]` parameter a scene field belongs to.
+fn parameter_of(field: &str) -> Option<&'static str> {
+    Some(match field {
+        "balls.gap" => "gap",
+        "balls.clearance" | "balls.container_length" => "clearance",
+        "balls.restitution" => "restitution",
+        "balls.mass_ratio" => "mass_ratio",
+        "balls.large_mass" => "large_mass",
+        "balls.density" => "density",
+        "frame.mass" => "frame_mass",
+        "frame.stiffness" => "stiffness",
+        "frame.damping" => "damping",
+        "frame.initial_displacement" => "initial_displacement",
+        "forcing.amplitude" => "forcing_amplitude",
+        "forcing.frequency" => "forcing_frequency",
+        _ => return None,
+    })
+}
+
+/// Runs `f` on every member in parallel, in member order; `progress` is called after each.
+pub fn map_members<T: Send, E: Send>(
+    members: &[Member],
+    f: impl Fn(&Member) -> Result<T, E> + Sync,
+    progress: &(dyn Fn() + Sync),
+) -> Result<Vec<T>, E> {
+    members
+        .par_iter()
+        .map(|m| {
+            let r = f(m);
+            progress();
+            r
+        })
+        .collect()
+}
+
+/// What an ensemble's runs leave: every member's metrics ([`SUMMARY_METRICS`] order) and, when
+/// asked for, every member's frame displacement at the common sample times.
+#[derive(Debug, Clone, Default)]
+pub struct EnsembleRuns {
+    /// `[member][metric]`.
+    pub metrics: Vec<Vec<Option<f64>>>,
+    /// Sample times of `xs`, s (empty unless kept).
+    pub t: Vec<f64>,
+    /// `[member][sample]`, m (empty unless kept).
+    pub xs: Vec<Vec<f64>>,
+}
+
+/// Runs every member with `model`. Members build no series unless `keep_xs`, which keeps each
+/// member's frame displacement (the ensemble's band) and drops the rest.
+pub fn run_members(
+    ensemble: &Ensemble,
+    model: Model,
+    keep_xs: bool,
+    progress: &(dyn Fn() + Sync),
+) -> Result<EnsembleRuns, ModelError> {
+    let record = if keep_xs { Record::Series } else { Record::MetricsOnly };
+    if keep_xs {
+        if let Some(first) = ensemble.members.first() {
+            check_band_memory(&first.scene, ensemble.members.len())?;
+        }
+    }
+    let runs = map_members(
+        &ensemble.members,
+        |m| {
+            let run = model.simulate_recording(&m.scene, record)?;
+            let metrics = Headline::of_run(&run).values();
+            let series = keep_xs.then_some(run.series);
+            Ok::<_, ModelError>((metrics, series))
+        },
+        progress,
+    )?;
+    let mut out = EnsembleRuns::default();
+    for (metrics, series) in runs {
+        out.metrics.push(metrics);
+        if let Some(s) = series {
+            if out.t.is_empty() {
+                out.t = s.t;
+            }
+            out.xs.push(s.xs);
+        }
+    }
+    Ok(out)
+}
+
+/// Refuses, with the numbers, a band whose members' displacements would not fit in memory.
+fn check_band_memory(scene: &Scene, members: usize) -> Result<(), ModelError> {
+    let need = scene.sample_count() as f64 * members as f64 * 8.0;
+    if need < 1e8 {
+        return Ok(());
+    }
+    match crate::run::available_memory() {
+        Some(available) if need > crate::run::MEMORY_SHARE * available => Err(ModelError::Refused(format!(
+            "the band of {members} members x {} samples would take {:.0} MB of the {:.0} MB this process can still use; \
+             raise run.sample_dt, use fewer members, or leave out --out (the metrics need no series)",
+            scene.sample_count(),
+            need / 1e6,
+            available / 1e6
+        ))),
+        _ => Ok(()),
+    }
+}
+
+/// A distribution's summary: median, 5-95 % band, mean, standard deviation and range of the
+/// members that define the value (`null` when none does), and how many do not.
+#[derive(Debug, Clone, Copy, PartialEq, Default, Serialize, Deserialize)]
+pub struct Stats {
+    /// 50 % quantile.
+    pub median: Option<f64>,
+    /// 5 % quantile.
+    pub p05: Option<f64>,
+    /// 95 % quantile.
+    pub p95: Option<f64>,
+    /// Mean.
+    pub mean: Option<f64>,
+    /// Sample standard deviation (0 for one member).
+    pub std: Option<f64>,
+    /// Smallest.
+    pub min: Option<f64>,
+    /// Largest.
+    pub max: Option<f64>,
+    /// Members for which the value is undefined (a run that never settled, say).
+    #[serde(default, skip_serializing_if = "is_zero")]
+    pub undefined: usize,
+}
+
+fn is_zero(k: &usize) -> bool {
+    *k == 0
+}
+
+impl Stats {
+    /// The summary of `values` (`None` for an undefined value).
+    pub fn of(values: impl IntoIterator<Item = Option<f64>>) -> Stats {
+        let mut undefined = 0;
+        let mut v: Vec<f64> = values
+            .into_iter()
+            .filter_map(|x| {
+                undefined += x.is_none() as usize;
+                x
+            })
+            .collect();
+        if v.is_empty() {
+            return Stats { undefined, ..Stats::default() };
+        }
+        v.sort_by(f64::total_cmp);
+        let n = v.len() as f64;
+        let mean = v.iter().sum::<f64>() / n;
+        let var = if v.len() > 1 { v.iter().map(|x| (x - mean).powi(2)).sum::<f64>() / (n - 1.0) } else { 0.0 };
+        Stats {
+            median: Some(quantile(&v, 0.5)),
+            p05: Some(quantile(&v, 0.05)),
+            p95: Some(quantile(&v, 0.95)),
+            mean: Some(mean),
+            std: Some(var.sqrt()),
+            min: v.first().copied(),
+            max: v.last().copied(),
+            undefined,
+        }
+    }
+}
+
+/// The `q` quantile of sorted values, interpolated linearly between order statistics (the
+/// usual definition: `q = 0` is the least, `q = 1` the largest). NaN when empty.
+pub fn quantile(sorted: &[f64], q: f64) -> f64 {
+    if sorted.is_empty() {
+        return f64::NAN;
+    }
+    let h = q.clamp(0.0, 1.0) * (sorted.len() - 1) as f64;
+    let (lo, frac) = (h.floor() as usize, h - h.floor());
+    let hi = (lo + 1).min(sorted.len() - 1);
+    // Exactly on an order statistic, or between equal ones (infinite ones too: a run that
+    // never settled ranks last), there is nothing to interpolate.
+    if frac == 0.0 || sorted[lo] == sorted[hi] {
+        return sorted[lo];
+    }
+    sorted[lo] + frac * (sorted[hi] - sorted[lo])
+}
+
+/// `lpc run --ensemble`'s JSON (`ensemble.json`).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct EnsembleSummary {
+    /// Scene name.
+    pub scene: String,
+    /// Model.
+    pub model: Model,
+    /// Number of members.
+    pub members: usize,
+    /// Draws thrown away as invalid.
+    pub redraws: u64,
+    /// Seed of the draws.
+    pub seed: u64,
+    /// Each metric of the single-run summary over the members.
+    pub metrics: BTreeMap<String, Stats>,
+    /// Computing time of the whole ensemble, s.
+    pub wall_time_s: f64,
+}
+
+/// Each metric's distribution over `metrics` (`[member][metric]`, [`SUMMARY_METRICS`] order).
+pub fn metric_stats(metrics: &[Vec<Option<f64>>]) -> BTreeMap<String, Stats> {
+    SUMMARY_METRICS
+        .iter()
+        .enumerate()
+        .map(|(j, name)| (name.to_string(), Stats::of(metrics.iter().map(|m| m[j]))))
+        .collect()
+}
+
+/// Each metric's `q` quantile over the members that define it (`None` when none does).
+pub fn metric_quantiles(metrics: &[Vec<Option<f64>>], q: f64) -> BTreeMap<String, Option<f64>> {
+    SUMMARY_METRICS
+        .iter()
+        .enumerate()
+        .map(|(j, name)| {
+            let mut v: Vec<f64> = metrics.iter().filter_map(|m| m[j]).collect();
+            v.sort_by(f64::total_cmp);
+            (name.to_string(), (!v.is_empty()).then(|| quantile(&v, q)))
+        })
+        .collect()
+}
+
+/// Checks a quantile given on the command line as `field`.
+pub fn check_quantile(q: f64) -> Result<f64, String> {
+    if (0.0..=1.0).contains(&q) {
+        Ok(q)
+    } else {
+        Err(format!("must lie in [0, 1] (got {})", crate::scene::human(q)))
+    }
+}
+
+/// The 5 %, 50 % and 95 % quantiles of the members' displacement at each sample, and the
+/// 95 % quantile of its magnitude: rows `t, xs_p05, xs_median, xs_p95, env_p95`.
+pub fn band(t: &[f64], xs: &[Vec<f64>]) -> Vec<[f64; 5]> {
+    let len = xs.iter().map(Vec::len).min().unwrap_or(0).min(t.len());
+    (0..len)
+        .into_par_iter()
+        .map(|k| {
+            let mut v: Vec<f64> = xs.iter().map(|m| m[k]).collect();
+            v.sort_by(f64::total_cmp);
+            let mut env: Vec<f64> = v.iter().map(|x| x.abs()).collect();
+            env.sort_by(f64::total_cmp);
+            [t[k], quantile(&v, 0.05), quantile(&v, 0.5), quantile(&v, 0.95), quantile(&env, 0.95)]
+        })
+        .collect()
+}
+
+/// The two-sample Kolmogorov-Smirnov statistic: the largest distance between the empirical
+/// distribution functions of `a` and `b` (0 when either is empty).
+pub fn ks_statistic(a: &[f64], b: &[f64]) -> f64 {
+    if a.is_empty() || b.is_empty() {
+        return 0.0;
+    }
+    let (mut a, mut b) = (a.to_vec(), b.to_vec());
+    a.sort_by(f64::total_cmp);
+    b.sort_by(f64::total_cmp);
+    let (mut i, mut j, mut d) = (0, 0, 0.0f64);
+    while i < a.len() && j < b.len() {
+        let x = a[i].min(b[j]);
+        while i < a.len() && a[i] <= x {
+            i += 1;
+        }
+        while j < b.len() && b[j] <= x {
+            j += 1;
+        }
+        d = d.max((i as f64 / a.len() as f64 - j as f64 / b.len() as f64).abs());
+    }
+    d
+}
+
+/// How one metric's distribution under a model stands against the reference's.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct Agreement {
+    /// Model's median minus the reference's (`null` when either has no defined value).
+    pub median_diff: Option<f64>,
+    /// Whether the model's median lies inside the reference's 5-95 % band.
+    pub median_inside_reference_band: Option<bool>,
+    /// Two-sample Kolmogorov-Smirnov statistic between the defined values.
+    pub ks: Option<f64>,
+}
+
+/// Each metric's [`Agreement`] of `model` with `reference` (`[member][metric]` each,
+/// [`SUMMARY_METRICS`] order).
+pub fn agreement(model: &[Vec<Option<f64>>], reference: &[Vec<Option<f64>>]) -> BTreeMap<String, Agreement> {
+    SUMMARY_METRICS
+        .iter()
+        .enumerate()
+        .map(|(j, name)| {
+            let values = |runs: &[Vec<Option<f64>>]| runs.iter().filter_map(|m| m[j]).collect::<Vec<f64>>();
+            let (m, r) = (values(model), values(reference));
+            let (sm, sr) = (Stats::of(m.iter().map(|&x| Some(x))), Stats::of(r.iter().map(|&x| Some(x))));
+            let both = !m.is_empty() && !r.is_empty();
+            let a = Agreement {
+                median_diff: sm.median.zip(sr.median).map(|(a, b)| a - b),
+                median_inside_reference_band: sm.median.zip(sr.p05.zip(sr.p95)).map(|(x, (lo, hi))| lo <= x && x <= hi),
+                ks: both.then(|| ks_statistic(&m, &r)),
+            };
+            (name.to_string(), a)
+        })
+        .collect()
+}
+
+/// Resamples of a bootstrap.
+pub const BOOTSTRAP_RESAMPLES: usize = 1000;
+
+/// The 5-95 % band of the `q` quantile of `values` by bootstrap ([`BOOTSTRAP_RESAMPLES`]
+/// resamples with replacement, drawn from `seed`): how well the members pin the quantile.
+pub fn bootstrap_band(values: &[f64], q: f64, seed: u64) -> Option<(f64, f64)> {
+    if values.is_empty() {
+        return None;
+    }
+    let mut rng = Pcg64::seed_from_u64(seed);
+    let mut estimates: Vec<f64> = (0..BOOTSTRAP_RESAMPLES)
+        .map(|_| {
+            let mut r: Vec<f64> = (0..values.len()).map(|_| values[rng.random_range(0..values.len())]).collect();
+            r.sort_by(f64::total_cmp);
+            quantile(&r, q)
+        })
+        .collect();
+    estimates.sort_by(f64::total_cmp);
+    Some((quantile(&estimates, 0.05), quantile(&estimates, 0.95)))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn quantiles_interpolate_between_order_statistics() {
+        let v = [1.0, 2.0, 3.0, 4.0, 5.0];
+        assert_eq!((quantile(&v, 0.0), quantile(&v, 0.5), quantile(&v, 1.0)), (1.0, 3.0, 5.0));
+        assert_eq!(quantile(&v, 0.05), 1.2);
+        let s = Stats::of([Some(2.0), None, Some(4.0)]);
+        assert_eq!((s.median, s.mean, s.undefined), (Some(3.0), Some(3.0), 1));
+        assert_eq!(s.std, Some(2f64.sqrt()));
+    }
+
+    #[test]
+    fn ks_statistic_of_identical_and_disjoint_samples() {
+        assert_eq!(ks_statistic(&[1.0, 2.0, 3.0], &[3.0, 1.0, 2.0]), 0.0);
+        assert_eq!(ks_statistic(&[1.0, 2.0], &[3.0, 4.0]), 1.0);
+        assert_eq!(ks_statistic(&[1.0, 2.0, 3.0, 4.0], &[2.5]), 0.5);
+    }
+}

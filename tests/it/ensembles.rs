@@ -1,0 +1,315 @@
+//! Ensembles (`--ensemble N`): members drawn under a scene's `[tolerances]`. Zero tolerances
+//! reproduce the single run exactly; a stiffness tolerance gives the analytic distribution of
+//! the frame's period; the draws depend only on (seed, k), never on threads; a metrics-only
+//! member has exactly the metrics of a full run; bad tolerances are refused with the field.
+
+use std::f64::consts::PI;
+
+use lpc_damper::output::Headline;
+use lpc_damper::run::Record;
+use lpc_damper::scene::{self, Loaded};
+use lpc_damper::studies::ensemble::{self, quantile};
+use lpc_damper::Model;
+
+use crate::common::lpc;
+
+const LSL: &str = r#"
+name = "lsl"
+[frame]
+mass = 1.35
+stiffness = 865.0
+damping = 1.092
+initial_displacement = 0.0185
+[balls]
+arrangement = "LSL"
+large_mass = 0.11
+mass_ratio = 10.0
+density = 8000.0
+restitution = 0.9
+gap = "0.25 Rr"
+clearance = "2 Rr"
+[run]
+horizon = 2.0
+"#;
+
+fn loaded(text: &str) -> Loaded {
+    scene::parse(text, "test.toml", "test").expect("the scene parses")
+}
+
+fn draw(l: &Loaded, count: usize, seed: Option<u64>) -> ensemble::Ensemble {
+    let nominal = l.scene.as_ref().expect("a damper scene");
+    ensemble::draw(&l.file, &l.path, nominal, l.tolerances.as_ref(), count, seed).expect("the members draw")
+}
+
+#[test]
+fn zero_tolerances_reproduce_the_single_run_exactly() {
+    // Both kinds of draw: the gaps moved on the built scene, the stiffness rebuilt from the file.
+    let l = loaded(&format!("{LSL}[tolerances]\ngap = 0.0\nstiffness = 0.0\nrestitution = 0.0\n"));
+    let members = draw(&l, 4, None);
+    assert_eq!(members.redraws, 0);
+    for model in Model::ALL {
+        let single = model.simulate(l.scene.as_ref().unwrap()).unwrap();
+        let expected = Headline::of_run(&single).values();
+        let runs = ensemble::run_members(&members, *model, true, &|| {}).unwrap();
+        for (k, m) in runs.metrics.iter().enumerate() {
+            assert_eq!(m, &expected, "{model}: member {k}'s metrics differ from the single run's");
+            assert_eq!(runs.xs[k], single.series.xs, "{model}: member {k}'s displacement differs from the single run's");
+        }
+    }
+}
+
+#[test]
+fn metrics_only_runs_have_exactly_the_metrics_of_full_runs() {
+    // Forced too: the tally must not depend on the series being kept in any model.
+    let forced = format!("{LSL}[forcing]\nkind = \"force\"\namplitude = 2.0\nfrequency = 4.0\n");
+    for text in [LSL.to_string(), forced] {
+        let s = loaded(&text).scene.unwrap();
+        for model in Model::ALL {
+            let full = model.simulate(&s).unwrap();
+            let lean = model.simulate_recording(&s, Record::MetricsOnly).unwrap();
+            assert!(lean.series.is_empty(), "{model}: a metrics-only run kept its series");
+            assert!(!full.series.is_empty());
+            assert_eq!(Headline::of_run(&lean), Headline::of_run(&full), "{model} on {}", s.name);
+        }
+    }
+}
+
+#[test]
+fn dissipation_times_are_the_first_samples_below_each_energy_level() {
+    // A bare damped frame: energy at each sample in closed form,
+    // x = xs0 e^{-st} (cos wt + s/w sin wt), v = -xs0 (w^2 + s^2)/w e^{-st} sin wt.
+    let text = "[frame]\nmass = 1.35\nstiffness = 865.0\ndamping = 1.092\ninitial_displacement = 0.0185\n\
+                [balls]\narrangement = \"L\"\nlarge_mass = 0.11\ndensity = 8000.0\nrestitution = 0.9\ngap = 0.2\nclearance = 0.2\n\
+                [run]\nhorizon = 8.0\n";
+    let s = loaded(text).scene.unwrap();
+    let run = Model::Reference.simulate(&s).unwrap();
+    assert!(run.impacts.is_empty(), "the ball was meant to stay clear of the walls");
+    let (m, k, c, x0): (f64, f64, f64, f64) = (1.35, 865.0, 1.092, 0.0185);
+    let sigma = c / (2.0 * m);
+    let w = (k / m - sigma * sigma).sqrt();
+    let energy = |t: f64| {
+        let decay = (-sigma * t).exp();
+        let x = x0 * decay * ((w * t).cos() + sigma / w * (w * t).sin());
+        let v = -x0 * (w * w + sigma * sigma) / w * decay * (w * t).sin();
+        0.5 * m * v * v + 0.5 * k * x * x
+    };
+    let e0 = 0.5 * k * x0 * x0;
+    let first_below = |level: f64| (0..=8000).map(|i| i as f64 * 1e-3).find(|&t| energy(t) <= level * e0);
+    let metrics = lpc_damper::metrics::metrics(&run);
+    for (got, level) in [(metrics.dissipation_time_90, 0.1), (metrics.dissipation_time_99, 0.01)] {
+        let want = first_below(level).expect("reached within the horizon");
+        // The first sample below the level, unless the crossing lies within round-off of a sample.
+        assert!(got.is_some_and(|t| (t - want).abs() < 0.5e-3 || (energy(want) - level * e0).abs() < 1e-12 * e0), "{got:?} vs {want}");
+    }
+    // Forced runs have none: energy need not fall.
+    let forced = loaded(&format!("{text}[forcing]\nkind = \"force\"\namplitude = 1.0\nfrequency = 3.0\n")).scene.unwrap();
+    let m = lpc_damper::metrics::metrics(&Model::Reference.simulate(&forced).unwrap());
+    assert_eq!((m.dissipation_time_90, m.dissipation_time_99), (None, None));
+}
+
+#[test]
+fn a_uniform_stiffness_tolerance_gives_the_analytic_distribution_of_the_period() {
+    // An undamped frame whose ball never reaches a wall: period 2 pi sqrt(m / k) with k uniform
+    // on [k0 - w, k0 + w], so P(T <= tau) = (k0 + w - 4 pi^2 m / tau^2) / (2 w).
+    let (m, k0, w): (f64, f64, f64) = (1.35, 865.0, 200.0);
+    let text = format!(
+        "[frame]\nmass = {m}\nstiffness = {k0}\ndamping = 0.0\ninitial_displacement = 0.001\n\
+         [balls]\narrangement = \"L\"\nlarge_mass = 0.11\ndensity = 8000.0\nrestitution = 0.9\ngap = 0.05\nclearance = 0.05\n\
+         [run]\nhorizon = 0.6\nsample_dt = 1e-4\n[tolerances]\nstiffness = {w}\n"
+    );
+    let l = loaded(&text);
+    let n = 400;
+    let members = draw(&l, n, Some(7));
+    let periods: Vec<f64> = ensemble::map_members(
+        &members.members,
+        |member| {
+            let run = Model::Reference.simulate(&member.scene)?;
+            assert!(run.impacts.is_empty());
+            // Two upward zero crossings of xs (linearly interpolated) one period apart.
+            let (t, x) = (&run.series.t, &run.series.xs);
+            let ups: Vec<f64> = (1..x.len())
+                .filter(|&i| x[i - 1] < 0.0 && x[i] >= 0.0)
+                .map(|i| t[i - 1] + (t[i] - t[i - 1]) * -x[i - 1] / (x[i] - x[i - 1]))
+                .collect();
+            Ok::<_, lpc_damper::model::ModelError>(ups[1] - ups[0])
+        },
+        &|| {},
+    )
+    .unwrap();
+    let cdf = |tau: f64| ((k0 + w - 4.0 * PI * PI * m / (tau * tau)) / (2.0 * w)).clamp(0.0, 1.0);
+    let mut sorted = periods.clone();
+    sorted.sort_by(f64::total_cmp);
+    let ks = sorted
+        .iter()
+        .enumerate()
+        .map(|(i, &tau)| (cdf(tau) - i as f64 / n as f64).abs().max(((i + 1) as f64 / n as f64 - cdf(tau)).abs()))
+        .fold(0.0, f64::max);
+    // One-sample Kolmogorov-Smirnov test at 1 % significance: critical value 1.628 / sqrt(n).
+    // The measured periods err by far less (interpolated crossings of 0.1 ms samples) than
+    // the spread (+-12 % in k, +-6 % in T).
+    assert!(ks < 1.628 / (n as f64).sqrt(), "KS statistic {ks} rejects the analytic distribution");
+    // And the draws span the range: the extremes of k lie within a few 1/n of its ends.
+    let t_of = |k: f64| 2.0 * PI * (m / k).sqrt();
+    assert!(quantile(&sorted, 0.0) < t_of(k0 + w * (1.0 - 10.0 / n as f64)));
+    assert!(quantile(&sorted, 1.0) > t_of(k0 - w * (1.0 - 10.0 / n as f64)));
+}
+
+#[test]
+fn members_draw_uniform_numbers_across_indices() {
+    // The first number of each of 20000 members, against the uniform distribution (one-sample
+    // Kolmogorov-Smirnov at 1 % significance, critical value 1.628 / sqrt(n)): members whose
+    // generators were seeded alike would share their numbers and fail it by far.
+    use rand::Rng;
+    let n = 20_000;
+    for seed in [0, 1, 7] {
+        let mut u: Vec<f64> = (0..n).map(|k| ensemble::member_rng(seed, k).random::<f64>()).collect();
+        u.sort_by(f64::total_cmp);
+        let ks = u.iter().enumerate().map(|(i, &x)| (x - i as f64 / n as f64).abs().max(((i + 1) as f64 / n as f64 - x).abs())).fold(0.0, f64::max);
+        assert!(ks < 1.628 / (n as f64).sqrt(), "seed {seed}: KS statistic {ks}");
+    }
+}
+
+#[test]
+fn members_depend_on_seed_and_index_only() {
+    let l = loaded(&format!("{LSL}[tolerances]\ngap = \"0.02 Rr\"\nrestitution = 0.02\nseed = 5\n"));
+    let (a, b) = (draw(&l, 8, None), draw(&l, 3, None));
+    for (x, y) in a.members.iter().zip(&b.members) {
+        assert_eq!(x.drawn, y.drawn, "member {} depends on the ensemble's size", x.index);
+    }
+    assert_eq!(a.seed, 5);
+    let c = draw(&l, 3, Some(6));
+    assert_ne!(c.members[0].drawn, a.members[0].drawn, "--seed is ignored");
+    // The gaps move with the container held: the clearance takes up their sum.
+    let nominal = l.scene.as_ref().unwrap();
+    for m in &a.members {
+        let gaps: f64 = m.drawn[..3].iter().sum();
+        let c = m.scene.container.unwrap();
+        let sum_d: f64 = m.scene.balls.iter().map(|b| 2.0 * b.radius).sum();
+        approx::assert_relative_eq!(gaps + sum_d + c.clearance, nominal.container.unwrap().length, max_relative = 1e-12);
+    }
+}
+
+#[test]
+fn the_same_seed_gives_the_same_bytes_at_any_thread_count() {
+    let tmp = tempfile::tempdir().unwrap();
+    let path = tmp.path().join("lsl.toml");
+    let text = std::fs::read_to_string(scene::scenes_dir().join("lpc-lsl.toml")).unwrap();
+    std::fs::write(&path, format!("{text}\n[tolerances]\ngap = \"0.02 Rr\"\n")).unwrap();
+    let run = |threads: &str, out: &str| {
+        let o = crate::common::lpc_command()
+            .env("RAYON_NUM_THREADS", threads)
+            .args(["run", "--horizon", "1", "--ensemble", "24", "--seed", "3", "--out"])
+            .arg(tmp.path().join(out))
+            .arg(&path)
+            .output()
+            .unwrap();
+        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+        ["members.csv", "band.csv"].map(|f| std::fs::read(tmp.path().join(out).join(f)).unwrap())
+    };
+    let (one, two) = (run("1", "one"), run("2", "two"));
+    assert_eq!(one, two, "members.csv or band.csv differ between 1 and 2 threads");
+    let members = String::from_utf8(one[0].clone()).unwrap();
+    assert_eq!(members.lines().count(), 25);
+    assert!(members.starts_with("member,gap1,gap2,gap3,peak_displacement,"));
+}
+
+#[test]
+fn run_ensemble_json_has_every_metric_distribution() {
+    let tmp = tempfile::tempdir().unwrap();
+    let path = tmp.path().join("lsl.toml");
+    std::fs::write(&path, format!("{LSL}[tolerances]\ngap = \"0.02 Rr\"\n")).unwrap();
+    let out = lpc(["run".as_ref(), path.as_os_str(), "--ensemble".as_ref(), "16".as_ref(), "--format".as_ref(), "json".as_ref()]);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(v["members"], 16);
+    assert_eq!(v["redraws"], 0);
+    for name in lpc_damper::output::SUMMARY_METRICS {
+        let s = &v["metrics"][name];
+        assert!(s.is_object(), "{name} missing");
+        if let (Some(lo), Some(med), Some(hi)) = (s["p05"].as_f64(), s["median"].as_f64(), s["p95"].as_f64()) {
+            assert!(s["min"].as_f64().unwrap() <= lo && lo <= med && med <= hi && hi <= s["max"].as_f64().unwrap(), "{name}: {s}");
+        }
+    }
+    // Impulse models have no contact force: every member reports it undefined.
+    assert_eq!(v["metrics"]["peak_contact_force"]["undefined"], 16);
+    assert!(v["metrics"]["dissipation_time_90"]["median"].as_f64().is_some());
+}
+
+#[test]
+fn studies_answer_with_distributions() {
+    let tmp = tempfile::tempdir().unwrap();
+    let path = tmp.path().join("lsl.toml");
+    std::fs::write(&path, format!("{LSL}[tolerances]\ngap = \"0.02 Rr\"\n")).unwrap();
+    let p = path.to_str().unwrap();
+    let json = |args: &[&str]| -> serde_json::Value {
+        let out = lpc(args.iter().copied().chain(["--format", "json"]));
+        assert!(out.status.success(), "{args:?}: {}", String::from_utf8_lossy(&out.stderr));
+        serde_json::from_slice(&out.stdout).unwrap()
+    };
+    // compare: every model against the reference's distribution.
+    let v = json(&["compare", p, "--models", "rapier", "--ensemble", "6"]);
+    let d = &v["models"]["rapier"]["agreement"]["dissipation_time_90"];
+    assert!(d["ks"].as_f64().is_some_and(|k| (0.0..=1.0).contains(&k)), "{d}");
+    assert!(d["median_inside_reference_band"].is_boolean());
+    assert_eq!(v["reference"]["agreement"]["impact_count"]["ks"], 0.0);
+    // sweep: every point a distribution, read at the chosen quantile.
+    let v = json(&["sweep", p, "--x", "clearance=1Rr,2Rr", "--ensemble", "6", "--quantile", "0.9", "--metric", "impact_loss"]);
+    let points = v.as_array().unwrap();
+    assert_eq!(points.len(), 2);
+    for point in points {
+        let (q, s) = (point["at_quantile"]["impact_loss"].as_f64().unwrap(), &point["metrics"]["impact_loss"]);
+        assert!(s["median"].as_f64().unwrap() <= q && q <= s["max"].as_f64().unwrap(), "{point}");
+    }
+    // optimize: ranked by the quantile, the best's band against the runner-up's (over a
+    // horizon long enough for most members to settle).
+    std::fs::write(&path, format!("{}[tolerances]\ngap = \"0.02 Rr\"\n", LSL.replace("horizon = 2.0", "horizon = 5.0"))).unwrap();
+    let v = json(&["optimize", p, "--vary", "gap=0.2Rr,0.3Rr", "--refinements", "0", "--ensemble", "8", "--quantile", "0.5"]);
+    assert!(v["distinguishable"].is_boolean(), "{v}");
+    let best = &v["ranking"][0];
+    let (lo, hi) = (best["band"][0].as_f64().unwrap(), best["band"][1].as_f64().unwrap());
+    assert!(lo <= hi);
+    // frf: per frequency the distribution of per-period peaks, with and without the damper.
+    let text = format!("{LSL}[forcing]\nkind = \"force\"\namplitude = 2.0\nfrequency = 4.0\n[tolerances]\ngap = \"0.02 Rr\"\n");
+    std::fs::write(&path, text).unwrap();
+    let v = json(&["frf", p, "--freq", "3..5", "--steps", "2", "--ensemble", "3"]);
+    for band in v.as_array().unwrap() {
+        assert_eq!(band["members"], 3);
+        let (a, b) = (&band["amplitude"], &band["amplitude_no_damper"]);
+        assert!(a["p05"].as_f64().unwrap() <= a["p95"].as_f64().unwrap() && b["median"].as_f64().unwrap() > 0.0, "{band}");
+    }
+}
+
+#[test]
+fn bad_tolerances_name_the_field_and_write_nothing() {
+    let tmp = tempfile::tempdir().unwrap();
+    let cases = [
+        ("gap = -0.001", "tolerances.gap"),
+        ("stiffness = nan", "tolerances.stiffness"),
+        ("stifness = 1.0", "stifness"),
+        ("mass_ratio = \"0.1 Rr\"", "tolerances.mass_ratio"),
+        ("distribution = \"cauchy\"", "distribution"),
+        // Every draw puts a ball through its neighbour: the gap is 0.25 Rr, the spread 5 Rr.
+        ("gap = \"5 Rr\"", "tolerances.gap"),
+        // A restitution drawn from [0.9 - 2, 0.9 + 2] leaves [0, 1] far more often than not.
+        ("restitution = 2.0", "tolerances.restitution"),
+        ("forcing_amplitude = 0.1", "tolerances.forcing_amplitude"),
+    ];
+    for (line, field) in cases {
+        let path = tmp.path().join("bad.toml");
+        std::fs::write(&path, format!("{LSL}[tolerances]\n{line}\n")).unwrap();
+        let out_dir = tmp.path().join("out");
+        let out = lpc(["run".as_ref(), path.as_os_str(), "--ensemble".as_ref(), "20".as_ref(), "--out".as_ref(), out_dir.as_os_str()]);
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(2), "{line}: {stderr}");
+        assert!(stderr.contains(field), "{line}: the error does not name `{field}`: {stderr}");
+        assert!(!stderr.contains("panicked"), "{stderr}");
+        assert!(!out_dir.exists(), "{line}: something was written");
+    }
+    // And the ensemble's own bounds.
+    let out = lpc(["run", "scenes/lpc-lsl.toml", "--ensemble", "0"]);
+    assert_eq!(out.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("--ensemble"));
+    let out = lpc(["sweep", "scenes/sweep-gap.toml", "--ensemble", "2", "--quantile", "1.5"]);
+    assert_eq!(out.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("--quantile"));
+}
