@@ -86,19 +86,31 @@ pub struct Robust {
 }
 
 
-/// Searches `arrangements` x the grid of `axes` (refined `refinements` times) for the design
-/// minimising `objective`, with the container's inner length fixed to `container_length`.
+/// How designs are judged.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Judging {
+    /// What is minimised.
+    pub objective: Objective,
+    /// The model that runs each design.
+    pub model: Model,
+    /// Refinements around the best grid point.
+    pub refinements: u32,
+    /// Over ensembles (ranked by a quantile), or one run per design.
+    pub robust: Option<Robust>,
+}
+
+/// Searches `arrangements` x the grid of `axes` (refined `judging.refinements` times) for the
+/// design minimising `judging.objective`, with the container's inner length fixed to
+/// `container_length`.
 pub fn optimize(
     loaded: &Loaded,
     axes: &[Axis],
     arrangements: &[String],
     container_length: Length,
-    objective: Objective,
-    model: Model,
-    refinements: u32,
-    robust: Option<Robust>,
+    judging: Judging,
     progress: &(dyn Fn() + Sync),
 ) -> Result<Search, StudyError> {
+    let Judging { objective, model, refinements, robust } = judging;
     let invalid = |field: &str, rule: String| SceneError::Invalid { file: loaded.path.clone(), field: field.into(), rule };
     if axes.iter().any(|a| a.parameter == "clearance") {
         return Err(invalid("clearance", "follows from the container length here: vary gap, mass_ratio, ... instead".into()).into());

@@ -62,7 +62,7 @@ enum ObjectiveArg {
 }
 
 pub fn run(a: Args) -> Result<ExitStatus> {
-    use lpc_damper::studies::optimize::{optimize, Objective};
+    use lpc_damper::studies::optimize::{optimize, Judging, Objective};
     let loaded = scene::load(&a.scene)?;
     let invalid = |field: &str, rule: String| invalid(&a.scene, field, rule);
     let Some(base) = loaded.scene.clone() else {
@@ -110,7 +110,7 @@ pub fn run(a: Args) -> Result<ExitStatus> {
     let bar = progress_bar(usize::MAX >> 1, "designs");
     bar.set_style(ProgressStyle::with_template("{msg} {pos} ({elapsed})").expect("valid template"));
     let start = std::time::Instant::now();
-    let search = optimize(&loaded, &axes, &arrangements, length, objective, a.model, a.refinements, robust, &|| bar.inc(1))?;
+    let search = optimize(&loaded, &axes, &arrangements, length, Judging { objective, model: a.model, refinements: a.refinements, robust }, &|| bar.inc(1))?;
     bar.finish_and_clear();
     match a.format {
         Format::Json => print_json(&search)?,
