@@ -30,7 +30,7 @@ fn main() -> anyhow::Result<()> {
     // Rapier reads `Time` although the plug-in's fixed steps never use its value.
     app.init_resource::<Time>()
         .init_resource::<Watch>()
-        .add_plugins(LpcDamperPlugins { scene: scene.clone(), settings: settings(&scene) })
+        .add_plugins(LpcDamperPlugins { scene: scene.clone(), settings: settings(&scene), record: lpc_damper::run::Record::Series })
         .add_systems(PostUpdate, watch_frame.after(DamperSet::Feedback));
     app.finish();
     app.cleanup();

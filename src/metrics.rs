@@ -105,18 +105,36 @@ pub fn noise(run: &Run) -> Noise {
 
 /// Computes the metrics of `run`.
 pub fn metrics(run: &Run) -> Metrics {
-    let t = &run.tally;
+    let m = &run.motion;
     Metrics {
-        peak_displacement: t.peak_displacement,
-        peak_acceleration: t.peak_acceleration,
-        rms_displacement: if t.samples == 0 { 0.0 } else { (t.sum_sq / t.samples as f64).sqrt() },
-        settling_time: t.settling_time(),
+        peak_displacement: m.peak_displacement,
+        peak_acceleration: m.peak_acceleration,
+        rms_displacement: m.rms_displacement,
+        settling_time: m.settling_time,
         energy_remaining: (run.energy.initial != 0.0).then(|| run.energy.final_ / run.energy.initial),
-        dissipation_time_90: t.dissipated[0],
-        dissipation_time_99: t.dissipated[1],
+        dissipation_time_90: m.dissipation_times[0],
+        dissipation_time_99: m.dissipation_times[1],
         peak_contact_force: run.impacts.iter().filter_map(|i| i.peak_force).reduce(f64::max),
         peak_true_acceleration: run.peak_true_acceleration,
     }
+}
+
+/// The metrics read from the motion itself: peaks of `|xs|` and `|a|` from one bare period on,
+/// RMS of `xs`, the settling time and the dissipation times (see [`Metrics`]). Every model
+/// reads them at its samples ([`SampleTally`]); the reference computes them exactly from its
+/// closed-form motion in free vibration.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct MotionMetrics {
+    /// max |xs| for t >= T, m.
+    pub peak_displacement: f64,
+    /// max |a| for t >= T, m/s^2.
+    pub peak_acceleration: f64,
+    /// RMS of xs over the horizon, m.
+    pub rms_displacement: f64,
+    /// Last time |xs| >= 5 % of |xs0|, `None` when that still holds at the horizon.
+    pub settling_time: Option<f64>,
+    /// First times the energy has fallen to each of [`DISSIPATION_LEVELS`].
+    pub dissipation_times: [Option<f64>; 2],
 }
 
 /// Energy fractions left at which the dissipation times are read: 10 % and 1 %.
@@ -184,6 +202,16 @@ impl SampleTally {
             }
         }
     }
+    /// The metrics tallied.
+    pub fn finish(&self) -> MotionMetrics {
+        MotionMetrics {
+            peak_displacement: self.peak_displacement,
+            peak_acceleration: self.peak_acceleration,
+            rms_displacement: if self.samples == 0 { 0.0 } else { (self.sum_sq / self.samples as f64).sqrt() },
+            settling_time: self.settling_time(),
+            dissipation_times: self.dissipated,
+        }
+    }
     /// The last sampled time at which `|xs| >= 5 % |xs0|`, or `None` if the last sample still
     /// is (not settled within the horizon). A series that never reaches the band settles at 0.
     pub fn settling_time(&self) -> Option<f64> {
@@ -220,7 +248,7 @@ mod tests {
         for (k, e) in [1.0, 0.5, 0.1, 0.2, 0.05, 0.01, 0.001].into_iter().enumerate() {
             tally.add(k as f64, 0.0, 0.0, e);
         }
-        assert_eq!(tally.dissipated, [Some(2.0), Some(5.0)]);
+        assert_eq!(tally.finish().dissipation_times, [Some(2.0), Some(5.0)]);
     }
 
     #[test]

@@ -146,6 +146,31 @@ impl Oscillator {
         ROUNDOFF_ULPS * f64::EPSILON * (2.0 + self.rate() * t) * (y0.abs() + (y1 + self.sigma * y0).abs() * t.min(self.f_cap()))
     }
 
+    /// For an oscillating solution `y` with `y(0) = y0`, `y'(0) = y1` (`y ~ cos(w t - phi)`),
+    /// the phase `phi + pi / 2` at which its zeros fall, `w t = phi + pi/2 + k pi`: one `atan2`
+    /// per solution, which [`Oscillator::next_sign_change`] would otherwise repeat per call.
+    pub fn zero_phase(&self, y0: f64, y1: f64) -> Option<f64> {
+        match self.regime {
+            Regime::Under { w } if y0 != 0.0 || y1 + self.sigma * y0 != 0.0 => {
+                Some(((y1 + self.sigma * y0) / w).atan2(y0) + 0.5 * PI)
+            }
+            _ => None,
+        }
+    }
+
+    /// The first zero after `after` of an oscillating solution whose zeros have phase `base`
+    /// ([`Oscillator::zero_phase`]), angular frequency `w`.
+    #[inline]
+    pub fn next_zero(w: f64, base: f64, after: f64) -> f64 {
+        let mut k = ((w * after - base) / PI).floor();
+        let mut t = (base + k * PI) / w;
+        while t <= after {
+            k += 1.0;
+            t = (base + k * PI) / w;
+        }
+        t
+    }
+
     /// The first time `t > after` at which the solution `y` with `y(0) = y0`, `y'(0) = y1`
     /// changes sign (for the acceleration: where the force on the frame reverses).
     pub fn next_sign_change(&self, y0: f64, y1: f64, after: f64) -> Option<f64> {
@@ -155,16 +180,7 @@ impl Oscillator {
                 if y0 == 0.0 && q == 0.0 {
                     return None;
                 }
-                // y ~ cos(w t - phi): zero where w t = phi + pi/2 + k pi.
-                let phi = (q / w).atan2(y0);
-                let base = phi + 0.5 * PI;
-                let mut k = ((w * after - base) / PI).floor();
-                let mut t = (base + k * PI) / w;
-                while t <= after {
-                    k += 1.0;
-                    t = (base + k * PI) / w;
-                }
-                Some(t)
+                Some(Self::next_zero(w, self.zero_phase(y0, y1)?, after))
             }
             Regime::Critical => {
                 // y ~ y0 + q t.

@@ -1,7 +1,7 @@
 //! The common output of every model: sampled series, impact list, energy account and wall
 //! time. Metrics, comparison and output read only this type, so models stay interchangeable.
 
-use crate::metrics::SampleTally;
+use crate::metrics::{MotionMetrics, SampleTally};
 use crate::scene::{Body, Scene};
 
 /// A model of the damper.
@@ -144,9 +144,9 @@ impl Recorder {
         let energy = if wants_energy { scene.frame_energy(t, xs, vs) + kinetic } else { 0.0 };
         self.tally.add(t, xs, a, energy);
     }
-    /// The series (empty when not kept) and the tally.
-    pub fn finish(self) -> (Series, SampleTally) {
-        (self.series.unwrap_or_default(), self.tally)
+    /// The series (empty when not kept) and the metrics tallied at the samples.
+    pub fn finish(self) -> (Series, MotionMetrics) {
+        (self.series.unwrap_or_default(), self.tally.finish())
     }
 }
 
@@ -228,8 +228,9 @@ pub struct Run {
     pub damped_period: f64,
     /// Sampled motion (empty when the run kept only its metrics, [`Record::MetricsOnly`]).
     pub series: Series,
-    /// The metrics of the sampled motion, tallied as it was sampled.
-    pub tally: SampleTally,
+    /// The metrics of the motion (tallied at the samples, or exact where a model knows its
+    /// motion in closed form).
+    pub motion: MotionMetrics,
     /// Every impact, in time order.
     pub impacts: Vec<Impact>,
     /// Energy account.
@@ -265,7 +266,7 @@ impl Run {
             initial_displacement: 0.0,
             damped_period: 0.0,
             series: Series::default(),
-            tally: SampleTally::default(),
+            motion: MotionMetrics::default(),
             impacts: vec![],
             energy: EnergyAccount::default(),
             events: 0,

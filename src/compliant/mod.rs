@@ -796,7 +796,7 @@ impl<'s, 'a> Driver<'s, 'a> {
             self.y[sys.forcing_work()],
         );
         let final_velocities = (0..sys.n).map(|i| self.y[sys.v(i)]).collect();
-        let (series, tally) = self.recorder.finish();
+        let (series, motion) = self.recorder.finish();
         Ok(Run {
             scene: scene.name.clone(),
             model: crate::run::Model::Compliant,
@@ -805,7 +805,7 @@ impl<'s, 'a> Driver<'s, 'a> {
             initial_displacement: scene.initial_displacement,
             damped_period: scene.frame.map_or(0.0, |f| f.damped_period()),
             series,
-            tally,
+            motion,
             impacts: self.impacts,
             energy,
             events: self.accepted,

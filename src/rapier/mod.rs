@@ -27,7 +27,7 @@ use crate::model::ModelError;
 use crate::run::{EnergyAccount, Record, Run};
 use crate::scene::{Body, Scene};
 pub use plugin::{DamperSet, DamperStep, LpcDamperPlugins};
-pub use resources::{Bodies, DamperScene, FrameState, Keep, Recording, StepClock, StepPlan, StepSettings};
+pub use resources::{Bodies, DamperScene, FrameState, Recording, StepClock, StepPlan, StepSettings};
 pub use crate::scene::Stepping;
 
 /// Default stepping (from the accuracy study in docs/BENCHMARKS.md).
@@ -123,10 +123,15 @@ pub fn can_represent(scene: &Scene) -> Result<(), ModelError> {
 /// A headless app (no window, renderer or audio) simulating `scene`: one Rapier step per
 /// `app.update()`, never paced to real time.
 pub fn headless_app(scene: &Scene, settings: StepSettings) -> App {
+    headless_app_recording(scene, settings, Record::Series)
+}
+
+/// [`headless_app`], keeping what `record` asks for.
+pub fn headless_app_recording(scene: &Scene, settings: StepSettings, record: Record) -> App {
     let mut app = App::new();
     // Rapier reads `Time` although fixed steps never use its value.
     app.init_resource::<Time>();
-    app.add_plugins(LpcDamperPlugins { scene: scene.clone(), settings });
+    app.add_plugins(LpcDamperPlugins { scene: scene.clone(), settings, record });
     app.finish();
     app.cleanup();
     app
@@ -150,8 +155,7 @@ pub fn simulate_recording(scene: &Scene, record: Record) -> Result<Run, ModelErr
 fn run_app(scene: &Scene, settings: StepSettings, record: Record) -> Result<Run, ModelError> {
     can_represent(scene)?;
     let start = Instant::now();
-    let mut app = headless_app(scene, settings);
-    app.insert_resource(Keep(record));
+    let mut app = headless_app_recording(scene, settings, record);
     // The first update spawns the scene, lets bevy_rapier create its bodies and takes the
     // first step; the rest run the lean step schedule alone.
     app.update();
@@ -186,7 +190,7 @@ pub fn collect(world: &mut World, scene: &Scene, steps: u64) -> Run {
         rec.impact_loss,
         frame.map_or(0.0, |f| f.forcing_work),
     );
-    let (series, tally) = rec.recorder.finish();
+    let (series, motion) = rec.recorder.finish();
     Run {
         scene: scene.name.clone(),
         model: crate::run::Model::Rapier,
@@ -195,7 +199,7 @@ pub fn collect(world: &mut World, scene: &Scene, steps: u64) -> Run {
         initial_displacement: scene.initial_displacement,
         damped_period: f.map_or(0.0, |f| f.damped_period()),
         series,
-        tally,
+        motion,
         impacts: rec.impacts,
         energy,
         events: steps,

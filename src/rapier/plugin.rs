@@ -47,6 +47,8 @@ pub struct LpcDamperPlugins {
     pub scene: Scene,
     /// Stepping.
     pub settings: StepSettings,
+    /// What the run keeps besides its metrics.
+    pub record: Record,
 }
 
 impl PluginGroup for LpcDamperPlugins {
@@ -56,7 +58,7 @@ impl PluginGroup for LpcDamperPlugins {
             .add(ContactPhysicsPlugin { scene: self.scene.clone(), settings: self.settings })
             .add(SceneSpawnPlugin { scene: self.scene.clone() })
             .add(FramePlugin)
-            .add(RecordPlugin)
+            .add(RecordPlugin { record: self.record })
     }
 }
 
@@ -264,17 +266,23 @@ pub fn drive_frame(
 }
 
 /// Measures impacts, feeds them back into the frame and records the series.
-pub struct RecordPlugin;
+pub struct RecordPlugin {
+    /// What the run keeps besides its metrics.
+    pub record: Record,
+}
 
 impl Plugin for RecordPlugin {
     fn build(&self, app: &mut App) {
-        app.add_systems(Startup, init_recording)
+        // Passed in the system, not as a resource: adding a resource reorders what Bevy
+        // iterates, and the contact model's chaotic runs follow any change of order.
+        let record = self.record;
+        app.add_systems(Startup, move |commands: Commands, scene: Res<DamperScene>| init_recording(commands, scene, record))
             .add_systems(PostUpdate, (feedback.in_set(DamperSet::Feedback), record_samples.in_set(DamperSet::Record)))
             .add_systems(DamperStep, (feedback.in_set(DamperSet::Feedback), record_samples.in_set(DamperSet::Record)));
     }
 }
 
-fn init_recording(mut commands: Commands, scene: Res<DamperScene>, keep: Option<Res<Keep>>) {
+fn init_recording(mut commands: Commands, scene: Res<DamperScene>, record: Record) {
     commands.insert_resource(StepClock::default());
-    commands.insert_resource(Recording::new(&scene.0, keep.map_or(Record::Series, |k| k.0)));
+    commands.insert_resource(Recording::new(&scene.0, record));
 }

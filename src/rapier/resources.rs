@@ -102,10 +102,6 @@ pub struct StepPlan {
     pub horizon: f64,
 }
 
-/// What a run keeps besides its metrics (the series unless told otherwise).
-#[derive(Resource, Debug, Clone, Copy, Default)]
-pub struct Keep(pub Record);
-
 /// What the contact model has recorded so far.
 #[derive(Resource, Debug, Clone)]
 pub struct Recording {

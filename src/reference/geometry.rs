@@ -72,10 +72,22 @@ impl Solver<'_> {
         }
     }
 
+    /// The frame's state at `t` in the current segment (the last one asked for is kept).
+    #[inline]
+    pub(super) fn frame_state(&self, t: f64) -> (f64, f64) {
+        let (segment, last, xs, vs) = self.last_state.get();
+        if segment == self.segment && last == t {
+            return (xs, vs);
+        }
+        let (xs, vs) = self.seg.state(t);
+        self.last_state.set((self.segment, t, xs, vs));
+        (xs, vs)
+    }
+
     /// Gap and its rate for a ball-frame pair at time `t` (the ball flies from `self.t`).
     #[inline]
     pub(super) fn frame_gap_at(&self, ball: usize, s: f64, k: f64, t: f64) -> (f64, f64) {
-        let (xs, vs) = self.seg.state(t);
+        let (xs, vs) = self.frame_state(t);
         let xb = self.x[ball] + self.v[ball] * (t - self.t);
         (s * (xb - xs) + k, s * (self.v[ball] - vs))
     }
@@ -88,7 +100,7 @@ impl Solver<'_> {
     /// keep that overlap). The reference
     /// takes no contact below minus this, and its postcondition checks it (docs/MODEL.md).
     pub(super) fn frame_gap_tolerance(&self, ball: usize, s: f64, k: f64, t: f64) -> (f64, f64, f64) {
-        let (xs, vs) = self.seg.state(t);
+        let (xs, vs) = self.frame_state(t);
         let xb = self.x[ball] + self.v[ball] * (t - self.t);
         let rate = s * (self.v[ball] - vs);
         (s * (xb - xs) + k, rate, self.frame_tolerance(ball, t, xb, xs, k, rate))
@@ -176,7 +188,7 @@ impl Solver<'_> {
                 return (n.xs, n.vs, n.accel_ahead);
             }
         }
-        let (xs, vs) = self.seg.state(self.t);
+        let (xs, vs) = self.frame_state(self.t);
         let accel_ahead = self.accel_ahead(self.t);
         self.now.set(Some(FrameNow { segment: self.segment, t: self.t, xs, vs, accel_ahead }));
         (xs, vs, accel_ahead)
@@ -201,7 +213,7 @@ impl Solver<'_> {
             };
             return sign * a.abs().max(f64::MIN_POSITIVE);
         }
-        let (x, v) = self.seg.state(t);
+        let (x, v) = self.frame_state(t);
         let o = &self.seg.osc;
         let a = o.accel(x, v);
         // Scales of a and its derivative over the motion (w0 |v| matters where x passes 0).

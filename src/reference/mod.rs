@@ -25,12 +25,14 @@
 //! holds the solver's state, its limits and the event loop.
 
 mod events;
+mod exact;
 mod geometry;
 pub mod impact_law;
 mod output;
 mod search;
 mod segment;
 
+use exact::ExactTally;
 use geometry::*;
 use output::*;
 use search::*;
@@ -159,6 +161,10 @@ struct Solver<'a> {
     /// The frame's state and acceleration ahead at `t` under segment `segment`, kept while
     /// neither changes (a cascade of impulses at one instant asks for them every pass).
     now: std::cell::Cell<Option<FrameNow>>,
+    /// The last frame state evaluated, `(segment, t, xs, vs)`: the searches of both walls and
+    /// the checks ask for the same instant in turn, and each evaluation costs an `exp` and a
+    /// `sin_cos` ([`Solver::frame_state`]).
+    last_state: std::cell::Cell<(u64, f64, f64, f64)>,
     /// Scratch of `resolve`: each pair's contact now.
     contacts: Vec<Contact>,
     t: f64,
@@ -197,6 +203,10 @@ struct Solver<'a> {
     last_impact: Vec<Option<usize>>,
     events: u64,
     recorder: Recorder,
+    /// Exact metrics of a free run (`None` when forced or frameless: read at the samples).
+    exact: Option<ExactTally>,
+    /// Whether samples are taken: for the series, or for the metrics when not exact.
+    sampling: bool,
     next_sample: usize,
     sample_count: usize,
     cursor: SampleCursor,
@@ -251,6 +261,7 @@ impl<'a> Solver<'a> {
             segment: 1,
             sign_changes: Default::default(),
             now: Default::default(),
+            last_state: std::cell::Cell::new((0, f64::NAN, 0.0, 0.0)),
             contacts: Vec::new(),
             t: 0.0,
             x: scene.initial_positions.clone(),
@@ -279,6 +290,8 @@ impl<'a> Solver<'a> {
             last_impact: vec![None; n + 1],
             events: 0,
             recorder: Recorder::new(scene, record),
+            exact: ExactTally::new(scene),
+            sampling: record == Record::Series || ExactTally::new(scene).is_none(),
             next_sample: 0,
             sample_count: samples,
             cursor: SampleCursor { seg_t0: f64::NAN, k: 0, x: 0.0, v: 0.0, steps: 0, mass: f64::NAN, transition: [[0.0; 2]; 2] },
@@ -337,6 +350,7 @@ impl<'a> Solver<'a> {
                     continue;
                 }
             }
+            self.tally_until(t);
             self.sample_until(t, false);
             same_instant = if t == self.t { same_instant + 1 } else { 0 };
             self.advance(t);
@@ -361,6 +375,7 @@ impl<'a> Solver<'a> {
             }
             self.resolve()?;
         }
+        self.tally_until(self.horizon);
         self.sample_until(self.horizon, true);
         self.advance(self.horizon);
         self.check_contacts(None)

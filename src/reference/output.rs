@@ -21,6 +21,9 @@ pub(super) struct SampleCursor {
 impl Solver<'_> {
     /// Writes every sample with time `<= until` (strictly before when `inclusive` is false).
     pub(super) fn sample_until(&mut self, until: f64, inclusive: bool) {
+        if !self.sampling {
+            return;
+        }
         let dt = self.scene.sample_dt;
         while self.next_sample < self.sample_count {
             let ts = self.next_sample as f64 * dt;
@@ -36,6 +39,21 @@ impl Solver<'_> {
             });
             self.next_sample += 1;
         }
+    }
+
+    /// Adds the motion from now to `until` (no event between) to the exact metrics.
+    pub(super) fn tally_until(&mut self, until: f64) {
+        if self.exact.is_none() {
+            return;
+        }
+        let ends = [self.frame_state(self.t), self.frame_state(until)];
+        let Some(exact) = &mut self.exact else { return };
+        let free_energy = if exact.wants_energy() {
+            (0..self.n).filter(|&i| self.hold[i] == Hold::Free).map(|i| 0.5 * self.mass[i] * self.v[i] * self.v[i]).sum()
+        } else {
+            0.0
+        };
+        exact.interval(&self.seg, self.t, until, ends, free_energy);
     }
 
     /// The frame's state at sample `self.next_sample` (time `ts`): one step of the exact
@@ -90,7 +108,8 @@ impl Solver<'_> {
             self.impact_loss,
             self.forcing_work,
         );
-        let (series, tally) = self.recorder.finish();
+        let (series, sampled) = self.recorder.finish();
+        let motion = self.exact.map_or(sampled, |e| e.finish());
         Run {
             scene: self.scene.name.clone(),
             model: crate::run::Model::Reference,
@@ -99,7 +118,7 @@ impl Solver<'_> {
             initial_displacement: self.scene.initial_displacement,
             damped_period: self.scene.frame.map_or(0.0, |f| f.damped_period()),
             series,
-            tally,
+            motion,
             impacts: self.impacts,
             energy,
             events: self.events,

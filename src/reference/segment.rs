@@ -16,6 +16,21 @@ pub(super) struct Segment {
     pub(super) j0: f64,
     pub(super) osc: Oscillator,
     pub(super) forced: Option<Forced>,
+    /// `(w, phase)` of the acceleration's zeros when the segment oscillates
+    /// ([`Oscillator::zero_phase`]), computed once.
+    accel_zeros: Option<(f64, f64)>,
+    /// The same for the velocity's and the jerk's zeros (the extrema of `x` and of the
+    /// acceleration, for the exact metrics of free vibration), computed once.
+    extremum_zeros: Option<(f64, f64, f64)>,
+}
+
+/// Which extrema of a free segment's motion.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(super) enum Extremum {
+    /// Of `x` (zeros of the velocity).
+    Displacement,
+    /// Of the acceleration (zeros of the jerk).
+    Acceleration,
 }
 
 /// A forced segment: the motion is `xp(t)` plus the free motion of the departure from it.
@@ -68,7 +83,13 @@ impl Segment {
         });
         let (hx, hv) = forced.map_or((x0, v0), |f| f.h0);
         let a0 = osc.accel(hx, hv);
-        Segment { t0, x0, v0, a0, j0: -2.0 * osc.sigma * a0 - osc.w0sq * hv, osc, forced }
+        let j0 = -2.0 * osc.sigma * a0 - osc.w0sq * hv;
+        let accel_zeros = osc.damped_omega().zip(osc.zero_phase(a0, j0));
+        let extremum_zeros = match (forced, osc.damped_omega()) {
+            (None, Some(w)) => osc.zero_phase(v0, a0).zip(osc.zero_phase(j0, osc.accel(a0, j0))).map(|(pv, pj)| (w, pv, pj)),
+            _ => None,
+        };
+        Segment { t0, x0, v0, a0, j0, osc, forced, accel_zeros, extremum_zeros }
     }
     #[inline]
     pub(super) fn state(&self, t: f64) -> (f64, f64) {
@@ -94,13 +115,36 @@ impl Segment {
         let parts = [(ah, d[2]), (jh, d[3]), (sh, d[4])];
         std::array::from_fn(|n| (parts[n].0 + parts[n].1, parts[n].0.abs() + f.particular[n + 2]))
     }
+    /// The first extremum of `what` strictly after `t` (an unforced segment), or `None`.
+    pub(super) fn next_extremum(&self, what: Extremum, t: f64) -> Option<f64> {
+        let zero = |after: f64| match (self.extremum_zeros, what) {
+            (Some((w, pv, _)), Extremum::Displacement) => Some(Oscillator::next_zero(w, pv, after)),
+            (Some((w, _, pj)), Extremum::Acceleration) => Some(Oscillator::next_zero(w, pj, after)),
+            (None, Extremum::Displacement) => self.osc.next_sign_change(self.v0, self.a0, after),
+            (None, Extremum::Acceleration) => self.osc.next_sign_change(self.j0, self.osc.accel(self.a0, self.j0), after),
+        };
+        // A zero just after `t` in segment time can round onto `t` in absolute time: take the
+        // next one then (as `free_sign_change` does).
+        let mut after = t - self.t0;
+        while let Some(tau) = zero(after) {
+            if self.t0 + tau > t {
+                return Some(self.t0 + tau);
+            }
+            after = tau;
+        }
+        None
+    }
     /// Next time after `t` at which an unforced frame's acceleration changes sign (closed
     /// form), or infinity.
     pub(super) fn free_sign_change(&self, t: f64) -> f64 {
         // A root just after `t` in segment time can round onto `t` in absolute time: take the
         // next one then, so that time always moves on.
         let mut after = t - self.t0;
-        while let Some(tau) = self.osc.next_sign_change(self.a0, self.j0, after) {
+        let next = |after: f64| match self.accel_zeros {
+            Some((w, phase)) => Some(Oscillator::next_zero(w, phase, after)),
+            None => self.osc.next_sign_change(self.a0, self.j0, after),
+        };
+        while let Some(tau) = next(after) {
             if self.t0 + tau > t {
                 return self.t0 + tau;
             }
