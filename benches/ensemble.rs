@@ -9,13 +9,13 @@
 //! `cargo bench --bench ensemble`.
 
 use criterion::{criterion_group, criterion_main, Criterion};
-use lpc_damper::scene::{parse, scenes_dir};
+use lpc_damper::scene::{load, scenes_dir};
 use lpc_damper::studies::ensemble::{draw, run_members, Ensemble};
 use lpc_damper::Model;
 
 fn lsl_with_tolerance() -> (lpc_damper::scene::Scene, Ensemble, Ensemble) {
-    let text = std::fs::read_to_string(scenes_dir().join("lpc-lsl.toml")).unwrap() + "\n[tolerances]\ngap = \"0.02 Rr\"\n";
-    let l = parse(&text, "lpc-lsl.toml", "lpc-lsl").unwrap();
+    // The scene's own [tolerances]: gap 0.02 Rr.
+    let l = load(scenes_dir().join("lpc-lsl.toml")).unwrap();
     let nominal = l.scene.clone().unwrap();
     let big = draw(&l.file, &l.path, &nominal, l.tolerances.as_ref(), 1000, None).unwrap();
     let small = draw(&l.file, &l.path, &nominal, l.tolerances.as_ref(), 200, None).unwrap();

@@ -104,7 +104,8 @@ pub enum Record {
 #[derive(Debug, Clone)]
 pub struct Recorder {
     series: Option<Series>,
-    tally: SampleTally,
+    /// `None` when the model computes the metrics itself ([`Recorder::untallied`]).
+    tally: Option<SampleTally>,
     masses: Vec<f64>,
 }
 
@@ -113,16 +114,21 @@ impl Recorder {
     pub fn new(scene: &Scene, record: Record) -> Self {
         Recorder {
             series: (record == Record::Series).then(|| Series::with_capacity(scene.balls.len(), scene.sample_count())),
-            tally: SampleTally::new(scene),
+            tally: Some(SampleTally::new(scene)),
             masses: scene.balls.iter().map(|b| b.mass).collect(),
         }
+    }
+    /// This recorder keeping the series only: for a model that computes the metrics itself
+    /// (the reference, exactly, in free vibration).
+    pub fn untallied(self) -> Self {
+        Recorder { tally: None, ..self }
     }
     /// The sample at `t`: the frame's state, and each ball's `(x, v)` from `ball(i)`. The
     /// acceleration is the one every model reports, [`Scene::frame_acceleration`].
     #[inline]
     pub fn sample(&mut self, scene: &Scene, t: f64, xs: f64, vs: f64, ball: impl Fn(usize) -> (f64, f64)) {
         let a = scene.frame_acceleration(t, xs, vs);
-        let wants_energy = self.tally.wants_energy();
+        let wants_energy = self.tally.as_ref().is_some_and(|t| t.wants_energy());
         let mut kinetic = 0.0;
         if let Some(s) = &mut self.series {
             s.t.push(t);
@@ -142,11 +148,14 @@ impl Recorder {
             }
         }
         let energy = if wants_energy { scene.frame_energy(t, xs, vs) + kinetic } else { 0.0 };
-        self.tally.add(t, xs, a, energy);
+        if let Some(tally) = &mut self.tally {
+            tally.add(t, xs, a, energy);
+        }
     }
-    /// The series (empty when not kept) and the metrics tallied at the samples.
+    /// The series (empty when not kept) and the metrics tallied at the samples (the default
+    /// when untallied).
     pub fn finish(self) -> (Series, MotionMetrics) {
-        (self.series.unwrap_or_default(), self.tally.finish())
+        (self.series.unwrap_or_default(), self.tally.map(|t| t.finish()).unwrap_or_default())
     }
 }
 

@@ -43,7 +43,8 @@ pub(super) struct ExactTally {
 }
 
 impl ExactTally {
-    /// The tally of a free run of `scene`, or `None` when it has no frame or is forced.
+    /// The tally of a free run of `scene`, or `None` when it has no frame (the chain: `xs` is
+    /// 0 throughout, the samples serve) or is forced.
     pub(super) fn new(scene: &Scene) -> Option<Self> {
         let frame = scene.frame?;
         if scene.forcing.is_some() {

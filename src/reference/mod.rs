@@ -289,7 +289,10 @@ impl<'a> Solver<'a> {
             impacts: Vec::new(),
             last_impact: vec![None; n + 1],
             events: 0,
-            recorder: Recorder::new(scene, record),
+            recorder: match ExactTally::new(scene) {
+                Some(_) => Recorder::new(scene, record).untallied(),
+                None => Recorder::new(scene, record),
+            },
             exact: ExactTally::new(scene),
             sampling: record == Record::Series || ExactTally::new(scene).is_none(),
             next_sample: 0,
