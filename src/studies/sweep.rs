@@ -9,9 +9,9 @@ use crate::model::{Model, ModelError};
 use crate::output::RunSummary;
 use crate::scene::{self, Length, Loaded, Scene, SceneError};
 
-/// One value of a sweep (the JSON contract of `lpc sweep`).
+/// Where a point of a sweep lies (the first fields of `lpc sweep`'s JSON).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-pub struct SweepPoint {
+pub struct Coordinates {
     /// Parameter name.
     pub parameter: String,
     /// Its value as written in the file (metres or Rr multiples for lengths).
@@ -22,6 +22,26 @@ pub struct SweepPoint {
     /// Its value.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub value_y: Option<f64>,
+}
+
+impl Coordinates {
+    /// The coordinates of a grid point with `values` on the axes `parameters`.
+    pub fn of(parameters: &[String], values: &[f64]) -> Self {
+        Coordinates {
+            parameter: parameters[0].clone(),
+            value: values[0],
+            parameter_y: parameters.get(1).cloned(),
+            value_y: values.get(1).copied(),
+        }
+    }
+}
+
+/// One value of a sweep (the JSON contract of `lpc sweep`).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct SweepPoint {
+    /// Where.
+    #[serde(flatten)]
+    pub at: Coordinates,
     /// The run.
     pub summary: RunSummary,
 }
@@ -29,16 +49,9 @@ pub struct SweepPoint {
 /// One value of a sweep whose every point is an ensemble (`lpc sweep --ensemble`).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct EnsemblePoint {
-    /// Parameter name.
-    pub parameter: String,
-    /// Its value as written.
-    pub value: f64,
-    /// The second parameter of a grid.
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub parameter_y: Option<String>,
-    /// Its value.
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub value_y: Option<f64>,
+    /// Where.
+    #[serde(flatten)]
+    pub at: Coordinates,
     /// Members.
     pub members: usize,
     /// Draws thrown away as invalid.
@@ -216,13 +229,7 @@ pub fn run_grid(
         .map(|g| {
             let run = model.simulate(&g.scene)?;
             progress();
-            Ok(SweepPoint {
-                parameter: parameters[0].clone(),
-                value: g.values[0],
-                parameter_y: parameters.get(1).cloned(),
-                value_y: g.values.get(1).copied(),
-                summary: RunSummary::of(&run),
-            })
+            Ok(SweepPoint { at: Coordinates::of(parameters, &g.values), summary: RunSummary::of(&run) })
         })
         .collect()
 }

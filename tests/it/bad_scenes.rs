@@ -4,25 +4,7 @@
 use std::path::Path;
 use crate::common::lpc_command;
 
-const GOOD: &str = r#"
-name = "t"
-[frame]
-mass = 1.35
-stiffness = 865.0
-damping = 1.092
-initial_displacement = 0.0185
-[balls]
-arrangement = "LSL"
-large_mass = 0.11
-mass_ratio = 10.0
-density = 8000.0
-restitution = 0.9
-gap = "0.25 Rr"
-clearance = "2 Rr"
-[run]
-horizon = 5.0
-sample_dt = 0.001
-"#;
+const GOOD: &str = crate::common::LSL_TOML;
 
 /// Runs `lpc run` on `text` written to a file; returns (status, stderr, out dir existed).
 fn run_lpc(text: &str, extra: &[&str]) -> (i32, String, bool) {

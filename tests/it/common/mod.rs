@@ -19,6 +19,27 @@ pub fn scene_from_toml(text: &str) -> Scene {
     lpc_damper::scene::parse(text, "test.toml", "test").expect("the scene parses").scene.expect("a single-run scene")
 }
 
+/// The paper's LSL damper (Fig. 9) as scene text, to edit or extend in a test.
+pub const LSL_TOML: &str = r#"
+name = "t"
+[frame]
+mass = 1.35
+stiffness = 865.0
+damping = 1.092
+initial_displacement = 0.0185
+[balls]
+arrangement = "LSL"
+large_mass = 0.11
+mass_ratio = 10.0
+density = 8000.0
+restitution = 0.9
+gap = "0.25 Rr"
+clearance = "2 Rr"
+[run]
+horizon = 5.0
+sample_dt = 0.001
+"#;
+
 /// `lpc ARGS...`, run to completion.
 pub fn lpc<S: AsRef<OsStr>>(args: impl IntoIterator<Item = S>) -> Output {
     lpc_command().args(args).output().expect("the lpc binary runs")

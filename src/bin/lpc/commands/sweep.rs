@@ -9,7 +9,7 @@ use lpc_damper::scene;
 use lpc_damper::Model;
 
 use lpc_damper::studies::ensemble;
-use lpc_damper::studies::sweep::{Axis, EnsemblePoint, GridScene};
+use lpc_damper::studies::sweep::{Axis, Coordinates, EnsemblePoint, GridScene};
 
 use crate::args::{invalid, override_scene, print_json, progress_bar, quantile_arg, EnsembleArgs, Format, Nominal, RapierArgs};
 use crate::table::{right, Table};
@@ -93,14 +93,9 @@ pub fn run(a: Args) -> Result<ExitStatus> {
     bar.finish_and_clear();
     let elapsed = start.elapsed().as_secs_f64();
     if let Some(dir) = &a.out {
-        write_atomic(&dir.join("sweep.json"), &serde_json::to_vec_pretty(&points)?)
-            .with_context(|| format!("writing {}", dir.display()))?;
-        if axes.len() == 2 {
-            let cells: Vec<Option<f64>> =
-                points.iter().map(|p| lpc_damper::studies::sweep::metric_value(&p.summary, &a.metric)).collect();
-            let title = format!("{}: {} ({})", loaded.scene.as_ref().map_or("", |s| s.name.as_str()), a.metric, a.model.name());
-            write_map(dir, &axes, &cells, title, a.metric.clone())?;
-        }
+        let cells: Vec<Option<f64>> = points.iter().map(|p| lpc_damper::studies::sweep::metric_value(&p.summary, &a.metric)).collect();
+        let title = format!("{}: {} ({})", loaded.scene.as_ref().map_or("", |s| s.name.as_str()), a.metric, a.model.name());
+        write_sweep(dir, &points, &axes, &cells, title, a.metric.clone())?;
     }
     match a.format {
         Format::Json => print_json(&points)?,
@@ -125,8 +120,8 @@ pub fn run(a: Args) -> Result<ExitStatus> {
             table.print_header();
             for p in &points {
                 let m = &p.summary.metrics;
-                let mut cells = vec![p.value.to_string()];
-                cells.extend(p.value_y.map(|v| v.to_string()));
+                let mut cells = vec![p.at.value.to_string()];
+                cells.extend(p.at.value_y.map(|v| v.to_string()));
                 cells.extend([
                     p.summary.impact_count.to_string(),
                     format!("{:.4}", m.peak_displacement * 1e3),
@@ -155,8 +150,20 @@ fn axis_title(axis: &lpc_damper::studies::sweep::Axis) -> String {
     }
 }
 
-/// The design map of a grid: `cells` in grid order (first axis fastest).
-fn write_map(dir: &std::path::Path, axes: &[Axis], cells: &[Option<f64>], title: String, z_desc: String) -> anyhow::Result<()> {
+/// `sweep.json` of `points` and, for a grid, its design map of `cells` (grid order, first
+/// axis fastest).
+fn write_sweep(
+    dir: &std::path::Path,
+    points: &impl serde::Serialize,
+    axes: &[Axis],
+    cells: &[Option<f64>],
+    title: String,
+    z_desc: String,
+) -> anyhow::Result<()> {
+    write_atomic(&dir.join("sweep.json"), &serde_json::to_vec_pretty(points)?).with_context(|| format!("writing {}", dir.display()))?;
+    if axes.len() != 2 {
+        return Ok(());
+    }
     let (nx, ny) = (axes[0].values.len(), axes[1].values.len());
     let map = lpc_damper::output::figures::HeatMap {
         name: "sweep-map".into(),
@@ -181,10 +188,7 @@ fn sweep_ensembles(a: &Args, nominal: &Nominal, axes: &[Axis], parameters: &[Str
         let Some(members) = nominal.ensemble_of(a.ensemble, &g.file, &g.scene)? else { continue };
         let runs = ensemble::run_members(&members, a.model, false, &|| bar.inc(1))?;
         points.push(EnsemblePoint {
-            parameter: parameters[0].clone(),
-            value: g.values[0],
-            parameter_y: parameters.get(1).cloned(),
-            value_y: g.values.get(1).copied(),
+            at: Coordinates::of(parameters, &g.values),
             members: members.members.len(),
             redraws: members.redraws,
             metrics: ensemble::metric_stats(&runs.metrics),
@@ -195,13 +199,9 @@ fn sweep_ensembles(a: &Args, nominal: &Nominal, axes: &[Axis], parameters: &[Str
     bar.finish_and_clear();
     let elapsed = start.elapsed().as_secs_f64();
     if let Some(dir) = &a.out {
-        write_atomic(&dir.join("sweep.json"), &serde_json::to_vec_pretty(&points)?)
-            .with_context(|| format!("writing {}", dir.display()))?;
-        if axes.len() == 2 {
-            let cells: Vec<Option<f64>> = points.iter().map(|p| p.at_quantile[&a.metric]).collect();
-            let title = format!("{}: {} at quantile {q} of {per_point} members ({})", nominal.scene.name, a.metric, a.model.name());
-            write_map(dir, axes, &cells, title, format!("{} (q {q})", a.metric))?;
-        }
+        let cells: Vec<Option<f64>> = points.iter().map(|p| p.at_quantile[&a.metric]).collect();
+        let title = format!("{}: {} at quantile {q} of {per_point} members ({})", nominal.scene.name, a.metric, a.model.name());
+        write_sweep(dir, &points, axes, &cells, title, format!("{} (q {q})", a.metric))?;
     }
     match a.format {
         Format::Json => print_json(&points)?,
@@ -221,8 +221,8 @@ fn sweep_ensembles(a: &Args, nominal: &Nominal, axes: &[Axis], parameters: &[Str
             let cell = |x: Option<f64>| x.map_or("-".into(), |x| format!("{x:.5}"));
             for p in &points {
                 let s = &p.metrics[&a.metric];
-                let mut cells = vec![p.value.to_string()];
-                cells.extend(p.value_y.map(|v| v.to_string()));
+                let mut cells = vec![p.at.value.to_string()];
+                cells.extend(p.at.value_y.map(|v| v.to_string()));
                 cells.extend([cell(s.median), cell(s.p05), cell(s.p95), cell(p.at_quantile[&a.metric]), s.undefined.to_string()]);
                 table.print_row(&cells);
             }
