@@ -355,7 +355,7 @@ pub fn check_memory(scene: &Scene) -> Result<(), String> {
 }
 
 /// `3.2 GB`, `512 MB`, `40 kB`.
-fn bytes_for_people(b: f64) -> String {
+pub fn bytes_for_people(b: f64) -> String {
     match b {
         b if b >= 1e12 => format!("{:.1} TB", b / 1e12),
         b if b >= 1e9 => format!("{:.1} GB", b / 1e9),

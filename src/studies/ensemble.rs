@@ -83,6 +83,7 @@ pub fn draw(
     if count == 0 || count > MAX_MEMBERS {
         return Err(invalid("--ensemble", format!("must lie in 1..={MAX_MEMBERS} (got {count})")));
     }
+    check_members_memory(nominal, count).map_err(|rule| invalid("--ensemble", rule))?;
     let spreads: &[(&'static str, f64)] = tolerances.map_or(&[], |t| &t.spreads);
     let normal = tolerances.is_some_and(|t| t.distribution == Distribution::Normal);
     let seed = seed.or(tolerances.map(|t| t.seed)).unwrap_or(DEFAULT_SEED);
@@ -114,6 +115,38 @@ pub fn draw(
         ));
     }
     Ok(Ensemble { columns, members: drawn.into_iter().map(|d| d.0).collect(), redraws, seed })
+}
+
+/// Bytes an ensemble of `count` members of `scene` holds at once: each member's scene (its
+/// balls, positions and velocities), its drawn values and its metrics.
+pub fn members_bytes(scene: &Scene, count: usize) -> f64 {
+    let balls = scene.balls.len() as f64;
+    let per_member = std::mem::size_of::<Member>() as f64
+        + balls * (std::mem::size_of::<crate::scene::Ball>() as f64 + 16.0)
+        + (balls + 12.0) * 8.0
+        + SUMMARY_METRICS.len() as f64 * 16.0
+        // The allocator's overhead on the name, the balls, positions, velocities, draws, metrics.
+        + 6.0 * 32.0;
+    count as f64 * per_member
+}
+
+/// Refuses, with the numbers, an ensemble whose members would not fit in the memory left.
+fn check_members_memory(scene: &Scene, count: usize) -> Result<(), String> {
+    let need = members_bytes(scene, count);
+    if need < 1e8 {
+        return Ok(());
+    }
+    match crate::run::available_memory() {
+        Some(available) if need > crate::run::MEMORY_SHARE * available => Err(format!(
+            "is {count}: its members would take {} of memory ({} balls each), more than {:.0} % of the {} this \
+             process can still use; use fewer members",
+            crate::run::bytes_for_people(need),
+            scene.balls.len(),
+            100.0 * crate::run::MEMORY_SHARE,
+            crate::run::bytes_for_people(available)
+        )),
+        _ => Ok(()),
+    }
 }
 
 struct Drawer<'a> {

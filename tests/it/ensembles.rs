@@ -288,6 +288,14 @@ fn bad_tolerances_name_the_field_and_write_nothing() {
         assert!(!stderr.contains("panicked"), "{stderr}");
         assert!(!out_dir.exists(), "{line}: something was written");
     }
+    // An ensemble whose members cannot all be held (a million members of 10 000 balls: about
+    // 500 GB) is refused before any is drawn, with the numbers.
+    let path = tmp.path().join("many.toml");
+    std::fs::write(&path, LSL.replace("arrangement = \"LSL\"", &format!("arrangement = \"{}\"", "L".repeat(10_000)))).unwrap();
+    let out = lpc(["run".as_ref(), path.as_os_str(), "--ensemble".as_ref(), "1000000".as_ref()]);
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(2), "{stderr}");
+    assert!(stderr.contains("--ensemble") && stderr.contains("GB of memory") && stderr.contains("10000 balls"), "{stderr}");
     // And the ensemble's own bounds.
     let out = lpc(["run", "scenes/lpc-lsl.toml", "--ensemble", "0"]);
     assert_eq!(out.status.code(), Some(2));
