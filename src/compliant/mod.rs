@@ -87,7 +87,7 @@ impl Default for Options {
 #[derive(Debug, thiserror::Error)]
 pub enum CompliantError {
     /// More steps than allowed.
-    #[error("scene `{scene}`: the compliant model stalled after {steps} steps at t = {t} s (limit {limit})")]
+    #[error("scene `{scene}`: the compliant model stalled after {steps} steps at t = {} s (limit {limit})", crate::scene::human(*.t))]
     Stalled {
         /// Scene name.
         scene: String,
@@ -99,7 +99,7 @@ pub enum CompliantError {
         limit: u64,
     },
     /// The step size fell to round-off.
-    #[error("scene `{scene}`: the compliant model's step fell to {h:e} s at t = {t} s")]
+    #[error("scene `{scene}`: the compliant model's step fell to {h:e} s at t = {} s", crate::scene::human(*.t))]
     StepUnderflow {
         /// Scene name.
         scene: String,
@@ -109,7 +109,7 @@ pub enum CompliantError {
         h: f64,
     },
     /// The state became NaN or infinite.
-    #[error("scene `{scene}`: the compliant model's state became non-finite at t = {t} s")]
+    #[error("scene `{scene}`: the compliant model's state became non-finite at t = {} s", crate::scene::human(*.t))]
     NonFinite {
         /// Scene name.
         scene: String,
@@ -117,7 +117,7 @@ pub enum CompliantError {
         t: f64,
     },
     /// The tolerance is not usable.
-    #[error("compliant model: tolerance must lie in (0, 1e-2] (got {0})")]
+    #[error("compliant model: tolerance must lie in (0, 1e-2] (got {})", crate::scene::human(*.0))]
     Tolerance(f64),
 }
 

@@ -111,8 +111,8 @@ pub fn can_represent(scene: &Scene) -> Result<(), ModelError> {
                      the two-body bounce of Eq. 9-10 for it; use --model reference",
                     scene.name,
                     Scene::body_name(Body::Ball(i)),
-                    b.mass,
-                    scene.restitution * f.mass
+                    crate::scene::human(b.mass),
+                    crate::scene::human(scene.restitution * f.mass)
                 )));
             }
         }

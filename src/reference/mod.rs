@@ -52,7 +52,7 @@ pub enum ReferenceError {
     /// The solver gives up rather than run forever: more events than [`MAX_EVENTS`], more
     /// than a thousand at one instant, or an instant whose impacts, merges
     /// and releases do not settle.
-    #[error("scene `{scene}`: stalled after {events} events at t = {t} s: {why}")]
+    #[error("scene `{scene}`: stalled after {events} events at t = {} s: {why}", crate::scene::human(*.t))]
     Stalled {
         /// Scene name.
         scene: String,
@@ -66,7 +66,7 @@ pub enum ReferenceError {
     /// The postcondition of an event failed: a pair overlaps, or the pair whose contact was
     /// taken does not touch, beyond the contact tolerance. The reference then missed or
     /// mistimed a contact; it stops rather than go on with a wrong run.
-    #[error("scene `{scene}`: the reference broke its contact invariant at t = {t} s: {pair} {broken} by {by:.3e} m (tolerance {tolerance:.3e} m); this is a bug of the reference, please report it with the scene file")]
+    #[error("scene `{scene}`: the reference broke its contact invariant at t = {} s: {pair} {broken} by {by:.3e} m (tolerance {tolerance:.3e} m); this is a bug of the reference, please report it with the scene file", crate::scene::human(*.t))]
     ContactInvariant {
         /// Scene name.
         scene: String,

@@ -147,3 +147,12 @@ fn impossible_forcing_and_material() {
     expect_error(&format!("{GOOD}\n[compliant]\npoisson_ratio = 0.5\n"), &[], "compliant.poisson_ratio", "(-1, 0.5)");
     expect_error(&format!("{GOOD}\n[compliant]\nyoungs_modulus = -2e11\n"), &[], "compliant.youngs_modulus", "positive");
 }
+
+#[test]
+fn model_errors_print_times_for_people() {
+    // Issue 19: a stall at t = 1.916e-6 s printed `0.000001916413341752815 s`.
+    let e = lpc_damper::reference::ReferenceError::Stalled { scene: "s".into(), events: 7, t: 1.916413341752815e-6, why: "w".into() };
+    assert!(e.to_string().contains("at t = 1.916e-6 s"), "{e}");
+    let e = lpc_damper::compliant::CompliantError::Stalled { scene: "s".into(), steps: 7, t: 0.30000000000000004, limit: 9 };
+    assert!(e.to_string().contains("at t = 0.3 s"), "{e}");
+}
