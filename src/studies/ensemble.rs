@@ -559,6 +559,9 @@ pub struct Agreement {
     pub median_inside_reference_band: Option<bool>,
     /// Two-sample Kolmogorov-Smirnov statistic between the defined values.
     pub ks: Option<f64>,
+    /// Whether that statistic says the two distributions differ at 5 % significance
+    /// (`D > 1.358 sqrt((n + m) / (n m))`, the asymptotic critical value).
+    pub differ_at_5_percent: Option<bool>,
 }
 
 /// Each metric's [`Agreement`] of `model` with `reference` (`[member][metric]` each,
@@ -572,10 +575,13 @@ pub fn agreement(model: &[Vec<Option<f64>>], reference: &[Vec<Option<f64>>]) -> 
             let (m, r) = (values(model), values(reference));
             let (sm, sr) = (Stats::of(m.iter().map(|&x| Some(x))), Stats::of(r.iter().map(|&x| Some(x))));
             let both = !m.is_empty() && !r.is_empty();
+            let ks = both.then(|| ks_statistic(&m, &r));
+            let (n, k) = (m.len() as f64, r.len() as f64);
             let a = Agreement {
                 median_diff: sm.median.zip(sr.median).map(|(a, b)| a - b),
                 median_inside_reference_band: sm.median.zip(sr.p05.zip(sr.p95)).map(|(x, (lo, hi))| lo <= x && x <= hi),
-                ks: both.then(|| ks_statistic(&m, &r)),
+                ks,
+                differ_at_5_percent: ks.map(|d| d > 1.358 * ((n + k) / (n * k)).sqrt()),
             };
             (name.to_string(), a)
         })

@@ -237,6 +237,7 @@ fn studies_answer_with_distributions() {
     assert!(d["ks"].as_f64().is_some_and(|k| (0.0..=1.0).contains(&k)), "{d}");
     assert!(d["median_inside_reference_band"].is_boolean());
     assert_eq!(v["reference"]["agreement"]["impact_count"]["ks"], 0.0);
+    assert_eq!(v["reference"]["agreement"]["impact_count"]["differ_at_5_percent"], false);
     // sweep: every point a distribution, read at the chosen quantile.
     let v = json(&["sweep", p, "--x", "clearance=1Rr,2Rr", "--ensemble", "6", "--quantile", "0.9", "--metric", "impact_loss"]);
     let points = v.as_array().unwrap();

@@ -187,6 +187,7 @@ fn compare_ensembles(a: &Args, scene: &str, members: &Ensemble) -> Result<ExitSt
                 right("d median", 12),
                 right("in band", 8),
                 right("KS", 6),
+                right("differ 5 %", 10),
             ]);
             table.print_header();
             let cell = |x: Option<f64>| x.map_or("-".into(), |x| format!("{x:.5}"));
@@ -207,6 +208,7 @@ fn compare_ensembles(a: &Args, scene: &str, members: &Ensemble) -> Result<ExitSt
                         if model == "reference" { "-".into() } else { g.median_diff.map_or("-".into(), |x| format!("{x:+.5}")) },
                         g.median_inside_reference_band.map_or("-".into(), |b| if b { "yes" } else { "no" }.into()),
                         g.ks.map_or("-".into(), |k| format!("{k:.2}")),
+                        g.differ_at_5_percent.map_or("-".into(), |b| if b { "yes" } else { "no" }.into()),
                     ]);
                 }
             }
