@@ -22,8 +22,8 @@ pub struct Metrics {
     pub settling_time: Option<f64>,
     /// Mechanical energy at the horizon / initial energy (`None` when the initial energy is 0).
     pub energy_remaining: Option<f64>,
-    /// First sampled time at which the mechanical energy has fallen to 10 % of its initial
-    /// value (`None` when forced, when the initial energy is 0, or not reached).
+    /// First time at which the mechanical energy has fallen to 10 % of its initial value
+    /// (`None` when forced, when the initial energy is 0, or not reached).
     #[serde(default)]
     pub dissipation_time_90: Option<f64>,
     /// The same for 1 %.

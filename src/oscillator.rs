@@ -176,12 +176,8 @@ impl Oscillator {
     pub fn next_sign_change(&self, y0: f64, y1: f64, after: f64) -> Option<f64> {
         let q = y1 + self.sigma * y0;
         match self.regime {
-            Regime::Under { w } => {
-                if y0 == 0.0 && q == 0.0 {
-                    return None;
-                }
-                Some(Self::next_zero(w, self.zero_phase(y0, y1)?, after))
-            }
+            // `zero_phase` is `None` for the solution that is identically zero.
+            Regime::Under { w } => Some(Self::next_zero(w, self.zero_phase(y0, y1)?, after)),
             Regime::Critical => {
                 // y ~ y0 + q t.
                 let t = -y0 / q;

@@ -123,6 +123,10 @@ impl Recorder {
     pub fn untallied(self) -> Self {
         Recorder { tally: None, ..self }
     }
+    /// Whether the series is kept.
+    pub fn keeps_series(&self) -> bool {
+        self.series.is_some()
+    }
     /// The sample at `t`: the frame's state, and each ball's `(x, v)` from `ball(i)`. The
     /// acceleration is the one every model reports, [`Scene::frame_acceleration`].
     #[inline]
@@ -327,31 +331,38 @@ pub fn available_memory() -> Option<f64> {
     limits.into_iter().reduce(f64::min)
 }
 
-/// Refuses, with the numbers, a run whose series would not fit in the memory left
-/// ([`MEMORY_SHARE`] of [`available_memory`]), before anything is allocated: otherwise the
-/// allocator aborts or the kernel kills the process without a word.
-pub fn check_memory(scene: &Scene) -> Result<(), String> {
-    let need = series_bytes(scene);
-    // Below this every machine the tool runs on has room, and the many short runs of a study
-    // skip reading /proc.
+/// Whether `need` bytes fit in the memory left: `Err` with what the process can still use
+/// when they take more than [`MEMORY_SHARE`] of it ([`available_memory`]). Checked before
+/// anything is allocated: otherwise the allocator aborts or the kernel kills the process
+/// without a word. Below 100 MB every machine the tool runs on has room, and the many short
+/// runs of a study skip reading /proc.
+pub fn fits_in_memory(need: f64) -> Result<(), f64> {
     if need < 1e8 {
         return Ok(());
     }
-    let Some(available) = available_memory() else { return Ok(()) };
-    if need <= MEMORY_SHARE * available {
-        return Ok(());
+    match available_memory() {
+        Some(available) if need > MEMORY_SHARE * available => Err(available),
+        _ => Ok(()),
     }
-    Err(format!(
-        "scene `{}`: its series would take {} of memory ({} samples x {} balls, {} bytes each), more than {:.0} % \
-         of the {} this process can still use; raise run.sample_dt, shorten the horizon or use fewer balls",
-        scene.name,
-        bytes_for_people(need),
-        crate::scene::human(scene.sample_count() as f64),
-        scene.balls.len(),
-        (4 + 2 * scene.balls.len()) * 8,
-        100.0 * MEMORY_SHARE,
-        bytes_for_people(available)
-    ))
+}
+
+/// Refuses, with the numbers, a run whose series would not fit in the memory left
+/// ([`fits_in_memory`]).
+pub fn check_memory(scene: &Scene) -> Result<(), String> {
+    let need = series_bytes(scene);
+    fits_in_memory(need).map_err(|available| {
+        format!(
+            "scene `{}`: its series would take {} of memory ({} samples x {} balls, {} bytes each), more than {:.0} % \
+             of the {} this process can still use; raise run.sample_dt, shorten the horizon or use fewer balls",
+            scene.name,
+            bytes_for_people(need),
+            crate::scene::human(scene.sample_count() as f64),
+            scene.balls.len(),
+            (4 + 2 * scene.balls.len()) * 8,
+            100.0 * MEMORY_SHARE,
+            bytes_for_people(available)
+        )
+    })
 }
 
 /// `3.2 GB`, `512 MB`, `40 kB`.

@@ -77,17 +77,18 @@ impl ExactTally {
     pub(super) fn interval(&mut self, seg: &Segment, a: f64, b: f64, ends: [(f64, f64); 2], free_energy: f64) {
         let osc = seg.osc;
         let [(xa, va), (xb, vb)] = ends;
-        // The first extremum of x after a (where v changes sign), if inside.
-        let first_x = seg.next_extremum(Extremum::Displacement, a).filter(|&t| t < b);
-        let x_first = first_x.map(|t| seg.state(t).0);
-        let max_x = xa.abs().max(xb.abs()).max(x_first.map_or(0.0, f64::abs));
+        let max_x = xa.abs().max(xb.abs()).max(first_extremum_x(seg, a, b).abs());
         if max_x >= self.band {
             self.last_outside = Some((*seg, a, b));
         }
         self.outside_at_end = xb.abs() >= self.band;
-        if b >= self.from {
-            let lo = if a >= self.from { (a, xa, va) } else { (self.from, seg.state(self.from).0, seg.state(self.from).1) };
-            self.peaks(seg, lo, b, (xb, vb));
+        if a >= self.from {
+            self.peaks(seg, (a, xa, va), max_x, b, (xb, vb));
+        } else if b >= self.from {
+            // The interval that straddles the first bare period (once per run).
+            let (x, v) = seg.state(self.from);
+            let max_x = x.abs().max(xb.abs()).max(first_extremum_x(seg, self.from, b).abs());
+            self.peaks(seg, (self.from, x, v), max_x, b, (xb, vb));
         }
         self.integral_x2 += integral_x2(seg, a, b, (xa, va), (xb, vb));
         if self.wants_energy() {
@@ -120,19 +121,16 @@ impl ExactTally {
         }
     }
 
-    /// Peaks of `|xs|` and of the frame's acceleration as every model reports it
-    /// ([`Frame::acceleration`], proportional to the segment's own) on `[lo, b]`.
-    fn peaks(&mut self, seg: &Segment, (lo, x, v): (f64, f64, f64), b: f64, (xb, vb): (f64, f64)) {
-        let mut px = x.abs().max(xb.abs());
+    /// Peaks on `[lo, b]`: of `|xs|`, whose largest there is `max_x`, and of the frame's
+    /// acceleration as every model reports it ([`Frame::acceleration`], proportional to the
+    /// segment's own).
+    fn peaks(&mut self, seg: &Segment, (lo, x, v): (f64, f64, f64), max_x: f64, b: f64, (xb, vb): (f64, f64)) {
         let mut pa = self.frame.acceleration(x, v).abs().max(self.frame.acceleration(xb, vb).abs());
-        if let Some(t) = seg.next_extremum(Extremum::Displacement, lo).filter(|&t| t < b) {
-            px = px.max(seg.state(t).0.abs());
-        }
-        if let Some(t) = seg.next_extremum(Extremum::Acceleration, lo).filter(|&t| t < b) {
+        if let Some(t) = seg.next_zero(Zeros::Jerk, lo).filter(|&t| t < b) {
             let (x, v) = seg.state(t);
             pa = pa.max(self.frame.acceleration(x, v).abs());
         }
-        self.peak_displacement = self.peak_displacement.max(px);
+        self.peak_displacement = self.peak_displacement.max(max_x);
         self.peak_acceleration = self.peak_acceleration.max(pa);
     }
 
@@ -151,6 +149,12 @@ impl ExactTally {
             dissipation_times: self.dissipated,
         }
     }
+}
+
+/// `x` at the first extremum of `x` in `(a, b)` (0 when there is none): the largest `|x|`
+/// inside the interval, the later extrema being smaller.
+fn first_extremum_x(seg: &Segment, a: f64, b: f64) -> f64 {
+    seg.next_zero(Zeros::Velocity, a).filter(|&t| t < b).map_or(0.0, |t| seg.state(t).0)
 }
 
 /// `integral_a^b x^2 dt` of the free segment `seg`, from the states at the ends.
@@ -178,7 +182,7 @@ fn integral_x2(seg: &Segment, a: f64, b: f64, (xa, va): (f64, f64), (xb, vb): (f
 /// (or after `a`); there it is bisected.
 fn last_time_outside(seg: &Segment, a: f64, b: f64, band: f64) -> f64 {
     let osc = seg.osc;
-    let first = seg.next_extremum(Extremum::Displacement, a).filter(|&t| t < b);
+    let first = seg.next_zero(Zeros::Velocity, a).filter(|&t| t < b);
     // The extrema after a, as times: evenly spaced by pi / w when oscillating, at most one
     // otherwise.
     let extremum = |n: usize| -> Option<f64> {

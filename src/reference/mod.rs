@@ -205,8 +205,6 @@ struct Solver<'a> {
     recorder: Recorder,
     /// Exact metrics of a free run (`None` when forced or frameless: read at the samples).
     exact: Option<ExactTally>,
-    /// Whether samples are taken: for the series, or for the metrics when not exact.
-    sampling: bool,
     next_sample: usize,
     sample_count: usize,
     cursor: SampleCursor,
@@ -246,6 +244,10 @@ impl<'a> Solver<'a> {
             .max(scene.initial_velocities.iter().fold(0.0, |m: f64, v| m.max(v.abs())))
             .max(length_scale / scene.horizon);
         let samples = scene.sample_count();
+        // Where its metrics are exact the reference tallies no samples, and takes none unless
+        // the series is kept.
+        let exact = ExactTally::new(scene);
+        let recorder = Recorder::new(scene, record);
         let mut s = Solver {
             scene,
             n,
@@ -289,12 +291,8 @@ impl<'a> Solver<'a> {
             impacts: Vec::new(),
             last_impact: vec![None; n + 1],
             events: 0,
-            recorder: match ExactTally::new(scene) {
-                Some(_) => Recorder::new(scene, record).untallied(),
-                None => Recorder::new(scene, record),
-            },
-            exact: ExactTally::new(scene),
-            sampling: record == Record::Series || ExactTally::new(scene).is_none(),
+            recorder: if exact.is_some() { recorder.untallied() } else { recorder },
+            exact,
             next_sample: 0,
             sample_count: samples,
             cursor: SampleCursor { seg_t0: f64::NAN, k: 0, x: 0.0, v: 0.0, steps: 0, mass: f64::NAN, transition: [[0.0; 2]; 2] },

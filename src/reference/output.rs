@@ -21,7 +21,8 @@ pub(super) struct SampleCursor {
 impl Solver<'_> {
     /// Writes every sample with time `<= until` (strictly before when `inclusive` is false).
     pub(super) fn sample_until(&mut self, until: f64, inclusive: bool) {
-        if !self.sampling {
+        // Samples serve the series, or the metrics when they are not exact.
+        if !self.recorder.keeps_series() && self.exact.is_some() {
             return;
         }
         let dt = self.scene.sample_dt;

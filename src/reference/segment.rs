@@ -16,21 +16,22 @@ pub(super) struct Segment {
     pub(super) j0: f64,
     pub(super) osc: Oscillator,
     pub(super) forced: Option<Forced>,
-    /// `(w, phase)` of the acceleration's zeros when the segment oscillates
-    /// ([`Oscillator::zero_phase`]), computed once.
-    accel_zeros: Option<(f64, f64)>,
-    /// The same for the velocity's and the jerk's zeros (the extrema of `x` and of the
-    /// acceleration, for the exact metrics of free vibration), computed once.
-    extremum_zeros: Option<(f64, f64, f64)>,
+    /// When the segment oscillates, the phase of each [`Zeros`]' zeros
+    /// ([`Oscillator::zero_phase`], an `atan2` each), computed once; `None` for a solution
+    /// that is identically zero. The velocity's and the jerk's only in free vibration.
+    phases: [Option<f64>; 3],
 }
 
-/// Which extrema of a free segment's motion.
+/// Zeros of a segment's motion that the reference looks for.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub(super) enum Extremum {
-    /// Of `x` (zeros of the velocity).
-    Displacement,
-    /// Of the acceleration (zeros of the jerk).
-    Acceleration,
+pub(super) enum Zeros {
+    /// Of the acceleration (of the departure from the steady response, when forced): where the
+    /// force on the frame reverses.
+    Acceleration = 0,
+    /// Of the velocity: the extrema of `x` (free vibration).
+    Velocity = 1,
+    /// Of the jerk: the extrema of the acceleration (free vibration).
+    Jerk = 2,
 }
 
 /// A forced segment: the motion is `xp(t)` plus the free motion of the departure from it.
@@ -84,12 +85,15 @@ impl Segment {
         let (hx, hv) = forced.map_or((x0, v0), |f| f.h0);
         let a0 = osc.accel(hx, hv);
         let j0 = -2.0 * osc.sigma * a0 - osc.w0sq * hv;
-        let accel_zeros = osc.damped_omega().zip(osc.zero_phase(a0, j0));
-        let extremum_zeros = match (forced, osc.damped_omega()) {
-            (None, Some(w)) => osc.zero_phase(v0, a0).zip(osc.zero_phase(j0, osc.accel(a0, j0))).map(|(pv, pj)| (w, pv, pj)),
-            _ => None,
-        };
-        Segment { t0, x0, v0, a0, j0, osc, forced, accel_zeros, extremum_zeros }
+        let mut seg = Segment { t0, x0, v0, a0, j0, osc, forced, phases: [None; 3] };
+        if osc.damped_omega().is_some() {
+            let which: &[Zeros] = if forced.is_none() { &[Zeros::Acceleration, Zeros::Velocity, Zeros::Jerk] } else { &[Zeros::Acceleration] };
+            for &z in which {
+                let (y0, y1) = seg.initial(z);
+                seg.phases[z as usize] = osc.zero_phase(y0, y1);
+            }
+        }
+        seg
     }
     #[inline]
     pub(super) fn state(&self, t: f64) -> (f64, f64) {
@@ -115,16 +119,26 @@ impl Segment {
         let parts = [(ah, d[2]), (jh, d[3]), (sh, d[4])];
         std::array::from_fn(|n| (parts[n].0 + parts[n].1, parts[n].0.abs() + f.particular[n + 2]))
     }
-    /// The first extremum of `what` strictly after `t` (an unforced segment), or `None`.
-    pub(super) fn next_extremum(&self, what: Extremum, t: f64) -> Option<f64> {
-        let zero = |after: f64| match (self.extremum_zeros, what) {
-            (Some((w, pv, _)), Extremum::Displacement) => Some(Oscillator::next_zero(w, pv, after)),
-            (Some((w, _, pj)), Extremum::Acceleration) => Some(Oscillator::next_zero(w, pj, after)),
-            (None, Extremum::Displacement) => self.osc.next_sign_change(self.v0, self.a0, after),
-            (None, Extremum::Acceleration) => self.osc.next_sign_change(self.j0, self.osc.accel(self.a0, self.j0), after),
+    /// The value and slope at `t0` of the solution whose zeros are `z`.
+    fn initial(&self, z: Zeros) -> (f64, f64) {
+        match z {
+            Zeros::Acceleration => (self.a0, self.j0),
+            Zeros::Velocity => (self.v0, self.a0),
+            Zeros::Jerk => (self.j0, self.osc.accel(self.a0, self.j0)),
+        }
+    }
+    /// The first zero of `z` strictly after `t` (closed form), or `None`. A zero just after
+    /// `t` in segment time can round onto `t` in absolute time: the next one is taken then, so
+    /// that time always moves on.
+    pub(super) fn next_zero(&self, z: Zeros, t: f64) -> Option<f64> {
+        debug_assert!(z == Zeros::Acceleration || self.forced.is_none(), "extrema of a forced segment");
+        let zero = |after: f64| match self.osc.damped_omega() {
+            Some(w) => self.phases[z as usize].map(|phase| Oscillator::next_zero(w, phase, after)),
+            None => {
+                let (y0, y1) = self.initial(z);
+                self.osc.next_sign_change(y0, y1, after)
+            }
         };
-        // A zero just after `t` in segment time can round onto `t` in absolute time: take the
-        // next one then (as `free_sign_change` does).
         let mut after = t - self.t0;
         while let Some(tau) = zero(after) {
             if self.t0 + tau > t {
@@ -137,20 +151,7 @@ impl Segment {
     /// Next time after `t` at which an unforced frame's acceleration changes sign (closed
     /// form), or infinity.
     pub(super) fn free_sign_change(&self, t: f64) -> f64 {
-        // A root just after `t` in segment time can round onto `t` in absolute time: take the
-        // next one then, so that time always moves on.
-        let mut after = t - self.t0;
-        let next = |after: f64| match self.accel_zeros {
-            Some((w, phase)) => Some(Oscillator::next_zero(w, phase, after)),
-            None => self.osc.next_sign_change(self.a0, self.j0, after),
-        };
-        while let Some(tau) = next(after) {
-            if self.t0 + tau > t {
-                return self.t0 + tau;
-            }
-            after = tau;
-        }
-        f64::INFINITY
+        self.next_zero(Zeros::Acceleration, t).unwrap_or(f64::INFINITY)
     }
 
     /// The forced acceleration `a = a_h + a_p` has no closed-form roots; it is scanned with

@@ -545,6 +545,47 @@ pub fn apply_sweep_value(file: &SceneFile, parameter: &str, value: Length) -> Re
     Ok(f)
 }
 
+/// The value of `parameter` (one of [`SWEEP_PARAMETERS`]) in `scene`, built from `file`: in
+/// the file's unit, lengths in metres; `None` when the scene has no such part (no forcing).
+pub fn parameter_value(file: &SceneFile, scene: &Scene, parameter: &str) -> Option<f64> {
+    let balls = file.balls.as_ref();
+    match parameter {
+        "clearance" => scene.container.map(|c| c.clearance),
+        "gap" => scene.container.map(|c| c.gap),
+        "initial_displacement" => Some(scene.initial_displacement),
+        "restitution" => Some(scene.restitution),
+        "mass_ratio" => balls.map(|b| b.mass_ratio),
+        "large_mass" => balls.map(|b| b.large_mass),
+        "density" => balls.map(|b| b.density),
+        "frame_mass" => scene.frame.map(|f| f.mass),
+        "stiffness" => scene.frame.map(|f| f.stiffness),
+        "damping" => scene.frame.map(|f| f.damping),
+        "forcing_amplitude" => scene.forcing.map(|g| g.amplitude),
+        "forcing_frequency" => scene.forcing.map(|g| g.frequency),
+        _ => None,
+    }
+}
+
+/// The parameter (one of [`SWEEP_PARAMETERS`]) whose value a scene field holds, for the
+/// fields that [`apply_sweep_value`] sets.
+pub fn parameter_of_field(field: &str) -> Option<&'static str> {
+    Some(match field {
+        "balls.gap" => "gap",
+        "balls.clearance" | "balls.container_length" => "clearance",
+        "balls.restitution" => "restitution",
+        "balls.mass_ratio" => "mass_ratio",
+        "balls.large_mass" => "large_mass",
+        "balls.density" => "density",
+        "frame.mass" => "frame_mass",
+        "frame.stiffness" => "stiffness",
+        "frame.damping" => "damping",
+        "frame.initial_displacement" => "initial_displacement",
+        "forcing.amplitude" => "forcing_amplitude",
+        "forcing.frequency" => "forcing_frequency",
+        _ => return None,
+    })
+}
+
 /// Checks values against the scene's rules and names what broke one.
 struct Validator<'a> {
     file: &'a str,

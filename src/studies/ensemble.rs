@@ -13,7 +13,7 @@ use serde::{Deserialize, Serialize};
 
 use crate::model::{Model, ModelError};
 use crate::output::{Headline, SUMMARY_METRICS};
-use crate::run::Record;
+use crate::run::{bytes_for_people, fits_in_memory, Record, MEMORY_SHARE};
 use crate::scene::{self, Distribution, Length, Scene, SceneError, SceneFile, Tolerances};
 
 /// Draws one member may take before its tolerances are declared too wide for it.
@@ -96,12 +96,12 @@ pub fn draw(
     base.sweep = None;
     base.tolerances = None;
     let drawer = Drawer { base, path, nominal, spreads, normal };
-    let drawn: Vec<(Member, u32, Vec<Failure>)> =
+    let drawn: Vec<(Member, Vec<Failure>)> =
         (0..count).into_par_iter().map(|k| drawer.member(seed, k)).collect::<Result<_, _>>()?;
-    let redraws: u64 = drawn.iter().map(|d| d.1 as u64).sum();
+    let redraws: u64 = drawn.iter().map(|d| d.1.len() as u64).sum();
     if redraws > count as u64 {
         let mut blame: BTreeMap<&str, (usize, &str)> = BTreeMap::new();
-        for f in drawn.iter().flat_map(|d| &d.2) {
+        for f in drawn.iter().flat_map(|d| &d.1) {
             let e = blame.entry(f.parameter).or_insert((0, &f.rule));
             e.0 += 1;
         }
@@ -133,20 +133,16 @@ pub fn members_bytes(scene: &Scene, count: usize) -> f64 {
 /// Refuses, with the numbers, an ensemble whose members would not fit in the memory left.
 fn check_members_memory(scene: &Scene, count: usize) -> Result<(), String> {
     let need = members_bytes(scene, count);
-    if need < 1e8 {
-        return Ok(());
-    }
-    match crate::run::available_memory() {
-        Some(available) if need > crate::run::MEMORY_SHARE * available => Err(format!(
+    fits_in_memory(need).map_err(|available| {
+        format!(
             "is {count}: its members would take {} of memory ({} balls each), more than {:.0} % of the {} this \
              process can still use; use fewer members",
-            crate::run::bytes_for_people(need),
+            bytes_for_people(need),
             scene.balls.len(),
-            100.0 * crate::run::MEMORY_SHARE,
-            crate::run::bytes_for_people(available)
-        )),
-        _ => Ok(()),
-    }
+            100.0 * MEMORY_SHARE,
+            bytes_for_people(available)
+        )
+    })
 }
 
 struct Drawer<'a> {
@@ -158,13 +154,13 @@ struct Drawer<'a> {
 }
 
 impl Drawer<'_> {
-    /// Member `k`: its first valid draw, the number of draws thrown away and why.
-    fn member(&self, seed: u64, k: usize) -> Result<(Member, u32, Vec<Failure>), SceneError> {
+    /// Member `k`: its first valid draw, and why each draw before it was thrown away.
+    fn member(&self, seed: u64, k: usize) -> Result<(Member, Vec<Failure>), SceneError> {
         let mut rng = member_rng(seed, k);
         let mut failures = vec![];
         for _ in 0..MAX_DRAWS_PER_MEMBER {
             match self.attempt(&mut rng, k) {
-                Ok(member) => return Ok((member, failures.len() as u32, failures)),
+                Ok(member) => return Ok((member, failures)),
                 Err(f) => failures.push(f),
             }
         }
@@ -188,28 +184,6 @@ impl Drawer<'_> {
         }
     }
 
-    fn nominal_value(&self, parameter: &str) -> f64 {
-        let s = self.nominal;
-        let balls = self.base.balls.as_ref();
-        let frame = s.frame;
-        let forcing = s.forcing;
-        let value = match parameter {
-            "clearance" => s.container.map(|c| c.clearance),
-            "initial_displacement" => Some(s.initial_displacement),
-            "restitution" => Some(s.restitution),
-            "mass_ratio" => balls.map(|b| b.mass_ratio),
-            "large_mass" => balls.map(|b| b.large_mass),
-            "density" => balls.map(|b| b.density),
-            "frame_mass" => frame.map(|f| f.mass),
-            "stiffness" => frame.map(|f| f.stiffness),
-            "damping" => frame.map(|f| f.damping),
-            "forcing_amplitude" => forcing.map(|g| g.amplitude),
-            "forcing_frequency" => forcing.map(|g| g.frequency),
-            _ => None,
-        };
-        value.unwrap_or(f64::NAN)
-    }
-
     fn attempt(&self, rng: &mut Pcg64, k: usize) -> Result<Member, Failure> {
         let n = self.nominal.balls.len();
         // Every deviation is drawn first, in a fixed order, so a member's numbers never
@@ -225,7 +199,7 @@ impl Drawer<'_> {
             if p == "gap" {
                 continue;
             }
-            let value = self.nominal_value(p) + d[0];
+            let value = scene::parameter_value(&self.base, self.nominal, p).unwrap_or(f64::NAN) + d[0];
             values.push(value);
             let f = file.as_ref().unwrap_or(&self.base);
             file = Some(
@@ -233,17 +207,19 @@ impl Drawer<'_> {
             );
         }
         let name = format!("{}#{k}", self.nominal.name);
+        // A failure the scene's rules cannot pin on a drawn parameter is blamed on the first.
+        let first = self.spreads[0].0;
         let mut scene = match file {
             None => self.nominal.clone(),
             Some(f) => scene::from_file(f, self.path, &name)
                 .map_err(|e| match e {
                     SceneError::Invalid { field, rule, .. } => {
-                        Failure { parameter: parameter_of(&field).unwrap_or(self.spreads[0].0), rule: format!("{field} {rule}") }
+                        Failure { parameter: scene::parameter_of_field(&field).unwrap_or(first), rule: format!("{field} {rule}") }
                     }
-                    other => Failure { parameter: self.spreads[0].0, rule: other.to_string() },
+                    other => Failure { parameter: first, rule: other.to_string() },
                 })?
                 .scene
-                .ok_or(Failure { parameter: self.spreads[0].0, rule: "no damper scene".into() })?,
+                .ok_or(Failure { parameter: first, rule: "no damper scene".into() })?,
         };
         scene.name = name;
         let mut drawn = vec![];
@@ -282,25 +258,6 @@ fn shift_gaps(scene: &mut Scene, deviation: &[f64]) -> Result<Vec<f64>, Failure>
         *x += shift;
     }
     Ok(gaps)
-}
-
-/// The `[tolerances]` parameter a scene field belongs to.
-fn parameter_of(field: &str) -> Option<&'static str> {
-    Some(match field {
-        "balls.gap" => "gap",
-        "balls.clearance" | "balls.container_length" => "clearance",
-        "balls.restitution" => "restitution",
-        "balls.mass_ratio" => "mass_ratio",
-        "balls.large_mass" => "large_mass",
-        "balls.density" => "density",
-        "frame.mass" => "frame_mass",
-        "frame.stiffness" => "stiffness",
-        "frame.damping" => "damping",
-        "frame.initial_displacement" => "initial_displacement",
-        "forcing.amplitude" => "forcing_amplitude",
-        "forcing.frequency" => "forcing_frequency",
-        _ => return None,
-    })
 }
 
 /// Runs `f` on every member in parallel, in member order; `progress` is called after each.
@@ -371,19 +328,15 @@ pub fn run_members(
 /// Refuses, with the numbers, a band whose members' displacements would not fit in memory.
 fn check_band_memory(scene: &Scene, members: usize) -> Result<(), ModelError> {
     let need = scene.sample_count() as f64 * members as f64 * 8.0;
-    if need < 1e8 {
-        return Ok(());
-    }
-    match crate::run::available_memory() {
-        Some(available) if need > crate::run::MEMORY_SHARE * available => Err(ModelError::Refused(format!(
-            "the band of {members} members x {} samples would take {:.0} MB of the {:.0} MB this process can still use; \
+    fits_in_memory(need).map_err(|available| {
+        ModelError::Refused(format!(
+            "the band of {members} members x {} samples would take {} of the {} this process can still use; \
              raise run.sample_dt, use fewer members, or leave out --out (the metrics need no series)",
             scene.sample_count(),
-            need / 1e6,
-            available / 1e6
-        ))),
-        _ => Ok(()),
-    }
+            bytes_for_people(need),
+            bytes_for_people(available)
+        ))
+    })
 }
 
 /// A distribution's summary: median, 5-95 % band, mean, standard deviation and range of the

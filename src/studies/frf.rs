@@ -67,7 +67,11 @@ pub struct SteadyState {
 
 /// Reads the steady amplitude of `run`, forced with period `period`.
 pub fn steady_state(run: &Run, period: f64) -> SteadyState {
-    let peaks = period_peaks(run, period);
+    steady_reading(run, &period_peaks(run, period), period)
+}
+
+/// [`steady_state`] from the run's per-period peaks ([`period_peaks`]).
+fn steady_reading(run: &Run, peaks: &[f64], period: f64) -> SteadyState {
     let periods = peaks.len();
     // The measuring window: the last block, or every period when there are too few.
     let window = periods.min(BLOCK_PERIODS);
@@ -116,9 +120,9 @@ pub fn steady_peaks(scene: &Scene, model: Model) -> Result<(SteadyState, f64, Ve
     let mut s = scene.clone();
     for doubling in 0..=MAX_DOUBLINGS {
         let run = model.simulate(&s)?;
-        let reading = steady_state(&run, period);
+        let peaks = period_peaks(&run, period);
+        let reading = steady_reading(&run, &peaks, period);
         if reading.steady || doubling == MAX_DOUBLINGS {
-            let peaks = period_peaks(&run, period);
             let last = peaks[peaks.len().saturating_sub(2 * BLOCK_PERIODS)..].to_vec();
             return Ok((reading, s.horizon, last));
         }

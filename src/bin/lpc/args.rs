@@ -6,7 +6,7 @@ use std::path::Path;
 use clap::ValueEnum;
 use indicatif::{ProgressBar, ProgressStyle};
 
-use lpc_damper::scene::{self, Overrides, Scene, SceneError, SceneFile, Stepping, Tolerances};
+use lpc_damper::scene::{self, Loaded, Overrides, Scene, SceneError, SceneFile, Stepping, Tolerances};
 use lpc_damper::studies::ensemble::{self, Ensemble};
 
 use crate::exit::Result;
@@ -113,10 +113,15 @@ impl Nominal {
 
 /// The damper scene at `path` with `overrides` applied, with its file and tolerances.
 pub fn load_nominal(path: &Path, overrides: Overrides) -> std::result::Result<Nominal, SceneError> {
-    let loaded = scene::load(path)?;
-    let name = path.display().to_string();
-    let scene = overrides.apply(loaded.damper()?.clone(), &name)?;
-    Ok(Nominal { path: name, file: loaded.file, tolerances: loaded.tolerances, scene })
+    Nominal::of(&scene::load(path)?, overrides)
+}
+
+impl Nominal {
+    /// The damper scene of `loaded` with `overrides` applied, with its file and tolerances.
+    pub fn of(loaded: &Loaded, overrides: Overrides) -> std::result::Result<Nominal, SceneError> {
+        let scene = overrides.apply(loaded.damper()?.clone(), &loaded.path)?;
+        Ok(Nominal { path: loaded.path.clone(), file: loaded.file.clone(), tolerances: loaded.tolerances.clone(), scene })
+    }
 }
 
 /// Replaces `scene` (one of a sweep's or a chain's) by itself with `overrides` applied and

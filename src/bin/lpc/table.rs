@@ -70,6 +70,11 @@ impl Table {
     }
 }
 
+/// A statistic's cell: five decimals, or `-` where no member defines it.
+pub fn statistic(x: Option<f64>) -> String {
+    x.map_or("-".into(), |x| format!("{x:.5}"))
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

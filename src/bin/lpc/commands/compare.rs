@@ -13,7 +13,7 @@ use lpc_damper::output::SUMMARY_METRICS;
 use lpc_damper::studies::ensemble::{self, Agreement, Ensemble, Stats};
 
 use crate::args::{load_nominal, print_json, progress_bar, EnsembleArgs, Format, RapierArgs};
-use crate::table::{left, right, Table};
+use crate::table::{left, right, statistic, Table};
 use crate::exit::{ExitStatus, Result};
 
 #[derive(clap::Args)]
@@ -190,7 +190,6 @@ fn compare_ensembles(a: &Args, scene: &str, members: &Ensemble) -> Result<ExitSt
                 right("differ 5 %", 10),
             ]);
             table.print_header();
-            let cell = |x: Option<f64>| x.map_or("-".into(), |x| format!("{x:.5}"));
             for name in SUMMARY_METRICS {
                 let mut rows = vec![("reference", &comparison.reference)];
                 rows.extend(comparison.models.iter().map(|(n, d)| (n.as_str(), d)));
@@ -202,9 +201,9 @@ fn compare_ensembles(a: &Args, scene: &str, members: &Ensemble) -> Result<ExitSt
                     table.print_row(&[
                         name.to_string(),
                         model.to_string(),
-                        cell(s.median),
-                        cell(s.p05),
-                        cell(s.p95),
+                        statistic(s.median),
+                        statistic(s.p05),
+                        statistic(s.p95),
                         if model == "reference" { "-".into() } else { g.median_diff.map_or("-".into(), |x| format!("{x:+.5}")) },
                         g.median_inside_reference_band.map_or("-".into(), |b| if b { "yes" } else { "no" }.into()),
                         g.ks.map_or("-".into(), |k| format!("{k:.2}")),

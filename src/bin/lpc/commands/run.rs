@@ -12,7 +12,7 @@ use lpc_damper::Model;
 
 use crate::args::{load_nominal, print_json, progress_bar, EnsembleArgs, Format, RapierArgs};
 use crate::exit::{ExitStatus, Result};
-use crate::table::{left, right, Table};
+use crate::table::{left, right, statistic, Table};
 
 #[derive(clap::Args)]
 pub struct Args {
@@ -104,16 +104,15 @@ fn run_ensemble(a: &Args, nominal: &lpc_damper::scene::Scene, members: &Ensemble
                 right("undefined", 10),
             ]);
             table.print_header();
-            let cell = |x: Option<f64>| x.map_or("-".into(), |x| format!("{x:.5}"));
             for name in SUMMARY_METRICS {
                 let s = &summary.metrics[*name];
                 table.print_row(&[
                     name.to_string(),
-                    cell(s.median),
-                    cell(s.p05),
-                    cell(s.p95),
-                    cell(s.mean),
-                    cell(s.std),
+                    statistic(s.median),
+                    statistic(s.p05),
+                    statistic(s.p95),
+                    statistic(s.mean),
+                    statistic(s.std),
                     s.undefined.to_string(),
                 ]);
             }

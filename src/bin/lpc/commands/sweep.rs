@@ -12,7 +12,7 @@ use lpc_damper::studies::ensemble;
 use lpc_damper::studies::sweep::{Axis, Coordinates, EnsemblePoint, GridScene};
 
 use crate::args::{invalid, override_scene, print_json, progress_bar, quantile_arg, EnsembleArgs, Format, Nominal, RapierArgs};
-use crate::table::{right, Table};
+use crate::table::{right, statistic, Table};
 use crate::exit::{ExitStatus, Result};
 
 #[derive(clap::Args)]
@@ -78,12 +78,7 @@ pub fn run(a: Args) -> Result<ExitStatus> {
     let parameters: Vec<String> = axes.iter().map(|x| x.parameter.clone()).collect();
     if a.ensemble.ensemble.is_some() {
         let q = quantile_arg(a.quantile, &a.scene)?;
-        let nominal = Nominal {
-            path: a.scene.display().to_string(),
-            file: loaded.file.clone(),
-            tolerances: loaded.tolerances.clone(),
-            scene: loaded.damper()?.clone(),
-        };
+        let nominal = Nominal::of(&loaded, a.rapier.overrides(a.horizon, None))?;
         return sweep_ensembles(&a, &nominal, &axes, &parameters, &grid, q);
     }
     let parameter = parameters.join(" x ");
@@ -218,12 +213,11 @@ fn sweep_ensembles(a: &Args, nominal: &Nominal, axes: &[Axis], parameters: &[Str
             columns.extend([right("median", 12), right("p05", 12), right("p95", 12), right(format!("q {q}"), 12), right("undefined", 10)]);
             let table = Table::new(columns);
             table.print_header();
-            let cell = |x: Option<f64>| x.map_or("-".into(), |x| format!("{x:.5}"));
             for p in &points {
                 let s = &p.metrics[&a.metric];
                 let mut cells = vec![p.at.value.to_string()];
                 cells.extend(p.at.value_y.map(|v| v.to_string()));
-                cells.extend([cell(s.median), cell(s.p05), cell(s.p95), cell(p.at_quantile[&a.metric]), s.undefined.to_string()]);
+                cells.extend([statistic(s.median), statistic(s.p05), statistic(s.p95), statistic(p.at_quantile[&a.metric]), s.undefined.to_string()]);
                 table.print_row(&cells);
             }
         }
