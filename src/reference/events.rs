@@ -200,7 +200,12 @@ impl Solver<'_> {
     /// (`None` when it does not touch, does not approach, or drifts off a wall that
     /// accelerates away, see [`Solver::reopens`]), and whether the frame presses it together.
     pub(super) fn contact_now(&self, p: usize) -> Contact {
-        let Some(PairNow { g, rate, tol, curvature }) = self.pair_now(p) else {
+        self.contact_of(self.pair_now(p))
+    }
+
+    /// [`Solver::contact_now`] of a pair read already.
+    pub(super) fn contact_of(&self, pair: Option<PairNow>) -> Contact {
+        let Some(PairNow { g, rate, tol, curvature }) = pair else {
             return Contact { approach: None, pressed: false, frame: false };
         };
         let frame = curvature.is_some();
@@ -220,8 +225,9 @@ impl Solver<'_> {
     ///
     /// A cascade at one instant can take thousands of impulses (a light ball between heavy
     /// ones), so each pass re-reads only the pairs its last impulse changed: the pair's
-    /// neighbours, and every ball-frame pair when the frame's velocity changed.
-    pub(super) fn resolve(&mut self) -> Result<(), ReferenceError> {
+    /// neighbours, and every ball-frame pair when the frame's velocity changed. With `checked`
+    /// the first pass takes the pairs [`Solver::check_contacts`] has just read at this state.
+    pub(super) fn resolve(&mut self, checked: bool) -> Result<(), ReferenceError> {
         let range = self.pair_range();
         let mut contacts = std::mem::take(&mut self.contacts);
         contacts.clear();
@@ -229,13 +235,19 @@ impl Solver<'_> {
         let mut impulses = 0usize;
         // Pairs to re-read: all, or the neighbours of `changed` (and the frame's pairs).
         let mut all = true;
+        let mut first = checked;
         let mut changed = (0usize, false);
         // Each pass changes the state (an impulse, a merge or a release); more passes than the
         // impulse cap allows plus a few per body means two judgements disagree and would
         // cycle: a stall to report, not a hang.
         let most_passes = MAX_IMPULSES_PER_INSTANT + 8 * (self.n + 1);
         for _ in 0..most_passes {
-            if all {
+            if first {
+                for p in range.clone() {
+                    contacts[p] = self.contact_of(self.pairs_now[p]);
+                }
+                first = false;
+            } else if all {
                 for p in range.clone() {
                     contacts[p] = self.contact_now(p);
                 }

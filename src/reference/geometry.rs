@@ -42,6 +42,7 @@ pub(super) enum Gap {
 }
 
 impl Solver<'_> {
+    #[inline]
     pub(super) fn gap(&self, p: usize) -> Gap {
         // Right edge of the left body and left edge of the right body: either a free ball's
         // (`Ok((ball, edge offset))`) or the frame's (`Err(offset from xs)`).
@@ -153,9 +154,16 @@ impl Solver<'_> {
     /// free pair's does not), so no pair may overlap by more than the largest tolerance a
     /// touching pair has had so far. A violation means a contact was missed or mistimed: an
     /// error naming the scene, the time and the pair, never a silent wrong run.
+    ///
+    /// Each pair read is kept in `self.pairs_now`: `resolve`, which comes next at the same
+    /// instant and state, judges the contacts from them instead of reading every pair again.
     pub(super) fn check_contacts(&mut self, trigger: Option<usize>) -> Result<(), ReferenceError> {
+        let mut pairs_now = std::mem::take(&mut self.pairs_now);
+        pairs_now.clear();
+        pairs_now.resize(self.n + 1, None);
         for p in self.pair_range() {
-            let Some(PairNow { g, tol, .. }) = self.pair_now(p) else { continue };
+            pairs_now[p] = self.pair_now(p);
+            let Some(PairNow { g, tol, .. }) = pairs_now[p] else { continue };
             if g.abs() <= tol {
                 self.accepted_overlap = self.accepted_overlap.max(tol);
             }
@@ -173,6 +181,7 @@ impl Solver<'_> {
                 });
             }
         }
+        self.pairs_now = pairs_now;
         Ok(())
     }
 

@@ -167,6 +167,8 @@ struct Solver<'a> {
     last_state: std::cell::Cell<(u64, f64, f64, f64)>,
     /// Scratch of `resolve`: each pair's contact now.
     contacts: Vec<Contact>,
+    /// Each pair as [`Solver::check_contacts`] last read it (for `resolve`'s first pass).
+    pairs_now: Vec<Option<PairNow>>,
     t: f64,
     x: Vec<f64>,
     v: Vec<f64>,
@@ -265,6 +267,7 @@ impl<'a> Solver<'a> {
             now: Default::default(),
             last_state: std::cell::Cell::new((0, f64::NAN, 0.0, 0.0)),
             contacts: Vec::new(),
+            pairs_now: Vec::new(),
             t: 0.0,
             x: scene.initial_positions.clone(),
             v: scene.initial_velocities.clone(),
@@ -322,7 +325,7 @@ impl<'a> Solver<'a> {
 
     fn run(&mut self) -> Result<(), ReferenceError> {
         let mut same_instant = 0u64;
-        self.resolve()?;
+        self.resolve(false)?;
         loop {
             self.refresh_candidates();
             // The earliest candidate; at a tie an exact one, so that a search stopped at that
@@ -374,7 +377,7 @@ impl<'a> Solver<'a> {
                 // turns out not to be one), or its cached time would fire forever.
                 self.dirty[p] = true;
             }
-            self.resolve()?;
+            self.resolve(true)?;
         }
         self.tally_until(self.horizon);
         self.sample_until(self.horizon, true);

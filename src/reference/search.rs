@@ -75,6 +75,10 @@ impl Solver<'_> {
         // its pieces would change the roots' last bits, which chaotic runs amplify).
         let bound = if self.seg.forced.is_some() { bound } else { self.horizon };
         let limit = (from + self.span).min(self.horizon).min(bound);
+        if !self.frame_may_reach(ball, s, k, from, limit) {
+            // What the search below would conclude, without evaluating the frame's motion.
+            return if limit >= self.horizon { NO_EVENT } else { Candidate { t: limit, exact: false } };
+        }
         let mut a = from;
         loop {
             let b = self.next_sign_change(a, limit).min(limit);
@@ -94,6 +98,41 @@ impl Solver<'_> {
             }
             a = b;
         }
+    }
+
+    /// Whether the gap `s (x_ball - xs) + k` can be evaluated at or below the length
+    /// tolerance anywhere on `[from, limit]`; `false` only when it provably cannot, so that
+    /// [`Solver::search_frame_pair`] would find no root there (the same answer, without the
+    /// closed form's `exp` and `sin_cos` at every piece and iterate).
+    ///
+    /// An unforced frame with a spring and damping `>= 0` never leaves `|xs| <= R =
+    /// sqrt(x0^2 + v0^2 / w0^2)` nor `|vs| <= sqrt(v0^2 + w0^2 x0^2)` (its `v^2 + w0^2 x^2`
+    /// never grows), so the gap is at least `s x_ball + k - R`, a line in time whose least value
+    /// lies at an end. That bound must clear the tolerance by what the evaluated gap can err by
+    /// (as [`Solver::frame_tolerance`] counts it, at the window's far end and with the frame at
+    /// its extremes, twice over), which also keeps every Newton step of the search longer than
+    /// an ulp of time.
+    pub(super) fn frame_may_reach(&self, ball: usize, s: f64, k: f64, from: f64, limit: f64) -> bool {
+        let seg = &self.seg;
+        let o = &seg.osc;
+        if seg.forced.is_some() || !(o.w0sq > 0.0) || o.sigma < 0.0 {
+            return true;
+        }
+        let reach = (seg.x0 * seg.x0 + seg.v0 * seg.v0 / o.w0sq).sqrt();
+        let speed = (seg.v0 * seg.v0 + o.w0sq * seg.x0 * seg.x0).sqrt();
+        let (x, v) = (self.x[ball], self.v[ball]);
+        let line = |t: f64| s * (x + v * (t - self.t)) + k;
+        let nearest = line(from).min(line(limit));
+        let eps = f64::EPSILON;
+        let farthest = x.abs() + v.abs() * (limit - self.t).abs();
+        let err = 2.0
+            * (self.drift[ball]
+                + seg.position_roundoff(limit)
+                + 4.0 * eps * (farthest + reach + k.abs())
+                + 2.0 * eps * limit.abs() * (v.abs() + speed).max(self.fastest))
+            + 4.0 * eps * reach;
+        // Written so that a NaN anywhere answers "may reach" (the search then decides).
+        !(nearest - reach - err > self.tol)
     }
 
     /// The first root of a gap that is convex on `[a, b]`: Newton from the left, whose
@@ -300,5 +339,46 @@ impl Solver<'_> {
             }
         }
         bound
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use rand::{Rng, SeedableRng};
+
+    /// [`Solver::frame_may_reach`] answers "cannot" only where the evaluated gap stays above
+    /// the tolerance over the whole window (read on a fine grid and at the window's ends), and
+    /// the test draws cases of both answers, so it can fail either way.
+    #[test]
+    fn a_frame_pair_ruled_out_never_touches_in_its_window() {
+        let scene = crate::scene::load(crate::scene::scenes_dir().join("lpc-lsl.toml")).unwrap().scene.unwrap();
+        let mut rng = rand_pcg::Pcg64::seed_from_u64(13);
+        let (mut ruled_out, mut kept) = (0, 0);
+        for _ in 0..2000 {
+            let mut s = Solver::new(&scene, Record::MetricsOnly);
+            let (x0, v0) = (rng.random_range(-0.02..0.02), rng.random_range(-1.0..1.0));
+            let t0 = rng.random_range(0.0..2.0);
+            s.seg = Segment::new(t0, x0, v0, s.seg.osc, None);
+            s.segment += 1;
+            s.t = t0;
+            let ball = if rng.random_bool(0.5) { 0 } else { s.n - 1 };
+            s.v[ball] = rng.random_range(-0.5..0.5);
+            s.x[ball] += rng.random_range(-0.01..0.01);
+            let p = if ball == 0 { 0 } else { s.n };
+            let Gap::Frame { ball, s: side, k } = s.gap(p) else { panic!("pair {p} is not a ball-frame pair") };
+            let limit = t0 + rng.random_range(0.0..0.3);
+            if s.frame_may_reach(ball, side, k, t0, limit) {
+                kept += 1;
+                continue;
+            }
+            ruled_out += 1;
+            for i in 0..=2000 {
+                let t = t0 + (limit - t0) * i as f64 / 2000.0;
+                let (g, _) = s.frame_gap_at(ball, side, k, t);
+                assert!(g > s.tol, "ruled out, but the gap is {g:e} m at t = {t} (window {t0}..{limit})");
+            }
+        }
+        assert!(ruled_out > 100 && kept > 100, "{ruled_out} ruled out, {kept} kept");
     }
 }

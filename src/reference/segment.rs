@@ -98,10 +98,11 @@ impl Segment {
     #[inline]
     pub(super) fn state(&self, t: f64) -> (f64, f64) {
         match &self.forced {
-            None => self.osc.state(self.x0, self.v0, t - self.t0),
             // At its start the segment is exactly the state it was made from (the forced sum
-            // below would round it, and a released ball would then drift off its wall).
-            Some(_) if t == self.t0 => (self.x0, self.v0),
+            // below would round it, and a released ball would then drift off its wall; the
+            // free closed form gives it too, at the cost of an `exp` and a `sin_cos`).
+            _ if t == self.t0 => (self.x0, self.v0),
+            None => self.osc.state(self.x0, self.v0, t - self.t0),
             Some(f) => {
                 let (xh, vh) = self.osc.state(f.h0.0, f.h0.1, t - self.t0);
                 let (xp, vp) = f.xp.state(t);
