@@ -43,6 +43,9 @@ pub struct Oscillator {
     /// `k / M`.
     pub w0sq: f64,
     regime: Regime,
+    /// [`Oscillator::rate`] and [`Oscillator::f_cap`], which every round-off bound asks for.
+    rate: f64,
+    f_cap: f64,
 }
 
 impl Oscillator {
@@ -61,7 +64,10 @@ impl Oscillator {
             let r1 = if sigma + b > 0.0 { -w0sq / (sigma + b) } else { 0.0 };
             Regime::Over { b, r1, r2: -sigma - b }
         };
-        Oscillator { mass, damping, stiffness, sigma, w0sq, regime }
+        let mut o = Oscillator { mass, damping, stiffness, sigma, w0sq, regime, rate: 0.0, f_cap: 0.0 };
+        o.rate = 2.0 * (sigma + w0sq.sqrt());
+        o.f_cap = o.compute_f_cap();
+        o
     }
 
     /// The damped angular frequency, when the oscillator oscillates.
@@ -117,13 +123,17 @@ impl Oscillator {
     /// round-off of evaluating it at `t` grows as `1 + rate t` (the rounding of the arguments
     /// of `exp`, `sin` and `cos`), see [`Oscillator::roundoff`].
     pub fn rate(&self) -> f64 {
-        2.0 * (self.sigma + self.w0sq.sqrt())
+        self.rate
     }
 
     /// A bound on `|F(t)|` for every `t >= 0` (`F <= t` always; this caps it): `1/w`
     /// oscillating, `1/(2b)` overdamped, `1/(e sigma)` critical, infinite without damping or
     /// spring.
     fn f_cap(&self) -> f64 {
+        self.f_cap
+    }
+
+    fn compute_f_cap(&self) -> f64 {
         match self.regime {
             Regime::Under { w } => 1.0 / w,
             Regime::Over { b, .. } => 1.0 / (2.0 * b),

@@ -77,13 +77,25 @@ impl ExactTally {
     pub(super) fn interval(&mut self, seg: &Segment, a: f64, b: f64, ends: [(f64, f64); 2], free_energy: f64) {
         let osc = seg.osc;
         let [(xa, va), (xb, vb)] = ends;
-        let max_x = xa.abs().max(xb.abs()).max(first_extremum_x(seg, a, b).abs());
+        let reach = self.reach(seg, b, (xa, va));
+        // Past the first period, an interval the frame's reach keeps inside the band and the
+        // peak found so far changes neither (peaks count from `from`, where they start at 0).
+        let x_bounded = reach.is_some_and(|(x, _)| x < self.band && x <= self.peak_displacement);
+        // Bounded, the reach stands in for the largest `|xs|`: below the band and the peak.
+        let max_x = match reach {
+            Some((x, _)) if x_bounded => x,
+            _ => xa.abs().max(xb.abs()).max(first_extremum_x(seg, a, b).abs()),
+        };
         if max_x >= self.band {
             self.last_outside = Some((*seg, a, b));
         }
         self.outside_at_end = xb.abs() >= self.band;
         if a >= self.from {
-            self.peaks(seg, (a, xa, va), max_x, b, (xb, vb));
+            if reach.is_some_and(|(_, acc)| acc <= self.peak_acceleration) {
+                self.peak_displacement = self.peak_displacement.max(max_x);
+            } else {
+                self.peaks(seg, (a, xa, va), max_x, b, (xb, vb));
+            }
         } else if b >= self.from {
             // The interval that straddles the first bare period (once per run).
             let (x, v) = seg.state(self.from);
@@ -119,6 +131,35 @@ impl ExactTally {
                 }
             }
         }
+    }
+
+    /// Bounds on `|xs|` and on the reported acceleration `|Frame::acceleration|` over an
+    /// interval of `seg` ending at `b` whose state at its start is `(x, v)`, above anything the
+    /// tally would evaluate there; `None` without a spring or with negative damping.
+    ///
+    /// `x` and the segment's acceleration are free solutions, whose `y'^2 + w0^2 y^2` never
+    /// grows (docs/MODEL.md §10), so `|x| <= sqrt(x^2 + v^2 / w0^2)` and likewise the
+    /// acceleration with its jerk; the reported acceleration is the segment's times
+    /// `M / ms`. The round-off of the evaluated states (the start's, and any later one's) is
+    /// added twice, with a relative millionth for the bounds' own arithmetic. With them the
+    /// tally skips the extrema (a zero search and a closed-form evaluation each) of intervals
+    /// that cannot raise a peak or reach the band, the usual case once the motion decays.
+    fn reach(&self, seg: &Segment, b: f64, (x, v): (f64, f64)) -> Option<(f64, f64)> {
+        let o = &seg.osc;
+        if !(o.w0sq > 0.0) || o.sigma < 0.0 {
+            return None;
+        }
+        let acc = o.accel(x, v);
+        let jerk = -2.0 * o.sigma * acc - o.w0sq * v;
+        let tau = b - seg.t0;
+        let err_x = 2.0 * o.roundoff(seg.x0, seg.v0, tau);
+        let err_v = 2.0 * o.roundoff(seg.v0, o.accel(seg.x0, seg.v0), tau);
+        let slack = 1.0 + 1e-6;
+        let f = &self.frame;
+        let reach_x = (x * x + v * v / o.w0sq).sqrt() * slack + err_x;
+        let reach_a = (acc * acc + jerk * jerk / o.w0sq).sqrt() * (o.mass / f.mass) * slack
+            + (f.stiffness * err_x + f.damping * err_v) / f.mass;
+        Some((reach_x, reach_a))
     }
 
     /// Peaks on `[lo, b]`: of `|xs|`, whose largest there is `max_x`, and of the frame's

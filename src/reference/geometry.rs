@@ -42,6 +42,15 @@ pub(super) enum Gap {
 }
 
 impl Solver<'_> {
+    /// Whether pair `p` is a free ball against the frame (a wall, or a ball the frame holds):
+    /// [`Solver::gap`]'s kind without its arithmetic.
+    #[inline]
+    pub(super) fn is_frame_pair(&self, p: usize) -> bool {
+        let left_frame = p == 0 || self.hold[p - 1] != Hold::Free;
+        let right_frame = p == self.n || self.hold[p] != Hold::Free;
+        left_frame != right_frame
+    }
+
     #[inline]
     pub(super) fn gap(&self, p: usize) -> Gap {
         // Right edge of the left body and left edge of the right body: either a free ball's

@@ -257,7 +257,7 @@ impl Solver<'_> {
     pub(super) fn refresh_candidates(&mut self) {
         if self.frame_dirty && self.has_frame() {
             for p in self.pair_range() {
-                if matches!(self.gap(p), Gap::Frame { .. }) {
+                if self.is_frame_pair(p) {
                     self.dirty[p] = true;
                 }
             }
@@ -280,7 +280,7 @@ impl Solver<'_> {
             if !self.dirty[p] {
                 continue;
             }
-            if matches!(self.gap(p), Gap::Frame { .. }) {
+            if self.is_frame_pair(p) {
                 // At most two: the free balls next to the walls (or to balls the frame holds).
                 frame[frames.min(1)] = p;
                 frames += 1;
