@@ -43,7 +43,9 @@ pub struct Oscillator {
     /// `k / M`.
     pub w0sq: f64,
     regime: Regime,
-    /// [`Oscillator::rate`] and [`Oscillator::f_cap`], which every round-off bound asks for.
+    /// [`Oscillator::w0`], [`Oscillator::rate`] and [`Oscillator::f_cap`], which every
+    /// round-off bound asks for.
+    w0: f64,
     rate: f64,
     f_cap: f64,
 }
@@ -64,8 +66,8 @@ impl Oscillator {
             let r1 = if sigma + b > 0.0 { -w0sq / (sigma + b) } else { 0.0 };
             Regime::Over { b, r1, r2: -sigma - b }
         };
-        let mut o = Oscillator { mass, damping, stiffness, sigma, w0sq, regime, rate: 0.0, f_cap: 0.0 };
-        o.rate = 2.0 * (sigma + w0sq.sqrt());
+        let mut o = Oscillator { mass, damping, stiffness, sigma, w0sq, regime, w0: w0sq.sqrt(), rate: 0.0, f_cap: 0.0 };
+        o.rate = 2.0 * (sigma + o.w0);
         o.f_cap = o.compute_f_cap();
         o
     }
@@ -124,6 +126,11 @@ impl Oscillator {
     /// of `exp`, `sin` and `cos`), see [`Oscillator::roundoff`].
     pub fn rate(&self) -> f64 {
         self.rate
+    }
+
+    /// The undamped angular frequency `w0 = sqrt(k / M)`, rad/s.
+    pub fn w0(&self) -> f64 {
+        self.w0
     }
 
     /// A bound on `|F(t)|` for every `t >= 0` (`F <= t` always; this caps it): `1/w`

@@ -53,32 +53,24 @@ impl Solver<'_> {
 
     #[inline]
     pub(super) fn gap(&self, p: usize) -> Gap {
-        // Right edge of the left body and left edge of the right body: either a free ball's
-        // (`Ok((ball, edge offset))`) or the frame's (`Err(offset from xs)`).
-        let left = if p == 0 {
-            Err(0.0)
-        } else {
-            let i = p - 1;
-            if self.hold[i] == Hold::Free {
-                Ok((i, self.radius[i]))
-            } else {
-                Err(self.offset[i] + self.radius[i])
+        // The left body's right edge and the right body's left edge: a free ball's, or the
+        // frame's (a wall, or a ball the frame holds, at an offset from `xs`).
+        let left_free = p >= 1 && self.hold[p - 1] == Hold::Free;
+        let right_free = p < self.n && self.hold[p] == Hold::Free;
+        match (left_free, right_free) {
+            (true, true) => {
+                let (i, j) = (p - 1, p);
+                Gap::Linear { g: (self.x[j] - self.radius[j]) - (self.x[i] + self.radius[i]), rate: self.v[j] - self.v[i] }
             }
-        };
-        let right = if p == self.n {
-            Err(self.length)
-        } else if self.hold[p] == Hold::Free {
-            Ok((p, -self.radius[p]))
-        } else {
-            Err(self.offset[p] - self.radius[p])
-        };
-        match (left, right) {
-            (Err(_), Err(_)) => Gap::Fixed,
-            (Ok((i, ri)), Ok((j, rj))) => {
-                Gap::Linear { g: (self.x[j] + rj) - (self.x[i] + ri), rate: self.v[j] - self.v[i] }
+            (false, true) => {
+                let c = if p == 0 { 0.0 } else { self.offset[p - 1] + self.radius[p - 1] };
+                Gap::Frame { ball: p, s: 1.0, k: -self.radius[p] - c }
             }
-            (Err(c), Ok((j, rj))) => Gap::Frame { ball: j, s: 1.0, k: rj - c },
-            (Ok((i, ri)), Err(c)) => Gap::Frame { ball: i, s: -1.0, k: c - ri },
+            (true, false) => {
+                let c = if p == self.n { self.length } else { self.offset[p] - self.radius[p] };
+                Gap::Frame { ball: p - 1, s: -1.0, k: c - self.radius[p - 1] }
+            }
+            (false, false) => Gap::Fixed,
         }
     }
 
@@ -235,7 +227,7 @@ impl Solver<'_> {
         let o = &self.seg.osc;
         let a = o.accel(x, v);
         // Scales of a and its derivative over the motion (w0 |v| matters where x passes 0).
-        let rate = 2.0 * o.sigma + o.w0sq.sqrt();
+        let rate = 2.0 * o.sigma + o.w0();
         if a.abs() > ROUNDOFF_RELATIVE * (o.w0sq * x.abs() + rate * v.abs()) {
             return a;
         }
