@@ -3,6 +3,7 @@
 
 pub mod figures;
 pub mod files;
+pub mod parquet;
 pub mod plot;
 
 use serde::{Deserialize, Serialize};

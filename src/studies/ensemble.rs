@@ -79,10 +79,29 @@ pub fn draw(
     count: usize,
     seed: Option<u64>,
 ) -> Result<Ensemble, SceneError> {
+    draw_range(file, path, nominal, tolerances, count, 0..count, seed)
+}
+
+/// Members `range` of an ensemble of `count` (a shard or a chunk of it): the very members
+/// [`draw`] gives those indices, since member `k` depends only on `(seed, k)`. The redraw
+/// rule (no more failed draws than members) is judged over the range.
+pub fn draw_range(
+    file: &SceneFile,
+    path: &str,
+    nominal: &Scene,
+    tolerances: Option<&Tolerances>,
+    count: usize,
+    range: std::ops::Range<usize>,
+    seed: Option<u64>,
+) -> Result<Ensemble, SceneError> {
     let invalid = |field: &str, rule: String| SceneError::Invalid { file: path.into(), field: field.into(), rule };
     if count == 0 || count > MAX_MEMBERS {
         return Err(invalid("--ensemble", format!("must lie in 1..={MAX_MEMBERS} (got {count})")));
     }
+    if range.start >= range.end || range.end > count {
+        return Err(invalid("--shard", format!("members {}..{} are not a part of 0..{count}", range.start, range.end)));
+    }
+    let count = range.len();
     check_members_memory(nominal, count).map_err(|rule| invalid("--ensemble", rule))?;
     let spreads: &[(&'static str, f64)] = tolerances.map_or(&[], |t| &t.spreads);
     let normal = tolerances.is_some_and(|t| t.distribution == Distribution::Normal);
@@ -97,7 +116,7 @@ pub fn draw(
     base.tolerances = None;
     let drawer = Drawer { base, path, nominal, spreads, normal };
     let drawn: Vec<(Member, Vec<Failure>)> =
-        (0..count).into_par_iter().map(|k| drawer.member(seed, k)).collect::<Result<_, _>>()?;
+        range.into_par_iter().map(|k| drawer.member(seed, k)).collect::<Result<_, _>>()?;
     let redraws: u64 = drawn.iter().map(|d| d.1.len() as u64).sum();
     if redraws > count as u64 {
         let mut blame: BTreeMap<&str, (usize, &str)> = BTreeMap::new();
@@ -116,6 +135,64 @@ pub fn draw(
     }
     Ok(Ensemble { columns, members: drawn.into_iter().map(|d| d.0).collect(), redraws, seed })
 }
+
+/// The table of an ensemble's members (`members.csv`, `members.parquet`, the Python
+/// binding's columns): `member`, the drawn values, then every metric ([`SUMMARY_METRICS`]),
+/// one row per member in member order; `metrics` is `[member][metric]`.
+pub fn members_table(columns: &[String], members: &[Member], metrics: &[Vec<Option<f64>>]) -> (Vec<String>, Vec<Vec<Option<f64>>>) {
+    let mut header = vec!["member".to_string()];
+    header.extend(columns.iter().cloned());
+    header.extend(SUMMARY_METRICS.iter().map(|m| m.to_string()));
+    let rows = members
+        .iter()
+        .zip(metrics)
+        .map(|(m, metrics)| {
+            let mut row = vec![Some(m.index as f64)];
+            row.extend(m.drawn.iter().map(|&x| Some(x)));
+            row.extend(metrics.iter().copied());
+            row
+        })
+        .collect();
+    (header, rows)
+}
+
+/// Members `[start, stop)` of shard `shard` of `shards` of an ensemble of `count`: consecutive
+/// members, the shards as even as integers allow. Each shard of a Slurm job array
+/// (`lpc run --ensemble N --shard I/K`) and each chunk of the Python binding's distributed
+/// ensemble is such a range, so its members are the ones the whole ensemble has there.
+pub fn shard_range(count: usize, shard: usize, shards: usize) -> std::ops::Range<usize> {
+    let at = |i: usize| ((count as u128 * i as u128) / shards as u128) as usize;
+    at(shard)..at(shard + 1)
+}
+
+/// What a shard of an ensemble was (`shard.json` beside its `members.csv`): what
+/// `lpc merge` checks the shards against each other with, and sums.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct ShardInfo {
+    /// Scene name.
+    pub scene: String,
+    /// Model.
+    pub model: Model,
+    /// Seed of the draws.
+    pub seed: u64,
+    /// Members of the whole ensemble.
+    pub members: usize,
+    /// This shard, from 0.
+    pub shard: usize,
+    /// Shards in all.
+    pub shards: usize,
+    /// First member of the shard.
+    pub start: usize,
+    /// One past its last member.
+    pub stop: usize,
+    /// Draws thrown away as invalid in this shard.
+    pub redraws: u64,
+    /// Computing time of this shard, s.
+    pub wall_time_s: f64,
+}
+
+/// Columns of [`members_table`] that hold integers.
+pub const INTEGER_COLUMNS: &[&str] = &["member", "impact_count"];
 
 /// Bytes an ensemble of `count` members of `scene` holds at once: each member's scene (its
 /// balls, positions and velocities), its drawn values and its metrics.
@@ -208,7 +285,7 @@ impl Drawer<'_> {
         }
         let name = format!("{}#{k}", self.nominal.name);
         // A failure the scene's rules cannot pin on a drawn parameter is blamed on the first.
-        let first = self.spreads[0].0;
+        let first = self.spreads.first().map_or("gap", |s| s.0);
         let mut scene = match file {
             None => self.nominal.clone(),
             Some(f) => scene::from_file(f, self.path, &name)

@@ -234,5 +234,29 @@ pub fn run_grid(
         .collect()
 }
 
+/// The table of a sweep (`sweep.parquet`, the Python binding's columns): `cell` (its index,
+/// the first axis varying fastest), each axis' value as written, then every metric
+/// ([`crate::output::SUMMARY_METRICS`]), one row per cell.
+pub fn cells_table(parameters: &[String], cells: &[(usize, SweepPoint)]) -> (Vec<String>, Vec<Vec<Option<f64>>>) {
+    let mut header = vec!["cell".to_string()];
+    header.extend(parameters.iter().cloned());
+    header.extend(crate::output::SUMMARY_METRICS.iter().map(|m| m.to_string()));
+    let rows = cells
+        .iter()
+        .map(|(cell, p)| {
+            let mut row = vec![Some(*cell as f64), Some(p.at.value)];
+            if parameters.len() > 1 {
+                row.push(p.at.value_y);
+            }
+            row.extend(crate::output::Headline::of_summary(&p.summary).values());
+            row
+        })
+        .collect();
+    (header, rows)
+}
+
+/// Columns of [`cells_table`] that hold integers.
+pub const INTEGER_COLUMNS: &[&str] = &["cell", "impact_count"];
+
 /// Metrics a design map can show: every metric of a run's summary.
 pub use crate::output::{metric_value, SUMMARY_METRICS as MAP_METRICS};

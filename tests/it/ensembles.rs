@@ -350,3 +350,70 @@ fn exact_reference_metrics_bound_the_sampled_ones_within_one_sample() {
         assert!((trapezoid - integral).abs() <= bound, "{name}: trapezoid {trapezoid} vs exact {integral} (bound {bound})");
     }
 }
+
+/// Shards (`--shard I/K`) merged by `lpc merge` give the unsharded run's `members.csv` and
+/// `members.parquet` byte for byte, and the Parquet table holds the CSV's numbers.
+#[test]
+fn shards_merge_into_the_unsharded_table() {
+    let tmp = tempfile::tempdir().unwrap();
+    let path = tmp.path().join("lsl.toml");
+    std::fs::write(&path, format!("{LSL}[tolerances]\ngap = \"0.02 Rr\"\nrestitution = 0.05\n")).unwrap();
+    let dir = |name: &str| tmp.path().join(name);
+    let run = |args: &[&str], out: &std::path::Path| {
+        let mut all: Vec<&std::ffi::OsStr> = vec!["run".as_ref(), path.as_os_str(), "--ensemble".as_ref(), "23".as_ref(), "--seed".as_ref(), "5".as_ref()];
+        all.extend(args.iter().map(|a| std::ffi::OsStr::new(a)));
+        all.extend(["--out".as_ref(), out.as_os_str()]);
+        let o = lpc(all);
+        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    };
+    run(&[], &dir("whole"));
+    for i in 0..4 {
+        run(&["--shard", &format!("{i}/4")], &dir(&format!("shard{i}")));
+    }
+    let o = lpc(["merge".as_ref(), dir("shard3").as_os_str(), dir("shard1").as_os_str(), dir("shard0").as_os_str(), dir("shard2").as_os_str(), "--out".as_ref(), dir("merged").as_os_str()]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    for file in ["members.csv", "members.parquet"] {
+        assert_eq!(std::fs::read(dir("whole").join(file)).unwrap(), std::fs::read(dir("merged").join(file)).unwrap(), "{file}");
+    }
+    let whole: serde_json::Value = serde_json::from_slice(&std::fs::read(dir("whole").join("ensemble.json")).unwrap()).unwrap();
+    let merged: serde_json::Value = serde_json::from_slice(&std::fs::read(dir("merged").join("ensemble.json")).unwrap()).unwrap();
+    assert_eq!(whole["metrics"], merged["metrics"]);
+    assert_eq!(whole["redraws"], merged["redraws"]);
+
+    // The Parquet table reads back to the CSV's numbers.
+    use parquet::arrow::arrow_reader::ParquetRecordBatchReaderBuilder;
+    let file = std::fs::File::open(dir("whole").join("members.parquet")).unwrap();
+    let batches: Vec<_> = ParquetRecordBatchReaderBuilder::try_new(file).unwrap().build().unwrap().collect::<Result<_, _>>().unwrap();
+    let csv_text = std::fs::read_to_string(dir("whole").join("members.csv")).unwrap();
+    let mut csv = csv::Reader::from_reader(csv_text.as_bytes());
+    let header: Vec<String> = csv.headers().unwrap().iter().map(String::from).collect();
+    let rows: Vec<csv::StringRecord> = csv.records().map(Result::unwrap).collect();
+    let batch = &batches[0];
+    assert_eq!(batches.len(), 1);
+    assert_eq!(batch.num_rows(), 23);
+    for (c, name) in header.iter().enumerate() {
+        let col = batch.column_by_name(name).unwrap_or_else(|| panic!("{name} missing from the Parquet table"));
+        for (r, row) in rows.iter().enumerate() {
+            let cell = &row[c];
+            let got = if col.is_null(r) {
+                None
+            } else if let Some(a) = col.as_any().downcast_ref::<arrow_array::Float64Array>() {
+                Some(a.value(r))
+            } else {
+                Some(col.as_any().downcast_ref::<arrow_array::Int64Array>().unwrap().value(r) as f64)
+            };
+            assert_eq!(got, (!cell.is_empty()).then(|| cell.parse::<f64>().unwrap()), "{name} row {r}");
+        }
+    }
+    let model = batch.column_by_name("model").unwrap().as_any().downcast_ref::<arrow_array::StringArray>().unwrap();
+    assert_eq!(model.value(0), "reference");
+
+    // Shards of different ensembles, or missing ones, are refused with the directory.
+    let o = lpc(["merge".as_ref(), dir("shard0").as_os_str(), dir("shard2").as_os_str(), "--out".as_ref(), dir("bad").as_os_str()]);
+    assert_eq!(o.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&o.stderr).contains("shard2"));
+    assert!(!dir("bad").exists());
+    let o = lpc(["run".as_ref(), path.as_os_str(), "--ensemble".as_ref(), "3".as_ref(), "--shard".as_ref(), "3/3".as_ref()]);
+    assert_eq!(o.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&o.stderr).contains("--shard"));
+}

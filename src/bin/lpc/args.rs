@@ -78,6 +78,13 @@ pub struct EnsembleArgs {
     pub seed: Option<u64>,
 }
 
+/// `I/K`: shard I (from 0) of K.
+pub fn parse_shard(s: &str) -> std::result::Result<(usize, usize), String> {
+    let bad = || format!("`{s}` is not a shard I/K (I from 0, K shards)");
+    let (i, k) = s.split_once('/').ok_or_else(bad)?;
+    Ok((i.trim().parse().map_err(|_| bad())?, k.trim().parse().map_err(|_| bad())?))
+}
+
 /// `--quantile Q` of a study over ensembles (default the median), checked.
 pub fn quantile_arg(q: Option<f64>, path: &Path) -> std::result::Result<f64, SceneError> {
     ensemble::check_quantile(q.unwrap_or(0.5)).map_err(|rule| invalid(path, "--quantile", rule))
@@ -108,6 +115,14 @@ impl Nominal {
     /// The members `e` asks for about the nominal scene.
     pub fn ensemble(&self, e: EnsembleArgs) -> std::result::Result<Option<Ensemble>, SceneError> {
         self.ensemble_of(e, &self.file, &self.scene)
+    }
+    /// The members of shard `(i, k)` of the ensemble `e` asks for ([`ensemble::shard_range`]).
+    pub fn ensemble_shard(&self, e: EnsembleArgs, (i, k): (usize, usize)) -> std::result::Result<Option<Ensemble>, SceneError> {
+        let Some(n) = e.ensemble else { return Ok(None) };
+        if k == 0 || i >= k || k > n {
+            return Err(invalid(Path::new(&self.path), "--shard", format!("must be I/K with 0 <= I < K <= N = {n} (got {i}/{k})")));
+        }
+        ensemble::draw_range(&self.file, &self.path, &self.scene, self.tolerances.as_ref(), n, ensemble::shard_range(n, i, k), e.seed).map(Some)
     }
 }
 

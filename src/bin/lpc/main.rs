@@ -28,6 +28,8 @@ enum Command {
     Run(commands::run::Args),
     /// Run every value of a scene's [sweep] table, in parallel.
     Sweep(commands::sweep::Args),
+    /// Join the shards of an ensemble (`lpc run --ensemble N --shard I/K --out DIR`) into one table.
+    Merge(commands::merge::Args),
     /// Frequency response: steady amplitude of xs against forcing frequency, with and without
     /// the damper (needs a [forcing] table, or --kind and --amplitude).
     Frf(commands::frf::Args),
@@ -60,6 +62,7 @@ fn main() -> ExitCode {
     let result = match cli.command {
         Command::Run(a) => commands::run::run(a),
         Command::Sweep(a) => commands::sweep::run(a),
+        Command::Merge(a) => commands::merge::run(a),
         Command::Frf(a) => commands::frf::run(a),
         Command::Optimize(a) => commands::optimize::run(a),
         Command::Chain(a) => commands::chain::run(a),

@@ -6,6 +6,7 @@ pub mod chain;
 pub mod check;
 pub mod compare;
 pub mod frf;
+pub mod merge;
 pub mod optimize;
 pub mod plot;
 pub mod render;

@@ -7,10 +7,11 @@ use std::path::{Path, PathBuf};
 use anyhow::Context;
 
 use lpc_damper::output::{table_csv, text_summary, write_atomic, write_run_dir, RunSummary, SUMMARY_METRICS};
-use lpc_damper::studies::ensemble::{self, Ensemble, EnsembleSummary};
+use lpc_damper::output::parquet::{table_parquet, Constant, TOOL_VERSION};
+use lpc_damper::studies::ensemble::{self, Ensemble, EnsembleSummary, ShardInfo};
 use lpc_damper::Model;
 
-use crate::args::{load_nominal, print_json, progress_bar, EnsembleArgs, Format, RapierArgs};
+use crate::args::{load_nominal, parse_shard, print_json, progress_bar, EnsembleArgs, Format, RapierArgs};
 use crate::exit::{ExitStatus, Result};
 use crate::table::{left, right, statistic, Table};
 
@@ -37,10 +38,19 @@ pub struct Args {
     format: Format,
     #[command(flatten)]
     ensemble: EnsembleArgs,
+    /// With --ensemble: run only shard I (from 0) of K, members I*N/K .. (I+1)*N/K, the ones
+    /// the whole ensemble has there (for a job array); --out then writes the shard's
+    /// members.csv, members.parquet and shard.json, which `lpc merge` joins.
+    #[arg(long, value_name = "I/K", requires = "ensemble", value_parser = parse_shard)]
+    shard: Option<(usize, usize)>,
 }
 
 pub fn run(a: Args) -> Result<ExitStatus> {
     let nominal = load_nominal(&a.scene, a.rapier.overrides(a.horizon, a.sample_dt))?;
+    if let Some(shard) = a.shard {
+        let members = nominal.ensemble_shard(a.ensemble, shard)?.expect("--shard requires --ensemble");
+        return run_shard(&a, &nominal.scene, &members, shard);
+    }
     if let Some(members) = nominal.ensemble(a.ensemble)? {
         return run_ensemble(&a, &nominal.scene, &members);
     }
@@ -81,7 +91,72 @@ fn run_ensemble(a: &Args, nominal: &lpc_damper::scene::Scene, members: &Ensemble
         write_ensemble_dir(dir, a.model, nominal, members, &runs, &summary)
             .with_context(|| format!("writing outputs to {}", dir.display()))?;
     }
-    match a.format {
+    print_ensemble(&summary, a.format, a.out.as_deref().map(|d| (d, "members.csv, members.parquet, ensemble.json, band.csv and the nominal run")))
+}
+
+/// One shard of an ensemble: its members' table and `shard.json` for `lpc merge`.
+fn run_shard(a: &Args, nominal: &lpc_damper::scene::Scene, members: &Ensemble, (shard, shards): (usize, usize)) -> Result<ExitStatus> {
+    let bar = progress_bar(members.members.len(), "shard");
+    let start = std::time::Instant::now();
+    let runs = ensemble::run_members(members, a.model, false, &|| bar.inc(1))?;
+    let wall_time_s = start.elapsed().as_secs_f64();
+    bar.finish_and_clear();
+    let first = members.members.first().map_or(0, |m| m.index);
+    let info = ShardInfo {
+        scene: nominal.name.clone(),
+        model: a.model,
+        seed: members.seed,
+        members: a.ensemble.ensemble.unwrap_or(0),
+        shard,
+        shards,
+        start: first,
+        stop: first + members.members.len(),
+        redraws: members.redraws,
+        wall_time_s,
+    };
+    if let Some(dir) = &a.out {
+        (|| -> anyhow::Result<()> {
+            std::fs::create_dir_all(dir)?;
+            write_members(dir, a.model, members.seed, &members.columns, members, &runs.metrics)?;
+            write_atomic(&dir.join("shard.json"), &serde_json::to_vec_pretty(&info)?)?;
+            Ok(())
+        })()
+        .with_context(|| format!("writing outputs to {}", dir.display()))?;
+    }
+    let summary = EnsembleSummary {
+        scene: info.scene.clone(),
+        model: a.model,
+        members: members.members.len(),
+        redraws: members.redraws,
+        seed: members.seed,
+        metrics: ensemble::metric_stats(&runs.metrics),
+        wall_time_s,
+    };
+    print_ensemble(&summary, a.format, a.out.as_deref().map(|d| (d, "members.csv, members.parquet and shard.json")))
+}
+
+/// `members.csv` and `members.parquet` of an ensemble's (or a shard's) members.
+pub fn write_members(dir: &Path, model: Model, seed: u64, columns: &[String], members: &Ensemble, metrics: &[Vec<Option<f64>>]) -> anyhow::Result<()> {
+    let (header, rows) = ensemble::members_table(columns, &members.members, metrics);
+    write_table(dir, "members", &header, &rows, model, seed)
+}
+
+/// `NAME.csv` and `NAME.parquet` of a members table.
+pub fn write_table(dir: &Path, name: &str, header: &[String], rows: &[Vec<Option<f64>>], model: Model, seed: u64) -> anyhow::Result<()> {
+    write_atomic(&dir.join(format!("{name}.csv")), &table_csv(header, rows.iter().cloned()))?;
+    let constants = [
+        ("seed", Constant::Unsigned(seed)),
+        ("model", Constant::Text(model.name().into())),
+        ("version", Constant::Text(TOOL_VERSION.into())),
+    ];
+    write_atomic(&dir.join(format!("{name}.parquet")), &table_parquet(header, rows, ensemble::INTEGER_COLUMNS, &constants)?)?;
+    Ok(())
+}
+
+/// Prints an ensemble's summary; `wrote` names the directory and what went into it.
+pub fn print_ensemble(summary: &EnsembleSummary, format: Format, wrote: Option<(&Path, &str)>) -> Result<ExitStatus> {
+    let wall_time_s = summary.wall_time_s;
+    match format {
         Format::Json => print_json(&summary)?,
         Format::Text => {
             println!(
@@ -116,8 +191,8 @@ fn run_ensemble(a: &Args, nominal: &lpc_damper::scene::Scene, members: &Ensemble
                     s.undefined.to_string(),
                 ]);
             }
-            if let Some(dir) = &a.out {
-                println!("wrote members.csv, ensemble.json, band.csv and the nominal run to {}", dir.display());
+            if let Some((dir, what)) = wrote {
+                println!("wrote {what} to {}", dir.display());
             }
         }
     }
@@ -136,16 +211,7 @@ fn write_ensemble_dir(
 ) -> anyhow::Result<()> {
     let run = model.simulate(nominal)?;
     write_run_dir(&run, dir)?;
-    let mut header = vec!["member".to_string()];
-    header.extend(members.columns.iter().cloned());
-    header.extend(SUMMARY_METRICS.iter().map(|m| m.to_string()));
-    let rows = members.members.iter().zip(&runs.metrics).map(|(m, metrics)| {
-        let mut row = vec![Some(m.index as f64)];
-        row.extend(m.drawn.iter().map(|&x| Some(x)));
-        row.extend(metrics.iter().copied());
-        row
-    });
-    write_atomic(&dir.join("members.csv"), &table_csv(&header, rows))?;
+    write_members(dir, model, members.seed, &members.columns, members, &runs.metrics)?;
     write_atomic(&dir.join("ensemble.json"), &serde_json::to_vec_pretty(summary)?)?;
     let header: Vec<String> = ["t", "xs_p05", "xs_median", "xs_p95", "env_p95"].iter().map(|s| s.to_string()).collect();
     let band = ensemble::band(&runs.t, &runs.xs);

@@ -4,12 +4,13 @@ use std::path::PathBuf;
 
 use anyhow::Context;
 
-use lpc_damper::output::write_atomic;
+use lpc_damper::output::parquet::{table_parquet, Constant, TOOL_VERSION};
+use lpc_damper::output::{write_atomic, SUMMARY_METRICS};
 use lpc_damper::scene;
 use lpc_damper::Model;
 
 use lpc_damper::studies::ensemble;
-use lpc_damper::studies::sweep::{Axis, Coordinates, EnsemblePoint, GridScene};
+use lpc_damper::studies::sweep::{Axis, Coordinates, EnsemblePoint, GridScene, SweepPoint};
 
 use crate::args::{invalid, override_scene, print_json, progress_bar, quantile_arg, EnsembleArgs, Format, Nominal, RapierArgs};
 use crate::table::{right, statistic, Table};
@@ -90,7 +91,10 @@ pub fn run(a: Args) -> Result<ExitStatus> {
     if let Some(dir) = &a.out {
         let cells: Vec<Option<f64>> = points.iter().map(|p| lpc_damper::studies::sweep::metric_value(&p.summary, &a.metric)).collect();
         let title = format!("{}: {} ({})", loaded.scene.as_ref().map_or("", |s| s.name.as_str()), a.metric, a.model.name());
-        write_sweep(dir, &points, &axes, &cells, title, a.metric.clone())?;
+        let numbered: Vec<(usize, SweepPoint)> = points.iter().cloned().enumerate().collect();
+        let (header, rows) = lpc_damper::studies::sweep::cells_table(&parameters, &numbered);
+        let table = SweepTable { header, rows, constants: vec![("model", Constant::Text(a.model.name().into())), ("version", Constant::Text(TOOL_VERSION.into()))] };
+        write_sweep(dir, &points, &axes, &cells, title, a.metric.clone(), &table)?;
     }
     match a.format {
         Format::Json => print_json(&points)?,
@@ -147,6 +151,13 @@ fn axis_title(axis: &lpc_damper::studies::sweep::Axis) -> String {
 
 /// `sweep.json` of `points` and, for a grid, its design map of `cells` (grid order, first
 /// axis fastest).
+/// The rows of `sweep.parquet`, and the constants every row carries.
+struct SweepTable {
+    header: Vec<String>,
+    rows: Vec<Vec<Option<f64>>>,
+    constants: Vec<(&'static str, Constant)>,
+}
+
 fn write_sweep(
     dir: &std::path::Path,
     points: &impl serde::Serialize,
@@ -154,8 +165,11 @@ fn write_sweep(
     cells: &[Option<f64>],
     title: String,
     z_desc: String,
+    table: &SweepTable,
 ) -> anyhow::Result<()> {
     write_atomic(&dir.join("sweep.json"), &serde_json::to_vec_pretty(points)?).with_context(|| format!("writing {}", dir.display()))?;
+    let parquet = table_parquet(&table.header, &table.rows, lpc_damper::studies::sweep::INTEGER_COLUMNS, &table.constants)?;
+    write_atomic(&dir.join("sweep.parquet"), &parquet).with_context(|| format!("writing {}", dir.display()))?;
     if axes.len() != 2 {
         return Ok(());
     }
@@ -196,7 +210,30 @@ fn sweep_ensembles(a: &Args, nominal: &Nominal, axes: &[Axis], parameters: &[Str
     if let Some(dir) = &a.out {
         let cells: Vec<Option<f64>> = points.iter().map(|p| p.at_quantile[&a.metric]).collect();
         let title = format!("{}: {} at quantile {q} of {per_point} members ({})", nominal.scene.name, a.metric, a.model.name());
-        write_sweep(dir, &points, axes, &cells, title, format!("{} (q {q})", a.metric))?;
+        // One row per cell: each metric at the quantile the map shows.
+        let mut header = vec!["cell".to_string()];
+        header.extend(parameters.iter().cloned());
+        header.extend(SUMMARY_METRICS.iter().map(|m| m.to_string()));
+        let rows = points
+            .iter()
+            .enumerate()
+            .map(|(cell, p)| {
+                let mut row = vec![Some(cell as f64), Some(p.at.value)];
+                if parameters.len() > 1 {
+                    row.push(p.at.value_y);
+                }
+                row.extend(SUMMARY_METRICS.iter().map(|m| p.at_quantile[*m]));
+                row
+            })
+            .collect();
+        let constants = vec![
+            ("members", Constant::Unsigned(per_point as u64)),
+            ("quantile", Constant::Text(q.to_string())),
+            ("model", Constant::Text(a.model.name().into())),
+            ("version", Constant::Text(TOOL_VERSION.into())),
+        ];
+        let table = SweepTable { header, rows, constants };
+        write_sweep(dir, &points, axes, &cells, title, format!("{} (q {q})", a.metric), &table)?;
     }
     match a.format {
         Format::Json => print_json(&points)?,

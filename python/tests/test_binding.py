@@ -1,0 +1,185 @@
+"""The binding against the CLI and the library's rules: same series to the bit, same errors,
+same ensembles and sweeps, columns a DataFrame takes, and the GIL released while it computes."""
+
+from __future__ import annotations
+
+import csv
+import pickle
+import subprocess
+import threading
+import time
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import lpc_damper as lpc
+
+
+def read_csv(path: Path) -> tuple[list[str], list[list[str]]]:
+    with open(path, newline="") as f:
+        rows = list(csv.reader(f))
+    return rows[0], rows[1:]
+
+
+def column(header: list[str], rows: list[list[str]], name: str) -> np.ndarray:
+    j = header.index(name)
+    return np.array([float(r[j]) if r[j] != "" else np.nan for r in rows])
+
+
+@pytest.mark.parametrize("model", ["reference", "compliant"])
+def test_run_equals_the_cli_series_to_the_last_bit(lpc_bin, scenes, tmp_path, model):
+    subprocess.run([lpc_bin, "run", scenes / "lpc-lsl.toml", "--model", model, "--out", tmp_path], check=True, capture_output=True)
+    header, rows = read_csv(tmp_path / "series.csv")
+    run = lpc.run(lpc.load_scene(scenes / "lpc-lsl.toml"), model=model)
+    # Rust writes the shortest string that reads back to the same double; float() reads it
+    # exactly: equality is bit equality.
+    for name, got in [("t", run.t), ("xs", run.xs), ("vs", run.vs), ("a", run.a)]:
+        assert np.array_equal(column(header, rows, name), got), name
+    assert run.x.shape == (3, len(rows)) and run.v.shape == (3, len(rows))
+    for i in range(3):
+        assert np.array_equal(column(header, rows, f"x{i + 1}"), run.x[i])
+        assert np.array_equal(column(header, rows, f"v{i + 1}"), run.v[i])
+    ih, irows = read_csv(tmp_path / "impacts.csv")
+    assert np.array_equal(column(ih, irows, "t"), run.impacts["t"])
+    assert list(run.impacts["body_a"]) == [r[ih.index("body_a")] for r in irows]
+    import json
+
+    summary = json.loads((tmp_path / "summary.json").read_text())
+    assert run.metrics == summary["metrics"]
+    assert run.energy == summary["energy"]
+    assert run.noise == summary["noise"]
+
+
+def test_series_arrays_are_float64_and_owned_by_numpy(scenes):
+    run = lpc.run(lpc.load_scene(scenes / "lpc-lsl.toml"))
+    for a in (run.t, run.xs, run.vs, run.a, run.x, run.v):
+        assert a.dtype == np.float64 and a.flags["C_CONTIGUOUS"]
+    assert run.t[0] == 0.0 and run.t[-1] == pytest.approx(5.0)
+
+
+def test_a_bad_field_raises_scene_error_with_the_cli_message(lpc_bin, scenes, tmp_path):
+    text = (scenes / "lpc-lsl.toml").read_text().replace("mass = 1.35", "mass = -1.35")
+    bad = tmp_path / "bad.toml"
+    bad.write_text(text)
+    cli = subprocess.run([lpc_bin, "run", bad], capture_output=True, text=True)
+    assert cli.returncode == 2
+    with pytest.raises(lpc.SceneError) as e:
+        lpc.load_scene(bad)
+    assert "`frame.mass`" in str(e.value)
+    assert str(e.value) in cli.stderr
+    d = lpc.load_scene(scenes / "lpc-lsl.toml").to_dict()
+    d["balls"]["restitution"] = float("nan")
+    with pytest.raises(lpc.SceneError, match="balls.restitution"):
+        lpc.Scene.from_dict(d)
+    d = lpc.load_scene(scenes / "lpc-lsl.toml").to_dict()
+    d["frame"]["colour"] = "red"
+    with pytest.raises(lpc.SceneError, match="colour"):
+        lpc.Scene.from_dict(d)
+    with pytest.raises(lpc.SceneError, match="cannot read"):
+        lpc.load_scene(tmp_path / "missing.toml")
+    with pytest.raises(lpc.SceneError, match="model"):
+        lpc.run(lpc.load_scene(scenes / "lpc-lsl.toml"), model="abaqus")
+    with pytest.raises(lpc.SceneError, match="horizon"):
+        lpc.run(lpc.load_scene(scenes / "lpc-lsl.toml"), horizon=-1.0)
+
+
+def test_a_dict_scene_is_the_file_scene(scenes):
+    scene = lpc.load_scene(scenes / "lpc-lsl.toml")
+    d = scene.to_dict()
+    assert d["tolerances"]["gap"] == "0.02 Rr"
+    again = lpc.Scene.from_dict(d)
+    assert again.to_dict() == d
+    assert np.array_equal(lpc.run(again).xs, lpc.run(scene).xs)
+    assert pickle.loads(pickle.dumps(scene)).to_dict() == d
+
+
+def test_ensemble_equals_the_cli_members_table(lpc_bin, scenes, tmp_path):
+    subprocess.run([lpc_bin, "run", scenes / "lpc-lsl.toml", "--ensemble", "40", "--seed", "7", "--out", tmp_path], check=True, capture_output=True)
+    header, rows = read_csv(tmp_path / "members.csv")
+    table = lpc.ensemble(lpc.load_scene(scenes / "lpc-lsl.toml"), 40, seed=7)
+    assert list(table) == header
+    assert table["member"].dtype == np.int64 and list(table["member"]) == list(range(40))
+    for name in header:
+        assert np.array_equal(column(header, rows, name), table[name].astype(float), equal_nan=True), name
+
+
+def test_ensemble_ranges_are_the_members_of_the_whole(scenes):
+    scene = lpc.load_scene(scenes / "lpc-lsl.toml")
+    whole = lpc.ensemble(scene, 30)
+    parts = [lpc.ensemble(scene, 30, start=a, stop=b) for a, b in [(0, 7), (7, 8), (8, 30)]]
+    for name, values in whole.items():
+        assert np.array_equal(np.concatenate([p[name] for p in parts]), values, equal_nan=True)
+
+
+def test_sweep_and_dataframe(scenes):
+    import pandas as pd
+
+    scene = lpc.load_scene(scenes / "sweep-gap.toml")
+    table = lpc.sweep(scene)
+    frame = pd.DataFrame(table)
+    assert list(frame.columns[:2]) == ["cell", "gap"] and len(frame) == lpc.sweep_cells(scene)
+    assert list(frame["cell"]) == list(range(len(frame)))
+    grid = lpc.sweep(lpc.load_scene(scenes / "lpc-lsl.toml"), ["gap=0.1 Rr,0.5 Rr", "restitution=0.5,0.9"])
+    assert list(grid["restitution"]) == [0.5, 0.5, 0.9, 0.9] and list(grid["gap"]) == [0.1, 0.5, 0.1, 0.5]
+    half = lpc.sweep(lpc.load_scene(scenes / "lpc-lsl.toml"), ["gap=0.1 Rr,0.5 Rr", "restitution=0.5,0.9"], start=2)
+    assert np.array_equal(half["impact_count"], grid["impact_count"][2:])
+
+
+def test_chain_ker_of_an_elastic_equal_chain_is_one(scenes, tmp_path):
+    d = lpc.load_scene(scenes / "chain-ker.toml").to_dict()
+    table = lpc.chain(lpc.load_scene(scenes / "chain-ker.toml"))
+    assert set(table) == {"large", "small", "ker"}
+    assert np.all((table["ker"] > 0) & (table["ker"] <= 1 + 1e-12))
+    assert "chain" in d
+
+
+def test_calls_release_the_gil(scenes):
+    """A Python thread keeps running while an ensemble computes: it could not if the call
+    held the GIL for its whole length."""
+    scene = lpc.load_scene(scenes / "lpc-lsl.toml")
+    ticks = [0]
+    stop = threading.Event()
+
+    def tick():
+        while not stop.is_set():
+            ticks[0] += 1
+            time.sleep(0.001)
+
+    t = threading.Thread(target=tick)
+    t.start()
+    time.sleep(0.01)
+    try:
+        before = ticks[0]
+        lpc.ensemble(scene, 3000, model="reference", horizon=5.0)
+        during = ticks[0] - before
+    finally:
+        stop.set()
+        t.join()
+    assert during > 5
+
+
+def test_ctrl_c_stops_a_long_ensemble_between_batches(scenes, tmp_path):
+    """SIGINT during a long call raises KeyboardInterrupt from inside it: the call stops, so
+    the table it would have written at its end is never written (a call that ran to its end
+    and raised only afterwards would have written it)."""
+    import signal
+    import sys
+
+    script = tmp_path / "long.py"
+    out = tmp_path / "parts"
+    script.write_text(
+        "import sys, lpc_damper as lpc\n"
+        f"scene = lpc.load_scene({str(scenes / 'lpc-lsl.toml')!r})\n"
+        "print('started', flush=True)\n"
+        f"lpc.ensemble(scene, 400000, out={str(out)!r})\n"
+        "print('finished', flush=True)\n"
+    )
+    p = subprocess.Popen([sys.executable, str(script)], stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    assert p.stdout.readline().strip() == "started"
+    time.sleep(0.5)
+    p.send_signal(signal.SIGINT)
+    stdout, stderr = p.communicate(timeout=600)
+    assert "KeyboardInterrupt" in stderr
+    assert "finished" not in stdout
+    assert not out.exists()
