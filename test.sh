@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # The whole test suite on a fresh machine: installs what it lacks, then runs every test (unit,
-# integration, property, doc and the off-screen render tests). CI runs exactly this script.
+# integration, property, doc and the off-screen render tests, then the Python package's).
+# CI runs exactly this script.
 set -euo pipefail
 cd "$(dirname "$0")"
 
@@ -15,3 +16,12 @@ fi
 cargo --version
 
 cargo test --locked --features render
+
+# The Python package (python/, built by maturin with the locked dependencies) in a virtual
+# environment of its own, with what its tests use (pytest, dask[distributed], pandas,
+# pyarrow); its tests compare it with the release CLI.
+cargo build --locked --release --bin lpc
+venv=target/python-venv
+[ -x "$venv/bin/python" ] || python3 -m venv "$venv"
+MATURIN_PEP517_ARGS="--locked" "$venv/bin/python" -m pip install --quiet --disable-pip-version-check "./python[test]"
+"$venv/bin/python" -m pytest -q python/tests

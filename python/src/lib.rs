@@ -15,6 +15,7 @@ use numpy::{IntoPyArray, PyArray1};
 use pyo3::create_exception;
 use pyo3::exceptions::{PyRuntimeError, PyValueError};
 use pyo3::prelude::*;
+use pyo3::sync::MutexExt;
 use pyo3::types::PyDict;
 
 use lpc_damper::model::ModelError as RustModelError;
@@ -234,6 +235,9 @@ impl Settings {
 
 /// One run: the sampled series as NumPy arrays (moved, not copied), the impacts as a dict of
 /// arrays, and the summary's `metrics`, `energy` and `noise` as dicts with `summary.json`'s keys.
+///
+/// Each is made when first read and kept: a run that is asked only for its metrics never
+/// builds the arrays, so the call itself costs the model's run and little more.
 #[pyclass(module = "lpc_damper", frozen)]
 struct Run {
     /// Scene name.
@@ -245,44 +249,115 @@ struct Run {
     /// Simulated time covered, s.
     #[pyo3(get)]
     horizon: f64,
-    /// Sample times, s.
-    #[pyo3(get)]
-    t: Py<PyAny>,
-    /// Frame displacement, m.
-    #[pyo3(get)]
-    xs: Py<PyAny>,
-    /// Frame velocity, m/s.
-    #[pyo3(get)]
-    vs: Py<PyAny>,
-    /// Frame acceleration without impulses and contact forces, m/s^2.
-    #[pyo3(get)]
-    a: Py<PyAny>,
-    /// Ball centres, `(balls, samples)`, m.
-    #[pyo3(get)]
-    x: Py<PyAny>,
-    /// Ball velocities, `(balls, samples)`, m/s.
-    #[pyo3(get)]
-    v: Py<PyAny>,
-    /// Impacts: `t`, `body_a`, `body_b`, `approach_speed`, `energy_lost`, `peak_force`,
-    /// `contact_duration` (NaN for impulse models).
-    #[pyo3(get)]
-    impacts: Py<PyAny>,
-    /// The summary's metrics.
-    #[pyo3(get)]
-    metrics: Py<PyAny>,
-    /// The energy account.
-    #[pyo3(get)]
-    energy: Py<PyAny>,
-    /// The noise proxy.
-    #[pyo3(get)]
-    noise: Py<PyAny>,
     /// Computing time of the model, s.
     #[pyo3(get)]
     wall_time_s: f64,
+    /// The run, whose series move out as they are read.
+    run: std::sync::Mutex<lpc_damper::run::Run>,
+    /// Everything read so far, by name.
+    made: std::sync::Mutex<std::collections::HashMap<&'static str, Py<PyAny>>>,
+}
+
+impl Run {
+    /// `name`, made by `make` (from the run) on first reading and kept.
+    fn cached(&self, py: Python<'_>, name: &'static str, make: impl FnOnce(Python<'_>, &mut lpc_damper::run::Run) -> PyResult<Py<PyAny>>) -> PyResult<Py<PyAny>> {
+        // Locked without holding up the interpreter: another thread reading the same run waits
+        // detached.
+        if let Some(v) = self.made.lock_py_attached(py).expect("not poisoned").get(name) {
+            return Ok(v.clone_ref(py));
+        }
+        let mut run = self.run.lock_py_attached(py).expect("not poisoned");
+        if let Some(v) = self.made.lock_py_attached(py).expect("not poisoned").get(name) {
+            return Ok(v.clone_ref(py)); // made meanwhile by another thread
+        }
+        let value = make(py, &mut run)?;
+        self.made.lock_py_attached(py).expect("not poisoned").insert(name, value.clone_ref(py));
+        Ok(value)
+    }
+
+    /// The run's summary as a dict (its `metrics`, `energy` and `noise` are read from it).
+    fn summary(&self, py: Python<'_>) -> PyResult<Py<PyAny>> {
+        self.cached(py, "summary", |py, run| {
+            let summary = RunSummary::of(run);
+            let value = serde_json::json!({"metrics": summary.metrics, "energy": summary.energy, "noise": summary.noise});
+            Ok(py.import("json")?.call_method1("loads", (value.to_string(),))?.unbind())
+        })
+    }
+
+    fn part(&self, py: Python<'_>, key: &str) -> PyResult<Py<PyAny>> {
+        Ok(self.summary(py)?.bind(py).get_item(key)?.unbind())
+    }
 }
 
 #[pymethods]
 impl Run {
+    /// Sample times, s.
+    #[getter]
+    fn t(&self, py: Python<'_>) -> PyResult<Py<PyAny>> {
+        self.cached(py, "t", |py, r| Ok(floats(py, std::mem::take(&mut r.series.t))))
+    }
+    /// Frame displacement, m.
+    #[getter]
+    fn xs(&self, py: Python<'_>) -> PyResult<Py<PyAny>> {
+        self.cached(py, "xs", |py, r| Ok(floats(py, std::mem::take(&mut r.series.xs))))
+    }
+    /// Frame velocity, m/s.
+    #[getter]
+    fn vs(&self, py: Python<'_>) -> PyResult<Py<PyAny>> {
+        self.cached(py, "vs", |py, r| Ok(floats(py, std::mem::take(&mut r.series.vs))))
+    }
+    /// Frame acceleration without impulses and contact forces, m/s^2.
+    #[getter]
+    fn a(&self, py: Python<'_>) -> PyResult<Py<PyAny>> {
+        self.cached(py, "a", |py, r| Ok(floats(py, std::mem::take(&mut r.series.a))))
+    }
+    /// Ball centres, `(balls, samples)`, m.
+    #[getter]
+    fn x(&self, py: Python<'_>) -> PyResult<Py<PyAny>> {
+        self.cached(py, "x", |py, r| matrix(py, std::mem::take(&mut r.series.x), r.series.t.len().max(r.series.xs.len())))
+    }
+    /// Ball velocities, `(balls, samples)`, m/s.
+    #[getter]
+    fn v(&self, py: Python<'_>) -> PyResult<Py<PyAny>> {
+        self.cached(py, "v", |py, r| matrix(py, std::mem::take(&mut r.series.v), r.series.t.len().max(r.series.xs.len())))
+    }
+    /// Impacts: `t`, `body_a`, `body_b`, `approach_speed`, `energy_lost`, `peak_force`,
+    /// `contact_duration` (NaN for impulse models).
+    #[getter]
+    fn impacts(&self, py: Python<'_>) -> PyResult<Py<PyAny>> {
+        self.cached(py, "impacts", |py, run| {
+            let impacts = PyDict::new(py);
+            let column = |f: &dyn Fn(&lpc_damper::run::Impact) -> f64| floats(py, run.impacts.iter().map(f).collect());
+            impacts.set_item("t", column(&|i| i.t))?;
+            let names = |left: bool| -> Vec<String> {
+                run.impacts.iter().map(|i| scene::Scene::body_name(if left { i.a } else { i.b })).collect()
+            };
+            let numpy = py.import("numpy")?;
+            impacts.set_item("body_a", numpy.call_method1("asarray", (names(true),))?)?;
+            impacts.set_item("body_b", numpy.call_method1("asarray", (names(false),))?)?;
+            impacts.set_item("approach_speed", column(&|i| i.approach_speed))?;
+            impacts.set_item("energy_lost", column(&|i| i.energy_lost))?;
+            impacts.set_item("peak_force", column(&|i| i.peak_force.unwrap_or(f64::NAN)))?;
+            impacts.set_item("contact_duration", column(&|i| i.contact_duration.unwrap_or(f64::NAN)))?;
+            Ok(impacts.into_any().unbind())
+        })
+    }
+    /// The summary's metrics.
+    #[getter]
+    fn metrics(&self, py: Python<'_>) -> PyResult<Py<PyAny>> {
+        self.part(py, "metrics")
+    }
+    /// The energy account.
+    #[getter]
+    fn energy(&self, py: Python<'_>) -> PyResult<Py<PyAny>> {
+        self.part(py, "energy")
+    }
+    /// The noise proxy.
+    #[getter]
+    fn noise(&self, py: Python<'_>) -> PyResult<Py<PyAny>> {
+        self.part(py, "noise")
+    }
+
     fn __repr__(&self) -> String {
         format!("Run(scene={:?}, model={:?}, horizon={}, wall_time_s={:.3e})", self.scene, self.model, self.horizon, self.wall_time_s)
     }
@@ -291,6 +366,7 @@ impl Run {
 /// `(balls, samples)` from one vector per ball, moved into one array.
 fn matrix(py: Python<'_>, rows: Vec<Vec<f64>>, samples: usize) -> PyResult<Py<PyAny>> {
     let balls = rows.len();
+    let samples = rows.first().map_or(samples, Vec::len);
     let mut flat = Vec::with_capacity(balls * samples);
     for r in rows {
         flat.extend(r);
@@ -320,45 +396,14 @@ fn run(
 ) -> PyResult<Run> {
     let model = parse_model(model)?;
     let s = scene.damper(&Settings { horizon, sample_dt, stepping, dt, solver_iterations, ccd })?;
-    let (run, summary) = py
-        .detach(|| {
-            let run = model.simulate(&s)?;
-            let summary = RunSummary::of(&run);
-            Ok::<_, RustModelError>((run, summary))
-        })
-        .map_err(model_error)?;
-    let json = py.import("json")?;
-    let loads = |v: serde_json::Value| json.call_method1("loads", (v.to_string(),)).map(|o| o.unbind());
-    let impacts = PyDict::new(py);
-    let column = |f: &dyn Fn(&lpc_damper::run::Impact) -> f64| floats(py, run.impacts.iter().map(f).collect());
-    impacts.set_item("t", column(&|i| i.t))?;
-    let names = |side: bool| -> Vec<String> {
-        run.impacts.iter().map(|i| scene::Scene::body_name(if side { i.a } else { i.b })).collect()
-    };
-    let numpy = py.import("numpy")?;
-    impacts.set_item("body_a", numpy.call_method1("asarray", (names(true),))?)?;
-    impacts.set_item("body_b", numpy.call_method1("asarray", (names(false),))?)?;
-    impacts.set_item("approach_speed", column(&|i| i.approach_speed))?;
-    impacts.set_item("energy_lost", column(&|i| i.energy_lost))?;
-    impacts.set_item("peak_force", column(&|i| i.peak_force.unwrap_or(f64::NAN)))?;
-    impacts.set_item("contact_duration", column(&|i| i.contact_duration.unwrap_or(f64::NAN)))?;
-    let series = run.series;
-    let samples = series.t.len();
+    let run = py.detach(|| model.simulate(&s)).map_err(model_error)?;
     Ok(Run {
-        scene: run.scene,
+        scene: run.scene.clone(),
         model: model.name().into(),
         horizon: run.horizon,
-        t: floats(py, series.t),
-        xs: floats(py, series.xs),
-        vs: floats(py, series.vs),
-        a: floats(py, series.a),
-        x: matrix(py, series.x, samples)?,
-        v: matrix(py, series.v, samples)?,
-        impacts: impacts.into_any().unbind(),
-        metrics: loads(serde_json::to_value(summary.metrics).expect("metrics serialise"))?,
-        energy: loads(serde_json::to_value(summary.energy).expect("energy serialises"))?,
-        noise: loads(serde_json::to_value(summary.noise).expect("noise serialises"))?,
         wall_time_s: run.wall_time_s,
+        run: std::sync::Mutex::new(run),
+        made: Default::default(),
     })
 }
 

@@ -183,3 +183,16 @@ def test_ctrl_c_stops_a_long_ensemble_between_batches(scenes, tmp_path):
     assert "KeyboardInterrupt" in stderr
     assert "finished" not in stdout
     assert not out.exists()
+
+
+def test_the_fig9_example_runs(tmp_path):
+    """examples/fig9.py (the README's Python example) runs and draws its figure."""
+    import os
+    import sys
+
+    root = Path(__file__).resolve().parents[2]
+    out = tmp_path / "fig9.png"
+    env = dict(os.environ, MPLBACKEND="Agg")
+    done = subprocess.run([sys.executable, str(root / "examples" / "fig9.py"), str(out)], env=env, capture_output=True, text=True, cwd=tmp_path)
+    assert done.returncode == 0, done.stderr
+    assert out.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n" and out.stat().st_size > 10_000
