@@ -29,8 +29,8 @@ pub struct Args {
     /// Output format on standard output.
     #[arg(long, value_enum, default_value_t = Format::Text)]
     format: Format,
-    /// Also write sweep.json (and, for a grid, the design map sweep-map.png/.svg) into this
-    /// directory.
+    /// Also write sweep.json, sweep.parquet (one row per cell) and, for a grid, the design map
+    /// sweep-map.png/.svg into this directory.
     #[arg(long)]
     out: Option<PathBuf>,
     /// First axis instead of the file's [sweep]: `PARAM=V1,V2,...` or `PARAM=A..B:N`
