@@ -40,8 +40,11 @@
 //!   `(m v^2 / K)^(2/5)` of the open contacts (or of the scene's speed scale) and on
 //!   velocities relative to their speed; within a contact a step is at most a tenth of
 //!   `1 / omega` of the contact's linearised stiffness at its largest overlap, about 40 steps
-//!   per elastic impact. More than `max_steps` steps, a step shrinking to round-off or a
-//!   non-finite state end the run with a [`CompliantError`] naming the scene.
+//!   per elastic impact. A step shrinking to round-off or a non-finite state end the run with
+//!   a [`CompliantError`] naming the scene; so do more than `max_steps` steps or more than
+//!   `max_wall_s` seconds of computing, which keep the run so far and say what its steps cost
+//!   (the last step, the open contacts, the stiffest of them: [`CompliantError::OverBudget`]).
+//!   [`Progress`] shows a run as it goes.
 
 pub mod contact;
 pub mod integrator;
@@ -71,32 +74,72 @@ const CLOSE_OVERSHOOT: f64 = 1.5;
 pub struct Options {
     /// Error tolerance per step, relative to the contact scales.
     pub tolerance: f64,
-    /// Most steps before the run is declared stalled.
+    /// Most steps (accepted and rejected) before the run stops ([`CompliantError::OverBudget`]).
     pub max_steps: u64,
+    /// Most seconds of computing before the run stops, if any ([`CompliantError::OverBudget`]).
+    pub max_wall_s: Option<f64>,
     /// What the run keeps besides its metrics.
     pub record: Record,
 }
 
 impl Default for Options {
     fn default() -> Self {
-        Options { tolerance: DEFAULT_TOLERANCE, max_steps: MAX_STEPS, record: Record::Series }
+        Options { tolerance: DEFAULT_TOLERANCE, max_steps: MAX_STEPS, max_wall_s: None, record: Record::Series }
+    }
+}
+
+/// Steps between two updates of a run's [`Progress`] and two looks at its wall-time budget.
+pub const PROGRESS_STEPS: u64 = 1024;
+
+/// Where a run stands, for a progress bar on another thread: the simulated time reached and
+/// the steps taken, updated every [`PROGRESS_STEPS`] steps.
+#[derive(Debug, Default)]
+pub struct Progress {
+    t: std::sync::atomic::AtomicU64,
+    steps: std::sync::atomic::AtomicU64,
+}
+
+impl Progress {
+    /// Simulated time reached, s.
+    pub fn time(&self) -> f64 {
+        f64::from_bits(self.t.load(std::sync::atomic::Ordering::Relaxed))
+    }
+    /// Steps taken (accepted and rejected).
+    pub fn steps(&self) -> u64 {
+        self.steps.load(std::sync::atomic::Ordering::Relaxed)
+    }
+    fn set(&self, t: f64, steps: u64) {
+        self.t.store(t.to_bits(), std::sync::atomic::Ordering::Relaxed);
+        self.steps.store(steps, std::sync::atomic::Ordering::Relaxed);
     }
 }
 
 /// Why the compliant model could not finish a scene.
 #[derive(Debug, thiserror::Error)]
 pub enum CompliantError {
-    /// More steps than allowed.
-    #[error("scene `{scene}`: the compliant model stalled after {steps} steps at t = {} s (limit {limit})", crate::scene::human(*.t))]
-    Stalled {
+    /// A budget ran out: more steps than `max_steps`, or more computing time than
+    /// `max_wall_s`. The run so far is kept, with what its steps cost.
+    #[error(
+        "scene `{scene}`: the compliant model stopped at t = {} s of {} s after {steps} steps and {wall_s:.1} s of computing: {budget}; {driver}",
+        crate::scene::human(*.t), crate::scene::human(*.horizon)
+    )]
+    OverBudget {
         /// Scene name.
         scene: String,
-        /// Steps taken.
-        steps: u64,
         /// Simulated time reached, s.
         t: f64,
-        /// The limit.
-        limit: u64,
+        /// The scene's horizon, s.
+        horizon: f64,
+        /// Steps taken.
+        steps: u64,
+        /// Computing time, s.
+        wall_s: f64,
+        /// Which budget ran out.
+        budget: String,
+        /// What the steps cost: the last step, the open contacts and the stiffest of them.
+        driver: String,
+        /// The run up to `t` (series, impacts, energy account so far).
+        partial: Box<Run>,
     },
     /// The step size fell to round-off.
     #[error("scene `{scene}`: the compliant model's step fell to {h:e} s at t = {} s", crate::scene::human(*.t))]
@@ -133,12 +176,17 @@ pub fn simulate_recording(scene: &Scene, record: Record) -> Result<Run, Complian
 
 /// Runs the compliant model on `scene` with `options`.
 pub fn simulate_with(scene: &Scene, options: Options) -> Result<Run, CompliantError> {
+    simulate_watched(scene, options, None)
+}
+
+/// [`simulate_with`], telling `progress` where the run stands as it goes.
+pub fn simulate_watched(scene: &Scene, options: Options, progress: Option<&Progress>) -> Result<Run, CompliantError> {
     if !(options.tolerance > 0.0 && options.tolerance <= 1e-2) {
         return Err(CompliantError::Tolerance(options.tolerance));
     }
     let start = Instant::now();
     let system = System::new(scene);
-    let mut run = Driver::new(&system, options).run()?;
+    let mut run = Driver::new(&system, options).run(start, progress)?;
     run.wall_time_s = start.elapsed().as_secs_f64();
     Ok(run)
 }
@@ -705,7 +753,81 @@ impl<'s, 'a> Driver<'s, 'a> {
         self.buf = buf;
     }
 
-    fn run(mut self) -> Result<Run, CompliantError> {
+    /// What the steps cost now: the last step, the contacts open and the stiffest of them
+    /// (its bodies and the period of its linearised stiffness at its overlap), or free flight.
+    fn cost_driver(&self, h: f64) -> String {
+        let sys = self.sys;
+        let mut stiffest: Option<(f64, &Pair)> = None;
+        let mut open = 0;
+        for (q, pair) in sys.pairs.iter().enumerate() {
+            let Some(c) = &self.contacts[q] else { continue };
+            open += 1;
+            let d = sys.overlap(pair, |i| self.y[i]).0.max(contact::max_overlap(pair.mass, c.v_max, pair.k));
+            let omega = (1.5 * pair.k * d.max(0.0).sqrt() / pair.mass).sqrt();
+            if stiffest.is_none_or(|(w, _)| omega > w) {
+                stiffest = Some((omega, pair));
+            }
+        }
+        let step = format!("the last step was {} s", crate::scene::human(h));
+        match stiffest {
+            Some((omega, pair)) if omega > 0.0 => {
+                let body = |side: Side| match side {
+                    Side::Ball(i) => format!("ball{} ({} kg)", i + 1, crate::scene::human(sys.scene.balls[i].mass)),
+                    Side::Wall(_) => "the wall".to_string(),
+                };
+                format!(
+                    "{step} with {open} contact{} open, the stiffest {} / {} (a Hertz period of {} s at its overlap); while \
+                     contacts rest or are pressed, the explicit integrator's steps stay this short for as long as they last",
+                    if open == 1 { "" } else { "s" },
+                    body(pair.left),
+                    body(pair.right),
+                    crate::scene::human(2.0 * std::f64::consts::PI / omega),
+                )
+            }
+            _ => format!("{step}, with no contact open"),
+        }
+    }
+
+    /// The run up to now, as [`Driver::run`] returns a finished one.
+    fn finish(mut self, initial: f64) -> Run {
+        let sys = self.sys;
+        let scene = sys.scene;
+        // Contacts open at the end are recorded with their duration so far.
+        for q in 0..self.contacts.len() {
+            if let Some(c) = self.contacts[q] {
+                self.close(q, c);
+            }
+        }
+        self.impacts.sort_by(|a, b| a.t.total_cmp(&b.t).then(a.a.cmp(&b.a)));
+        let impact_loss: f64 = (0..=sys.n).map(|p| self.y[sys.dissipation(p)]).sum();
+        let energy = EnergyAccount::forced(
+            initial,
+            sys.energy(self.t, &self.y),
+            self.y[sys.damping_work()],
+            impact_loss,
+            self.y[sys.forcing_work()],
+        );
+        let final_velocities = (0..sys.n).map(|i| self.y[sys.v(i)]).collect();
+        let (series, motion) = self.recorder.finish();
+        Run {
+            scene: scene.name.clone(),
+            model: crate::run::Model::Compliant,
+            horizon: self.t,
+            sample_dt: scene.sample_dt,
+            initial_displacement: scene.initial_displacement,
+            damped_period: scene.frame.map_or(0.0, |f| f.damped_period()),
+            series,
+            motion,
+            impacts: self.impacts,
+            energy,
+            events: self.accepted,
+            final_velocities,
+            peak_true_acceleration: sys.has_frame().then_some(self.peak_true_acceleration),
+            wall_time_s: 0.0,
+        }
+    }
+
+    fn run(mut self, start: Instant, progress: Option<&Progress>) -> Result<Run, CompliantError> {
         let sys = self.sys;
         let scene = sys.scene;
         let horizon = scene.horizon;
@@ -717,13 +839,34 @@ impl<'s, 'a> Driver<'s, 'a> {
         let mut h = sys.h_floor.min(sys.h_max);
         while self.t < horizon {
             self.steps += 1;
-            if self.steps > self.options.max_steps {
-                return Err(CompliantError::Stalled {
-                    scene: scene.name.clone(),
-                    steps: self.steps - 1,
-                    t: self.t,
-                    limit: self.options.max_steps,
-                });
+            let over_steps = self.steps > self.options.max_steps;
+            if over_steps || self.steps % PROGRESS_STEPS == 0 {
+                if let Some(p) = progress {
+                    p.set(self.t, self.steps);
+                }
+                let wall_s = start.elapsed().as_secs_f64();
+                let over_time = self.options.max_wall_s.is_some_and(|w| wall_s > w);
+                if over_steps || over_time {
+                    let budget = if over_steps {
+                        format!("more than {} steps (--max-steps)", self.options.max_steps)
+                    } else {
+                        format!("more than {} s of computing (--max-wall-time)", crate::scene::human(self.options.max_wall_s.unwrap_or(0.0)))
+                    };
+                    let driver = self.cost_driver(h);
+                    let (t, steps) = (self.t, self.steps - 1);
+                    let mut partial = self.finish(initial);
+                    partial.wall_time_s = wall_s;
+                    return Err(CompliantError::OverBudget {
+                        scene: scene.name.clone(),
+                        t,
+                        horizon,
+                        steps,
+                        wall_s,
+                        budget,
+                        driver,
+                        partial: Box::new(partial),
+                    });
+                }
             }
             let remaining = horizon - self.t;
             let h_try = h.min(self.step_bound()).min(remaining);
@@ -780,38 +923,9 @@ impl<'s, 'a> Driver<'s, 'a> {
                 self.derivative();
             }
         }
-        // Contacts open at the horizon are recorded with their duration so far.
-        for q in 0..self.contacts.len() {
-            if let Some(c) = self.contacts[q] {
-                self.close(q, c);
-            }
+        if let Some(p) = progress {
+            p.set(self.t, self.steps);
         }
-        self.impacts.sort_by(|a, b| a.t.total_cmp(&b.t).then(a.a.cmp(&b.a)));
-        let impact_loss: f64 = (0..=sys.n).map(|p| self.y[sys.dissipation(p)]).sum();
-        let energy = EnergyAccount::forced(
-            initial,
-            sys.energy(self.t, &self.y),
-            self.y[sys.damping_work()],
-            impact_loss,
-            self.y[sys.forcing_work()],
-        );
-        let final_velocities = (0..sys.n).map(|i| self.y[sys.v(i)]).collect();
-        let (series, motion) = self.recorder.finish();
-        Ok(Run {
-            scene: scene.name.clone(),
-            model: crate::run::Model::Compliant,
-            horizon,
-            sample_dt: scene.sample_dt,
-            initial_displacement: scene.initial_displacement,
-            damped_period: scene.frame.map_or(0.0, |f| f.damped_period()),
-            series,
-            motion,
-            impacts: self.impacts,
-            energy,
-            events: self.accepted,
-            final_velocities,
-            peak_true_acceleration: sys.has_frame().then_some(self.peak_true_acceleration),
-            wall_time_s: 0.0,
-        })
+        Ok(self.finish(initial))
     }
 }

@@ -153,6 +153,15 @@ fn model_errors_print_times_for_people() {
     // Issue 19: a stall at t = 1.916e-6 s printed `0.000001916413341752815 s`.
     let e = lpc_damper::reference::ReferenceError::Stalled { scene: "s".into(), events: 7, t: 1.916413341752815e-6, why: "w".into() };
     assert!(e.to_string().contains("at t = 1.916e-6 s"), "{e}");
-    let e = lpc_damper::compliant::CompliantError::Stalled { scene: "s".into(), steps: 7, t: 0.30000000000000004, limit: 9 };
-    assert!(e.to_string().contains("at t = 0.3 s"), "{e}");
+    let e = lpc_damper::compliant::CompliantError::OverBudget {
+        scene: "s".into(),
+        t: 0.30000000000000004,
+        horizon: 5.0,
+        steps: 7,
+        wall_s: 600.0000001,
+        budget: "b".into(),
+        driver: "d".into(),
+        partial: Box::new(lpc_damper::run::Run::empty("s", lpc_damper::Model::Compliant)),
+    };
+    assert!(e.to_string().contains("at t = 0.3 s of 5 s after 7 steps and 600.0 s of computing"), "{e}");
 }

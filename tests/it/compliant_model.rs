@@ -281,11 +281,70 @@ fn runs_are_bitwise_repeatable() {
 }
 
 #[test]
-fn a_step_limit_is_an_error_naming_the_scene() {
+fn a_step_limit_stops_the_run_and_keeps_it_so_far() {
     let scene = load_scene(scenes_dir().join("lpc-lsl.toml")).unwrap();
-    let err = compliant::simulate_with(&scene, Options { max_steps: 100, ..Default::default() }).unwrap_err();
+    let err = compliant::simulate_with(&scene, Options { max_steps: 3000, ..Default::default() }).unwrap_err();
     let msg = err.to_string();
-    assert!(msg.contains("lpc-lsl") && msg.contains("stalled"), "{msg}");
-    let via_model = lpc_damper::model::ModelError::from(err);
-    assert!(via_model.to_string().contains("lpc-lsl"));
+    assert!(msg.contains("lpc-lsl") && msg.contains("--max-steps"), "{msg}");
+    let compliant::CompliantError::OverBudget { t, steps, partial, .. } = err else { panic!("{msg}") };
+    assert_eq!(steps, 3000);
+    assert!(t > 0.0 && t < scene.horizon);
+    // The run so far is a run: its samples end by `t`, and its energy balance closes to the
+    // integration tolerance as a finished run's does.
+    assert_eq!(partial.horizon, t);
+    assert!(!partial.series.t.is_empty() && *partial.series.t.last().unwrap() <= t);
+    assert!(partial.energy.balance_error.abs() < 1e-6, "{:?}", partial.energy);
+    let via_model = lpc_damper::model::ModelError::from(compliant::CompliantError::Tolerance(0.0));
+    assert!(via_model.to_string().contains("tolerance"));
+}
+
+/// Issue 18's packed column (45 balls, no gaps, e = 0.07): the budget stops it and says what
+/// its steps cost (its open contacts and the stiffest of them).
+const PACKED_COLUMN: &str = r#"
+name = "packed-column"
+[frame]
+mass = 1.35
+stiffness = 55662.476667384384
+damping = 62.63313525734403
+initial_displacement = "-0.7917000580943232 Rr"
+[balls]
+arrangement = "SLLSSSSSLLLSLSSSSLSLLSSSLSSLSLSLSLSLSLLSLLLLS"
+large_mass = 0.11
+mass_ratio = 355.09605527615287
+density = 8000.0
+restitution = 0.07311002603701877
+gap = "0 Rr"
+clearance = "0 Rr"
+[run]
+horizon = 0.8086808531003047
+sample_dt = 0.00040434042655015234
+"#;
+
+#[test]
+fn a_budget_says_what_the_steps_cost() {
+    let scene = lpc_damper::scene::parse(PACKED_COLUMN, "packed.toml", "packed").unwrap().scene.unwrap();
+    let err = compliant::simulate_with(&scene, Options { max_steps: 20_000, ..Default::default() }).unwrap_err();
+    let msg = err.to_string();
+    assert!(msg.contains("packed-column") && msg.contains("contacts open, the stiffest ball") && msg.contains("Hertz period"), "{msg}");
+    // A wall-time budget of nothing stops at its first look, after PROGRESS_STEPS steps.
+    let err = compliant::simulate_with(&scene, Options { max_wall_s: Some(0.0), ..Default::default() }).unwrap_err();
+    let compliant::CompliantError::OverBudget { steps, budget, .. } = err else { panic!("not a budget stop") };
+    assert_eq!(steps, compliant::PROGRESS_STEPS - 1);
+    assert!(budget.contains("--max-wall-time"), "{budget}");
+}
+
+#[test]
+fn lpc_run_writes_the_run_a_budget_stopped() {
+    let tmp = tempfile::tempdir().unwrap();
+    let out = tmp.path().join("out");
+    let scene = scenes_dir().join("lpc-lsl.toml");
+    let o = crate::common::lpc(["run".as_ref(), scene.as_os_str(), "--model".as_ref(), "compliant".as_ref(), "--max-steps".as_ref(), "5000".as_ref(), "--out".as_ref(), out.as_os_str()]);
+    assert_eq!(o.status.code(), Some(1), "{}", String::from_utf8_lossy(&o.stderr));
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(err.contains("wrote the run up to t = ") && err.contains("--max-steps"), "{err}");
+    let series = std::fs::read_to_string(out.join("series.csv")).unwrap();
+    assert!(series.lines().count() > 10);
+    let o = crate::common::lpc(["run".as_ref(), scene.as_os_str(), "--max-steps".as_ref(), "5000".as_ref()]);
+    assert_eq!(o.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&o.stderr).contains("applies to the compliant model"));
 }

@@ -43,6 +43,74 @@ pub struct Args {
     /// members.csv, members.parquet and shard.json, which `lpc merge` joins.
     #[arg(long, value_name = "I/K", requires = "ensemble", value_parser = parse_shard)]
     shard: Option<(usize, usize)>,
+    /// Compliant model: stop after this many integration steps (default 5e7), keeping the run
+    /// so far (written with --out) and saying what its steps cost.
+    #[arg(long, value_name = "N")]
+    max_steps: Option<u64>,
+    /// Compliant model: stop after this many seconds of computing, likewise.
+    #[arg(long, value_name = "S")]
+    max_wall_time: Option<f64>,
+}
+
+/// How long a run goes before its progress is shown.
+const QUIET_FOR: std::time::Duration = std::time::Duration::from_secs(1);
+
+/// The compliant model on `scene` within the budgets of `a`, with a progress bar (on a
+/// terminal) once it has run for [`QUIET_FOR`]; a run stopped by a budget is written to
+/// `--out` as far as it got before the error is reported.
+fn run_compliant(a: &Args, scene: &lpc_damper::scene::Scene) -> Result<lpc_damper::run::Run> {
+    use lpc_damper::compliant::{self, CompliantError, Options, Progress};
+    let invalid = |flag: &str, rule: String| crate::args::invalid(&a.scene, flag, rule);
+    if a.max_steps == Some(0) {
+        return Err(invalid("--max-steps", "must be at least 1".into()).into());
+    }
+    if let Some(w) = a.max_wall_time {
+        if !(w > 0.0 && w.is_finite()) {
+            return Err(invalid("--max-wall-time", format!("must be a positive number of seconds (got {w})")).into());
+        }
+    }
+    let options = Options {
+        max_steps: a.max_steps.unwrap_or(compliant::MAX_STEPS),
+        max_wall_s: a.max_wall_time,
+        ..Options::default()
+    };
+    let progress = Progress::default();
+    let done = std::sync::atomic::AtomicBool::new(false);
+    let result = std::thread::scope(|s| {
+        s.spawn(|| {
+            let start = std::time::Instant::now();
+            let bar = indicatif::ProgressBar::new(1000);
+            let mut shown = false;
+            while !done.load(std::sync::atomic::Ordering::Relaxed) {
+                std::thread::sleep(std::time::Duration::from_millis(100));
+                if start.elapsed() < QUIET_FOR {
+                    continue;
+                }
+                if !shown {
+                    bar.set_style(
+                        indicatif::ProgressStyle::with_template("compliant [{bar:30}] {msg} ({elapsed}, about {eta} to go)").expect("valid template"),
+                    );
+                    shown = true;
+                }
+                let t = progress.time();
+                bar.set_position((1000.0 * t / scene.horizon).clamp(0.0, 1000.0) as u64);
+                bar.set_message(format!("t = {t:.3e} of {:.3e} s, {} steps", scene.horizon, progress.steps()));
+            }
+            bar.finish_and_clear();
+        });
+        let result = compliant::simulate_watched(scene, options, Some(&progress));
+        done.store(true, std::sync::atomic::Ordering::Relaxed);
+        result
+    });
+    let e = match result {
+        Ok(run) => return Ok(run),
+        Err(e) => e,
+    };
+    if let (CompliantError::OverBudget { partial, .. }, Some(dir)) = (&e, &a.out) {
+        write_run_dir(partial, dir).with_context(|| format!("writing outputs to {}", dir.display()))?;
+        eprintln!("wrote the run up to t = {} s to {}", lpc_damper::scene::human(partial.horizon), dir.display());
+    }
+    Err(lpc_damper::model::ModelError::from(e).into())
 }
 
 pub fn run(a: Args) -> Result<ExitStatus> {
@@ -55,7 +123,11 @@ pub fn run(a: Args) -> Result<ExitStatus> {
         return run_ensemble(&a, &nominal.scene, &members);
     }
     let scene = nominal.scene;
-    let run = a.model.simulate(&scene)?;
+    if (a.max_steps.is_some() || a.max_wall_time.is_some()) && a.model != Model::Compliant {
+        let flag = if a.max_steps.is_some() { "--max-steps" } else { "--max-wall-time" };
+        return Err(crate::args::invalid(&a.scene, flag, format!("applies to the compliant model, not to `{}`", a.model)).into());
+    }
+    let run = if a.model == Model::Compliant { run_compliant(&a, &scene)? } else { a.model.simulate(&scene)? };
     let summary = RunSummary::of(&run);
     if let Some(dir) = &a.out {
         write_run_dir(&run, dir).with_context(|| format!("writing outputs to {}", dir.display()))?;
