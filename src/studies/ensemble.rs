@@ -510,6 +510,22 @@ pub struct EnsembleSummary {
     pub wall_time_s: f64,
 }
 
+impl EnsembleSummary {
+    /// The summary of `members` of scene `scene` run with `model`, whose metrics are `metrics`
+    /// (`[member][metric]`), computed in `wall_time_s`.
+    pub fn of(scene: &str, model: Model, members: &Ensemble, metrics: &[Vec<Option<f64>>], wall_time_s: f64) -> Self {
+        EnsembleSummary {
+            scene: scene.to_string(),
+            model,
+            members: members.members.len(),
+            redraws: members.redraws,
+            seed: members.seed,
+            metrics: metric_stats(metrics),
+            wall_time_s,
+        }
+    }
+}
+
 /// Each metric's distribution over `metrics` (`[member][metric]`, [`SUMMARY_METRICS`] order).
 pub fn metric_stats(metrics: &[Vec<Option<f64>>]) -> BTreeMap<String, Stats> {
     SUMMARY_METRICS

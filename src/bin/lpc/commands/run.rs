@@ -150,15 +150,7 @@ fn run_ensemble(a: &Args, nominal: &lpc_damper::scene::Scene, members: &Ensemble
     let runs = ensemble::run_members(members, a.model, a.out.is_some(), &|| bar.inc(1))?;
     let wall_time_s = start.elapsed().as_secs_f64();
     bar.finish_and_clear();
-    let summary = EnsembleSummary {
-        scene: nominal.name.clone(),
-        model: a.model,
-        members: members.members.len(),
-        redraws: members.redraws,
-        seed: members.seed,
-        metrics: ensemble::metric_stats(&runs.metrics),
-        wall_time_s,
-    };
+    let summary = EnsembleSummary::of(&nominal.name, a.model, members, &runs.metrics, wall_time_s);
     if let Some(dir) = &a.out {
         write_ensemble_dir(dir, a.model, nominal, members, &runs, &summary)
             .with_context(|| format!("writing outputs to {}", dir.display()))?;
@@ -195,15 +187,7 @@ fn run_shard(a: &Args, nominal: &lpc_damper::scene::Scene, members: &Ensemble, (
         })()
         .with_context(|| format!("writing outputs to {}", dir.display()))?;
     }
-    let summary = EnsembleSummary {
-        scene: info.scene.clone(),
-        model: a.model,
-        members: members.members.len(),
-        redraws: members.redraws,
-        seed: members.seed,
-        metrics: ensemble::metric_stats(&runs.metrics),
-        wall_time_s,
-    };
+    let summary = EnsembleSummary::of(&info.scene, a.model, members, &runs.metrics, wall_time_s);
     print_ensemble(&summary, a.format, a.out.as_deref().map(|d| (d, "members.csv, members.parquet and shard.json")))
 }
 
