@@ -99,7 +99,7 @@ pub fn draw_range(
         return Err(invalid("--ensemble", format!("must lie in 1..={MAX_MEMBERS} (got {count})")));
     }
     if range.start >= range.end || range.end > count {
-        return Err(invalid("--shard", format!("members {}..{} are not a part of 0..{count}", range.start, range.end)));
+        return Err(invalid("members", format!("{}..{} are not a part of 0..{count}", range.start, range.end)));
     }
     let count = range.len();
     check_members_memory(nominal, count).map_err(|rule| invalid("--ensemble", rule))?;
