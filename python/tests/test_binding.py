@@ -169,7 +169,10 @@ def test_ctrl_c_stops_a_long_ensemble_between_batches(scenes, tmp_path):
     script = tmp_path / "long.py"
     out = tmp_path / "parts"
     script.write_text(
-        "import sys, lpc_damper as lpc\n"
+        "import signal, sys, lpc_damper as lpc\n"
+        # A process started in the background inherits SIGINT ignored, and Python then leaves
+        # it so: ask for Python's own handler (KeyboardInterrupt), as a terminal would give.
+        "signal.signal(signal.SIGINT, signal.default_int_handler)\n"
         f"scene = lpc.load_scene({str(scenes / 'lpc-lsl.toml')!r})\n"
         "print('started', flush=True)\n"
         f"lpc.ensemble(scene, 2000, model='compliant', out={str(out)!r})\n"
