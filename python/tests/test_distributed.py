@@ -9,13 +9,12 @@ import signal
 import threading
 import time
 
+import dask.distributed as dask_distributed
 import numpy as np
 import pytest
 
 import lpc_damper as lpc
 from lpc_damper import distributed
-
-dask_distributed = pytest.importorskip("dask.distributed")
 
 
 @pytest.fixture(scope="module")
