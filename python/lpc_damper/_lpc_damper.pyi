@@ -17,7 +17,10 @@ class SceneError(ValueError):
     """A scene (or a setting) that cannot exist; the message names the field and the rule."""
 
 class ModelError(RuntimeError):
-    """A model that could not finish a scene, with the reason."""
+    """A model that could not finish a scene, with the reason; a budget stop of the compliant
+    model carries the run so far as ``partial``."""
+
+    partial: Run
 
 class Scene:
     """A validated scene file: a damper scene or a chain experiment."""
@@ -65,6 +68,8 @@ def run(
     dt: float | None = None,
     solver_iterations: int | None = None,
     ccd: bool = False,
+    max_steps: int | None = None,
+    max_wall_time: float | None = None,
 ) -> Run: ...
 def ensemble(
     scene: Scene,

@@ -379,9 +379,24 @@ fn floats(py: Python<'_>, values: Vec<f64>) -> Py<PyAny> {
     values.into_pyarray(py).into_any().unbind()
 }
 
-/// Runs one model on a damper scene.
+impl Run {
+    fn of(run: lpc_damper::run::Run) -> Run {
+        Run {
+            scene: run.scene.clone(),
+            model: run.model.name().into(),
+            horizon: run.horizon,
+            wall_time_s: run.wall_time_s,
+            run: std::sync::Mutex::new(run),
+            made: Default::default(),
+        }
+    }
+}
+
+/// Runs one model on a damper scene. The compliant model takes budgets, as the CLI's
+/// `--max-steps` and `--max-wall-time`: a run that exceeds one raises `ModelError` whose
+/// `partial` attribute is the run so far.
 #[pyfunction]
-#[pyo3(signature = (scene, model = "reference", *, horizon = None, sample_dt = None, stepping = None, dt = None, solver_iterations = None, ccd = false))]
+#[pyo3(signature = (scene, model = "reference", *, horizon = None, sample_dt = None, stepping = None, dt = None, solver_iterations = None, ccd = false, max_steps = None, max_wall_time = None))]
 #[allow(clippy::too_many_arguments)]
 fn run(
     py: Python<'_>,
@@ -393,18 +408,42 @@ fn run(
     dt: Option<f64>,
     solver_iterations: Option<u32>,
     ccd: bool,
+    max_steps: Option<u64>,
+    max_wall_time: Option<f64>,
 ) -> PyResult<Run> {
+    use lpc_damper::compliant::{self, CompliantError, Options};
     let model = parse_model(model)?;
     let s = scene.damper(&Settings { horizon, sample_dt, stepping, dt, solver_iterations, ccd })?;
-    let run = py.detach(|| model.simulate(&s)).map_err(model_error)?;
-    Ok(Run {
-        scene: run.scene.clone(),
-        model: model.name().into(),
-        horizon: run.horizon,
-        wall_time_s: run.wall_time_s,
-        run: std::sync::Mutex::new(run),
-        made: Default::default(),
-    })
+    let budgeted = max_steps.is_some() || max_wall_time.is_some();
+    if budgeted && model != Model::Compliant {
+        let name = if max_steps.is_some() { "max_steps" } else { "max_wall_time" };
+        return Err(SceneError::new_err(format!("{name}: applies to the compliant model, not to `{model}`")));
+    }
+    if max_steps == Some(0) {
+        return Err(SceneError::new_err("max_steps: must be at least 1"));
+    }
+    if let Some(w) = max_wall_time {
+        if !(w > 0.0 && w.is_finite()) {
+            return Err(SceneError::new_err(format!("max_wall_time: must be a positive number of seconds (got {w})")));
+        }
+    }
+    if !budgeted {
+        return Ok(Run::of(py.detach(|| model.simulate(&s)).map_err(model_error)?));
+    }
+    let options = Options { max_steps: max_steps.unwrap_or(compliant::MAX_STEPS), max_wall_s: max_wall_time, ..Options::default() };
+    let e = match py.detach(|| compliant::simulate_with(&s, options)) {
+        Ok(run) => return Ok(Run::of(run)),
+        Err(e) => e,
+    };
+    let message = e.to_string();
+    match e {
+        CompliantError::OverBudget { partial, .. } => {
+            let err = ModelError::new_err(message);
+            err.value(py).setattr("partial", Py::new(py, Run::of(*partial))?)?;
+            Err(err)
+        }
+        other => Err(model_error(other.into())),
+    }
 }
 
 /// A table as a dict of NumPy columns: integers for `integers`, else doubles (NaN undefined).
