@@ -6,7 +6,7 @@ fn main() {
     let rows: Vec<String> = (1..=n).into_par_iter().map(|seed| {
         let file = lpc_damper::studies::stress::random_scene_file(seed, 1.0, false);
         let scene = lpc_damper::scene::from_file(file, "s", "s").unwrap().scene.unwrap();
-        let r = lpc_damper::studies::stress::judge_run(lpc_damper::Model::Rapier, &scene);
+        let r = lpc_damper::studies::stress::judge_run(lpc_damper::Model::Rapier, &scene, None);
         let f = scene.frame.unwrap();
         let w = (f.stiffness / f.mass).sqrt();
         let c = scene.container.unwrap();

@@ -19,7 +19,7 @@ fn main() {
     }
     let scene = lpc_damper::scene::from_file(file, "s", "s").unwrap().scene.unwrap();
     let t = std::time::Instant::now();
-    let r = lpc_damper::studies::stress::judge_run(model, &scene);
+    let r = lpc_damper::studies::stress::judge_run(model, &scene, None);
     if let Err(f) = &r { println!("{}", f.detail); }
-    println!("seed {seed}: {:.3} s balls {} horizon {:.2} -> {:?}", t.elapsed().as_secs_f64(), scene.balls.len(), scene.horizon, r.map(|p| match p { lpc_damper::studies::stress::Passed::Run(r) => Some((r.events, r.impacts.len())), lpc_damper::studies::stress::Passed::Refused { .. } => None }).map_err(|f| f.check));
+    println!("seed {seed}: {:.3} s balls {} horizon {:.2} -> {:?}", t.elapsed().as_secs_f64(), scene.balls.len(), scene.horizon, r.map(|p| match p { lpc_damper::studies::stress::Passed::Run(r) => Some((r.events, r.impacts.len())), lpc_damper::studies::stress::Passed::Refused { .. } | lpc_damper::studies::stress::Passed::Stopped(_) => None }).map_err(|f| f.check));
 }

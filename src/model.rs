@@ -14,13 +14,22 @@ impl Model {
     /// Runs the model on `scene`, keeping what `record` asks for (the series are checked
     /// against the memory left only when kept).
     pub fn simulate_recording(self, scene: &Scene, record: Record) -> Result<Run, ModelError> {
+        self.simulate_within(scene, record, None)
+    }
+
+    /// [`Model::simulate_recording`] within `max_wall_s` seconds of computing, if given: a run
+    /// that takes longer stops with a typed error (each model's `OverBudget`).
+    pub fn simulate_within(self, scene: &Scene, record: Record, max_wall_s: Option<f64>) -> Result<Run, ModelError> {
         if record == Record::Series {
             crate::run::check_memory(scene).map_err(ModelError::Refused)?;
         }
         match self {
-            Model::Reference => Ok(crate::reference::simulate_recording(scene, record)?),
-            Model::Rapier => crate::rapier::simulate_recording(scene, record),
-            Model::Compliant => Ok(crate::compliant::simulate_recording(scene, record)?),
+            Model::Reference => Ok(crate::reference::simulate_within(scene, record, max_wall_s)?),
+            Model::Rapier => crate::rapier::simulate_within(scene, record, max_wall_s),
+            Model::Compliant => {
+                let options = crate::compliant::Options { record, max_wall_s, ..Default::default() };
+                Ok(crate::compliant::simulate_with(scene, options)?)
+            }
         }
     }
 }
@@ -41,4 +50,7 @@ pub enum ModelError {
     /// and stopped rather than return a wrong run.
     #[error("{0}")]
     Unstable(String),
+    /// The contact model ran out of its computing-time budget (with where it stood).
+    #[error("{0}")]
+    OverBudget(String),
 }

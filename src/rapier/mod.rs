@@ -144,15 +144,24 @@ pub fn simulate(scene: &Scene) -> Result<Run, ModelError> {
 
 /// Runs the contact model on `scene` with `settings` as given (no step bound applied).
 pub fn simulate_with(scene: &Scene, settings: StepSettings) -> Result<Run, ModelError> {
-    run_app(scene, settings, Record::Series)
+    run_app(scene, settings, Record::Series, None)
 }
 
 /// Runs the contact model on `scene`, keeping what `record` asks for.
 pub fn simulate_recording(scene: &Scene, record: Record) -> Result<Run, ModelError> {
-    run_app(scene, settings(scene), record)
+    run_app(scene, settings(scene), record, None)
 }
 
-fn run_app(scene: &Scene, settings: StepSettings, record: Record) -> Result<Run, ModelError> {
+/// [`simulate_recording`] within `max_wall_s` seconds of computing, if given
+/// ([`ModelError::OverBudget`]).
+pub fn simulate_within(scene: &Scene, record: Record, max_wall_s: Option<f64>) -> Result<Run, ModelError> {
+    run_app(scene, settings(scene), record, max_wall_s)
+}
+
+/// Steps between two looks at the computing-time budget.
+const BUDGET_STEPS: u64 = 256;
+
+fn run_app(scene: &Scene, settings: StepSettings, record: Record, max_wall_s: Option<f64>) -> Result<Run, ModelError> {
     can_represent(scene)?;
     let start = Instant::now();
     let mut app = headless_app_recording(scene, settings, record);
@@ -162,6 +171,18 @@ fn run_app(scene: &Scene, settings: StepSettings, record: Record) -> Result<Run,
     let world = app.world_mut();
     while world.resource::<StepClock>().t < scene.horizon * (1.0 - 1e-12) {
         world.run_schedule(DamperStep);
+        let clock = world.resource::<StepClock>();
+        if let Some(budget) = max_wall_s.filter(|_| clock.steps % BUDGET_STEPS == 0) {
+            let wall_s = start.elapsed().as_secs_f64();
+            if wall_s > budget {
+                return Err(ModelError::OverBudget(format!(
+                    "scene `{}`: the contact model stopped at t = {} s after {} steps and {wall_s:.1} s of computing: more than {budget} s of computing",
+                    scene.name,
+                    crate::scene::human(clock.t),
+                    clock.steps
+                )));
+            }
+        }
         if let Some(reason) = world.resource::<Recording>().failure.clone() {
             return Err(ModelError::Unstable(format!(
                 "scene `{}`: the contact model stopped: {reason}; the reference and compliant models can run it",

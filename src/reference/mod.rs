@@ -63,6 +63,20 @@ pub enum ReferenceError {
         /// Which limit was reached.
         why: String,
     },
+    /// The computing-time budget ran out (a typed stop, not a failure of the scene).
+    #[error("scene `{scene}`: the reference stopped at t = {} s after {events} events and {wall_s:.1} s of computing: more than {budget_s} s of computing", crate::scene::human(*.t))]
+    OverBudget {
+        /// Scene name.
+        scene: String,
+        /// Events processed.
+        events: u64,
+        /// Simulated time reached.
+        t: f64,
+        /// Computing time, s.
+        wall_s: f64,
+        /// The budget, s.
+        budget_s: f64,
+    },
     /// The postcondition of an event failed: a pair overlaps, or the pair whose contact was
     /// taken does not touch, beyond the contact tolerance. The reference then missed or
     /// mistimed a contact; it stops rather than go on with a wrong run.
@@ -122,8 +136,18 @@ pub fn simulate(scene: &Scene) -> Result<Run, ReferenceError> {
 
 /// [`simulate`], keeping what `record` asks for.
 pub fn simulate_recording(scene: &Scene, record: Record) -> Result<Run, ReferenceError> {
+    simulate_within(scene, record, None)
+}
+
+/// Events between two looks at the computing-time budget.
+const BUDGET_EVENTS: u64 = 4096;
+
+/// [`simulate_recording`] within `max_wall_s` seconds of computing, if given
+/// ([`ReferenceError::OverBudget`]).
+pub fn simulate_within(scene: &Scene, record: Record, max_wall_s: Option<f64>) -> Result<Run, ReferenceError> {
     let start = Instant::now();
     let mut solver = Solver::new(scene, record);
+    solver.budget = max_wall_s.map(|w| (start, w));
     solver.run()?;
     let mut run = solver.finish();
     run.wall_time_s = start.elapsed().as_secs_f64();
@@ -205,6 +229,8 @@ struct Solver<'a> {
     last_impact: Vec<Option<usize>>,
     events: u64,
     recorder: Recorder,
+    /// When the run started and how many seconds of computing it may take.
+    budget: Option<(Instant, f64)>,
     /// Exact metrics of a free run (`None` when forced or frameless: read at the samples).
     exact: Option<ExactTally>,
     next_sample: usize,
@@ -295,6 +321,7 @@ impl<'a> Solver<'a> {
             last_impact: vec![None; n + 1],
             events: 0,
             recorder: if exact.is_some() { recorder.untallied() } else { recorder },
+            budget: None,
             exact,
             next_sample: 0,
             sample_count: samples,
@@ -360,6 +387,12 @@ impl<'a> Solver<'a> {
             self.advance(t);
             self.check_contacts(pair)?;
             self.events += 1;
+            if let Some((start, budget_s)) = self.budget.filter(|_| self.events % BUDGET_EVENTS == 0) {
+                let wall_s = start.elapsed().as_secs_f64();
+                if wall_s > budget_s {
+                    return Err(ReferenceError::OverBudget { scene: self.scene.name.clone(), events: self.events, t, wall_s, budget_s });
+                }
+            }
             if self.events > MAX_EVENTS || same_instant > MAX_EVENTS_PER_INSTANT {
                 let why = if same_instant > MAX_EVENTS_PER_INSTANT {
                     format!("more than {MAX_EVENTS_PER_INSTANT} events at one instant")

@@ -43,6 +43,67 @@ pub struct Outcome {
     pub refused: Option<String>,
     /// The refusal came during the run (the model stopped itself).
     pub refused_during_run: bool,
+    /// Why the run stopped before its end without failing: the computing-time budget ran out
+    /// (a typed stop, `--max-wall-time`).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub stopped: Option<String>,
+}
+
+/// What `lpc stress` draws and how long each run may take.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Draws {
+    /// Longest horizon drawn, s.
+    pub max_horizon: f64,
+    /// Harmonic forcing on every scene.
+    pub forced: bool,
+    /// The extremes a user can type ([`random_extreme_scene_file`]) instead of plausible dampers.
+    pub extreme: bool,
+    /// Seconds of computing each run may take, if limited.
+    pub max_wall_s: Option<f64>,
+}
+
+/// A random scene at the extremes the scene format accepts: 1 to 10 000 balls, frame periods
+/// 1 us to 1000 s (a fifth of the frames free), mass ratios 1 to 1e9, densities 1e-3 to 1e6
+/// kg/m^3, e of 0, 1 or between, gaps and clearances of 0 or 1e-6 to 1e3 Rr, initial
+/// displacements of 0 or up to 1e4 Rr (far beyond the container), horizons 1 ms to
+/// `max_horizon` (at most 1e4 s), 2000 samples. A drawn file the scene's rules reject is a
+/// typed refusal of the scene, as a user would get.
+pub fn random_extreme_scene_file(seed: u64, max_horizon: f64) -> SceneFile {
+    let mut rng = Pcg64::seed_from_u64(seed ^ 0x5eed_e87e_3e00_0000);
+    let log_uniform = |rng: &mut Pcg64, lo: f64, hi: f64| (rng.random_range(lo.ln()..hi.ln())).exp();
+    let n = log_uniform(&mut rng, 1.0, 10_000.5) as usize;
+    let letters: String = (0..n.max(1)).map(|_| if rng.random_bool(0.5) { 'L' } else { 'S' }).collect();
+    let mass = 1.35;
+    let free = rng.random_bool(0.2);
+    let period = log_uniform(&mut rng, 1e-6, 1e3);
+    let stiffness = if free { 0.0 } else { mass * (2.0 * std::f64::consts::PI / period).powi(2) };
+    let damping = if free { 0.0 } else { rng.random_range(0.0..0.5) * 2.0 * (stiffness * mass).sqrt() };
+    let zero_or = |rng: &mut Pcg64, lo: f64, hi: f64| if rng.random_bool(0.25) { 0.0 } else { log_uniform(rng, lo, hi) };
+    let gap = zero_or(&mut rng, 1e-6, 1e3);
+    let clearance = zero_or(&mut rng, 1e-6, 1e3);
+    let xs0 = zero_or(&mut rng, 1e-6, 1e4) * if rng.random_bool(0.5) { 1.0 } else { -1.0 };
+    let horizon = log_uniform(&mut rng, 1e-3, max_horizon.clamp(2e-3, 1e4));
+    let restitution = match rng.random_range(0..3) {
+        0 => 0.0,
+        1 => 1.0,
+        _ => rng.random_range(0.0..=1.0),
+    };
+    SceneFile {
+        name: Some(format!("extreme-{seed}")),
+        frame: Some(FrameFile { mass, stiffness, damping, initial_displacement: Length::Rr(xs0) }),
+        balls: Some(BallsFile {
+            arrangement: Arrangement::Letters(letters),
+            large_mass: 0.11,
+            mass_ratio: log_uniform(&mut rng, 1.0, 1e9),
+            density: log_uniform(&mut rng, 1e-3, 1e6),
+            restitution,
+            gap: Length::Rr(gap),
+            clearance: Some(Length::Rr(clearance)),
+            container_length: None,
+        }),
+        run: RunFile { horizon: Some(horizon), sample_dt: Some(horizon / 2000.0) },
+        ..SceneFile::default()
+    }
 }
 
 /// A random valid scene file: 1 to 50 balls, mass ratios 1 to 1000, e in [0, 1], gaps from 0
@@ -123,11 +184,14 @@ pub enum Passed {
         /// Stopped during the run.
         during_run: bool,
     },
+    /// The run's computing-time budget ran out: a typed stop, with where it stood.
+    Stopped(String),
 }
 
-/// Runs `model` on `scene` and checks the run.
-pub fn judge_run(model: Model, scene: &Scene) -> Result<Passed, Failure> {
-    let outcome = catch_unwind(AssertUnwindSafe(|| model.simulate(scene)));
+/// Runs `model` on `scene` within `max_wall_s` seconds of computing (if given) and checks the
+/// run.
+pub fn judge_run(model: Model, scene: &Scene, max_wall_s: Option<f64>) -> Result<Passed, Failure> {
+    let outcome = catch_unwind(AssertUnwindSafe(|| model.simulate_within(scene, crate::run::Record::Series, max_wall_s)));
     let run = match outcome {
         Err(panic) => {
             let msg = panic
@@ -140,6 +204,11 @@ pub fn judge_run(model: Model, scene: &Scene) -> Result<Passed, Failure> {
         // Refusing with a reason, before or during the run, is a correct answer.
         Ok(Err(crate::model::ModelError::Refused(reason))) => return Ok(Passed::Refused { reason, during_run: false }),
         Ok(Err(crate::model::ModelError::Unstable(reason))) => return Ok(Passed::Refused { reason, during_run: true }),
+        Ok(Err(
+            e @ (crate::model::ModelError::OverBudget(_)
+            | crate::model::ModelError::Reference(crate::reference::ReferenceError::OverBudget { .. })
+            | crate::model::ModelError::Compliant(crate::compliant::CompliantError::OverBudget { .. })),
+        )) => return Ok(Passed::Stopped(e.to_string())),
         Ok(Err(e)) => {
             let check = match &e {
                 crate::model::ModelError::Reference(crate::reference::ReferenceError::ContactInvariant { .. }) => "invariant",
@@ -329,13 +398,14 @@ fn simplifications(f: &SceneFile) -> Vec<SceneFile> {
     out
 }
 
-/// Shrinks a failing scene: keeps applying simplifications while the same check still fails.
-pub fn shrink(model: Model, file: &SceneFile, check_name: &str) -> SceneFile {
+/// Shrinks a failing scene: keeps applying simplifications while the same check still fails
+/// (each candidate run within `max_wall_s`).
+pub fn shrink(model: Model, file: &SceneFile, check_name: &str, max_wall_s: Option<f64>) -> SceneFile {
     let mut current = file.clone();
     'outer: for _ in 0..200 {
         for candidate in simplifications(&current) {
             if let Some(scene) = validate(&candidate) {
-                if matches!(judge_run(model, &scene), Err(f) if f.check == check_name) {
+                if matches!(judge_run(model, &scene, max_wall_s), Err(f) if f.check == check_name) {
                     current = candidate;
                     continue 'outer;
                 }
@@ -346,23 +416,50 @@ pub fn shrink(model: Model, file: &SceneFile, check_name: &str) -> SceneFile {
     current
 }
 
-/// Stresses `model` with `count` scenes from `seed` on; failing scenes are shrunk.
-pub fn stress(model: Model, seed: u64, count: u64, max_horizon: f64, forced: bool, progress: &(dyn Fn() + Sync)) -> Vec<Outcome> {
+/// Stresses `model` with `count` scenes from `seed` on, drawn as `draws` says; failing scenes
+/// are shrunk.
+pub fn stress(model: Model, seed: u64, count: u64, draws: Draws, progress: &(dyn Fn() + Sync)) -> Vec<Outcome> {
     use rayon::prelude::*;
     (seed..seed + count)
         .into_par_iter()
         .map(|s| {
-            let file = random_scene_file(s, max_horizon, forced);
-            let scene = validate(&file).expect("generated scenes are valid");
-            let (failure, refused, refused_during_run) = match judge_run(model, &scene) {
-                Ok(Passed::Run(_)) => (None, None, false),
-                Ok(Passed::Refused { reason, during_run }) => (None, Some(reason), during_run),
-                Err(f) => (Some(f), None, false),
+            let file = if draws.extreme {
+                random_extreme_scene_file(s, draws.max_horizon)
+            } else {
+                random_scene_file(s, draws.max_horizon, draws.forced)
             };
-            let minimal_scene =
-                failure.as_ref().map(|f| toml::to_string(&shrink(model, &file, f.check)).unwrap_or_default());
+            let outcome = |failure: Option<Failure>, minimal_scene, refused, refused_during_run, stopped| Outcome {
+                seed: s,
+                model,
+                failure,
+                minimal_scene,
+                refused,
+                refused_during_run,
+                stopped,
+            };
+            let scene = match scene::from_file(file.clone(), "stress", "stress").map(|l| l.scene) {
+                Ok(Some(scene)) => scene,
+                // An extreme draw the scene's rules reject: the user gets that refusal.
+                Ok(None) => {
+                    progress();
+                    return outcome(None, None, Some("no damper scene".into()), false, None);
+                }
+                Err(e) => {
+                    progress();
+                    return outcome(None, None, Some(e.to_string()), false, None);
+                }
+            };
+            let (failure, refused, refused_during_run, stopped) = match judge_run(model, &scene, draws.max_wall_s) {
+                Ok(Passed::Run(_)) => (None, None, false, None),
+                Ok(Passed::Refused { reason, during_run }) => (None, Some(reason), during_run, None),
+                Ok(Passed::Stopped(why)) => (None, None, false, Some(why)),
+                Err(f) => (Some(f), None, false, None),
+            };
+            let minimal_scene = failure
+                .as_ref()
+                .map(|f| toml::to_string(&shrink(model, &file, f.check, draws.max_wall_s)).unwrap_or_default());
             progress();
-            Outcome { seed: s, model, failure, minimal_scene, refused, refused_during_run }
+            outcome(failure, minimal_scene, refused, refused_during_run, stopped)
         })
         .collect()
 }

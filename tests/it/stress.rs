@@ -4,7 +4,7 @@
 //! pass every check (no panic, finite, no energy gained, impact losses bounded, momentum kept
 //! on free frames, balls inside, no stall). The full count is a documented command.
 
-use lpc_damper::studies::stress::{stress, Outcome};
+use lpc_damper::studies::stress::{stress, Draws, Outcome};
 use lpc_damper::Model;
 
 /// Every outcome passed; otherwise the count, the first failure and its shrunk scene.
@@ -22,7 +22,7 @@ fn assert_all_pass(outcomes: &[Outcome]) {
 
 #[test]
 fn three_hundred_random_scenes_pass_every_check() {
-    assert_all_pass(&stress(Model::Reference, 1, 300, 2.0, false, &|| {}));
+    assert_all_pass(&stress(Model::Reference, 1, 300, Draws { max_horizon: 2.0, forced: false, extreme: false, max_wall_s: None }, &|| {}));
 }
 
 /// The same under a random harmonic force or base motion (`lpc stress --forced`): besides the
@@ -31,7 +31,7 @@ fn three_hundred_random_scenes_pass_every_check() {
 /// up to 10 s, all pass) is a documented command.
 #[test]
 fn forced_random_scenes_pass_every_check() {
-    assert_all_pass(&stress(Model::Reference, 1, 100, 2.0, true, &|| {}));
+    assert_all_pass(&stress(Model::Reference, 1, 100, Draws { max_horizon: 2.0, forced: true, extreme: false, max_wall_s: None }, &|| {}));
 }
 
 #[test]
@@ -48,5 +48,21 @@ fn generated_scenes_are_reproducible_from_their_seed() {
 /// --count 1000` passes all 1000, 235 of them refused; docs/BENCHMARKS.md "Stress runs").
 #[test]
 fn contact_model_passes_the_first_seeded_scenes() {
-    assert_all_pass(&stress(Model::Rapier, 1, 25, 1.0, false, &|| {}));
+    assert_all_pass(&stress(Model::Rapier, 1, 25, Draws { max_horizon: 1.0, forced: false, extreme: false, max_wall_s: None }, &|| {}));
+}
+
+/// Issue 19: scenes at the extremes a user can type (`lpc stress --extreme`: 1-10 000 balls,
+/// frame periods 1 us-1000 s, mass ratios up to 1e9, densities 1e-3-1e6, gaps, clearances and
+/// displacements far beyond the container) end in a pass, a typed refusal or a typed stop at
+/// the time budget, never a panic; the reference passes every check on every one it finishes.
+/// (Whether a run finishes within its budget depends on the machine; what is asserted does not.)
+#[test]
+fn extreme_scenes_pass_refuse_or_stop_never_panic() {
+    let draws = |max_wall_s| Draws { max_horizon: 100.0, forced: false, extreme: true, max_wall_s: Some(max_wall_s) };
+    assert_all_pass(&stress(Model::Reference, 1, 24, draws(1.0), &|| {}));
+    for model in [Model::Rapier, Model::Compliant] {
+        for o in stress(model, 1, 6, draws(0.5), &|| {}) {
+            assert!(o.failure.as_ref().is_none_or(|f| f.check != "panic" && f.check != "non-finite"), "{model} seed {}: {:?}", o.seed, o.failure);
+        }
+    }
 }

@@ -12,7 +12,7 @@ fn stiff_frames_at_rest_do_not_stall() {
     for seed in [1557, 1977] {
         let file = random_scene_file(seed, 100.0, false);
         let scene = lpc_damper::scene::from_file(file, "stress", "stress").unwrap().scene.unwrap();
-        if let Err(f) = judge_run(Model::Reference, &scene) {
+        if let Err(f) = judge_run(Model::Reference, &scene, None) {
             panic!("seed {seed}: {} ({})", f.check, f.detail);
         }
     }

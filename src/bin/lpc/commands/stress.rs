@@ -26,6 +26,15 @@ pub struct Args {
     /// frame's resonance, from barely impacting to violent).
     #[arg(long)]
     forced: bool,
+    /// Draw the extremes a user can type instead of plausible dampers: 1-10 000 balls, frame
+    /// periods 1 us-1000 s, mass ratios up to 1e9, densities 1e-3-1e6, gaps, clearances and
+    /// displacements from 0 to far beyond the container, horizons up to 1e4 s.
+    #[arg(long, conflicts_with = "forced")]
+    extreme: bool,
+    /// Seconds of computing each run may take; a run that takes longer stops (a typed stop,
+    /// counted apart from passes and failures). Default: none, 10 s with --extreme.
+    #[arg(long, value_name = "S")]
+    max_wall_time: Option<f64>,
     /// Output format on standard output.
     #[arg(long, value_enum, default_value_t = Format::Text)]
     format: Format,
@@ -35,11 +44,27 @@ pub struct Args {
 }
 
 pub fn run(a: Args) -> Result<ExitStatus> {
+    if let Some(w) = a.max_wall_time {
+        if !(w > 0.0 && w.is_finite()) {
+            let e = lpc_damper::scene::SceneError::Invalid {
+                file: "(command line)".into(),
+                field: "--max-wall-time".into(),
+                rule: format!("must be a positive number of seconds (got {w})"),
+            };
+            return Err(e.into());
+        }
+    }
+    let draws = lpc_damper::studies::stress::Draws {
+        max_horizon: a.max_horizon,
+        forced: a.forced,
+        extreme: a.extreme,
+        max_wall_s: a.max_wall_time.or(a.extreme.then_some(10.0)),
+    };
     let mut outcomes = Vec::new();
     let start = std::time::Instant::now();
     for &model in &a.models {
         let bar = progress_bar(a.count as usize, &format!("stress {}", model.name()));
-        outcomes.extend(lpc_damper::studies::stress::stress(model, a.seed, a.count, a.max_horizon, a.forced, &|| bar.inc(1)));
+        outcomes.extend(lpc_damper::studies::stress::stress(model, a.seed, a.count, draws, &|| bar.inc(1)));
         bar.finish_and_clear();
     }
     let failures: Vec<_> = outcomes.iter().filter(|o| o.failure.is_some()).collect();
@@ -64,12 +89,14 @@ pub fn run(a: Args) -> Result<ExitStatus> {
                 let failed = failures.iter().filter(|o| o.model == model).count();
                 let refused = outcomes.iter().filter(|o| o.model == model && o.refused.is_some()).count();
                 let unstable = outcomes.iter().filter(|o| o.model == model && o.refused_during_run).count();
+                let stopped = outcomes.iter().filter(|o| o.model == model && o.stopped.is_some()).count();
                 println!(
-                    "{}: {} passed ({} of them refused with a reason, {} of those during the run), {} failed",
+                    "{}: {} passed ({} of them refused with a reason, {} of those during the run), {} stopped at the time budget, {} failed",
                     model.name(),
-                    total - failed,
+                    total - failed - stopped,
                     refused,
                     unstable,
+                    stopped,
                     failed
                 );
             }
