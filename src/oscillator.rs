@@ -50,6 +50,17 @@ pub struct Oscillator {
     f_cap: f64,
 }
 
+/// A bound on `|F(t)|` for every `t >= 0` (`F <= t` always; this caps it): `1/w` oscillating,
+/// `1/(2b)` overdamped, `1/(e sigma)` critical, infinite without damping or spring.
+fn f_cap(regime: Regime, sigma: f64) -> f64 {
+    match regime {
+        Regime::Under { w } => 1.0 / w,
+        Regime::Over { b, .. } => 1.0 / (2.0 * b),
+        Regime::Critical if sigma > 0.0 => 1.0 / (std::f64::consts::E * sigma),
+        Regime::Critical => f64::INFINITY,
+    }
+}
+
 impl Oscillator {
     /// The oscillator of mass `mass`, damping `damping` and stiffness `stiffness`.
     pub fn new(mass: f64, damping: f64, stiffness: f64) -> Self {
@@ -66,10 +77,8 @@ impl Oscillator {
             let r1 = if sigma + b > 0.0 { -w0sq / (sigma + b) } else { 0.0 };
             Regime::Over { b, r1, r2: -sigma - b }
         };
-        let mut o = Oscillator { mass, damping, stiffness, sigma, w0sq, regime, w0: w0sq.sqrt(), rate: 0.0, f_cap: 0.0 };
-        o.rate = 2.0 * (sigma + o.w0);
-        o.f_cap = o.compute_f_cap();
-        o
+        let w0 = w0sq.sqrt();
+        Oscillator { mass, damping, stiffness, sigma, w0sq, regime, w0, rate: 2.0 * (sigma + w0), f_cap: f_cap(regime, sigma) }
     }
 
     /// The damped angular frequency, when the oscillator oscillates.
@@ -133,20 +142,17 @@ impl Oscillator {
         self.w0
     }
 
-    /// A bound on `|F(t)|` for every `t >= 0` (`F <= t` always; this caps it): `1/w`
-    /// oscillating, `1/(2b)` overdamped, `1/(e sigma)` critical, infinite without damping or
-    /// spring.
+    /// A bound on `|F(t)|` for every `t >= 0` ([`f_cap`]).
     fn f_cap(&self) -> f64 {
         self.f_cap
     }
 
-    fn compute_f_cap(&self) -> f64 {
-        match self.regime {
-            Regime::Under { w } => 1.0 / w,
-            Regime::Over { b, .. } => 1.0 / (2.0 * b),
-            Regime::Critical if self.sigma > 0.0 => 1.0 / (std::f64::consts::E * self.sigma),
-            Regime::Critical => f64::INFINITY,
-        }
+    /// A bound on `|y(t)|` for all `t >= 0` of the solution with `y(0) = y0`, `y'(0) = y1`,
+    /// `sqrt(y0^2 + y1^2 / w0^2)`: with damping `>= 0` its `y'^2 + w0^2 y^2` never grows (its
+    /// derivative is `-4 sigma y'^2`). `None` without a spring or with negative damping. The
+    /// frame's position, velocity and acceleration are such solutions.
+    pub fn envelope(&self, y0: f64, y1: f64) -> Option<f64> {
+        (self.w0sq > 0.0 && self.sigma >= 0.0).then(|| (y0 * y0 + y1 * y1 / self.w0sq).sqrt())
     }
 
     /// A bound on the round-off of evaluating `y(t) = y0 E(t) + (y1 + sigma y0) F(t)` (the

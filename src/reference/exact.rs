@@ -137,28 +137,24 @@ impl ExactTally {
     /// interval of `seg` ending at `b` whose state at its start is `(x, v)`, above anything the
     /// tally would evaluate there; `None` without a spring or with negative damping.
     ///
-    /// `x` and the segment's acceleration are free solutions, whose `y'^2 + w0^2 y^2` never
-    /// grows (docs/MODEL.md §10), so `|x| <= sqrt(x^2 + v^2 / w0^2)` and likewise the
-    /// acceleration with its jerk; the reported acceleration is the segment's times
-    /// `M / ms`. The round-off of the evaluated states (the start's, and any later one's) is
+    /// `x` and the segment's acceleration are free solutions, bounded by their
+    /// [`Oscillator::envelope`]; the reported acceleration is the segment's times `M / ms`.
+    /// The round-off of the evaluated states (the start's, and any later one's) is
     /// added twice, with a relative millionth for the bounds' own arithmetic. With them the
     /// tally skips the extrema (a zero search and a closed-form evaluation each) of intervals
     /// that cannot raise a peak or reach the band, the usual case once the motion decays.
     fn reach(&self, seg: &Segment, b: f64, (x, v): (f64, f64)) -> Option<(f64, f64)> {
         let o = &seg.osc;
-        if !(o.w0sq > 0.0) || o.sigma < 0.0 {
-            return None;
-        }
         let acc = o.accel(x, v);
         let jerk = -2.0 * o.sigma * acc - o.w0sq * v;
+        let (envelope_x, envelope_a) = (o.envelope(x, v)?, o.envelope(acc, jerk)?);
         let tau = b - seg.t0;
         let err_x = 2.0 * o.roundoff(seg.x0, seg.v0, tau);
         let err_v = 2.0 * o.roundoff(seg.v0, o.accel(seg.x0, seg.v0), tau);
         let slack = 1.0 + 1e-6;
         let f = &self.frame;
-        let reach_x = (x * x + v * v / o.w0sq).sqrt() * slack + err_x;
-        let reach_a = (acc * acc + jerk * jerk / o.w0sq).sqrt() * (o.mass / f.mass) * slack
-            + (f.stiffness * err_x + f.damping * err_v) / f.mass;
+        let reach_x = envelope_x * slack + err_x;
+        let reach_a = envelope_a * (o.mass / f.mass) * slack + (f.stiffness * err_x + f.damping * err_v) / f.mass;
         Some((reach_x, reach_a))
     }
 

@@ -106,7 +106,7 @@ impl Solver<'_> {
     /// closed form's `exp` and `sin_cos` at every piece and iterate).
     ///
     /// An unforced frame with a spring and damping `>= 0` never leaves `|xs| <= R =
-    /// sqrt(x0^2 + v0^2 / w0^2)` nor `|vs| <= sqrt(v0^2 + w0^2 x0^2)` (its `v^2 + w0^2 x^2`
+    /// sqrt(x0^2 + v0^2 / w0^2)` ([`Segment::reach`]) nor `|vs| <= w0 R` (its `v^2 + w0^2 x^2`
     /// never grows), so the gap is at least `s x_ball + k - R`, a line in time whose least value
     /// lies at an end. That bound must clear the tolerance by what the evaluated gap can err by
     /// (as [`Solver::frame_tolerance`] counts it, at the window's far end and with the frame at
@@ -114,12 +114,8 @@ impl Solver<'_> {
     /// an ulp of time.
     pub(super) fn frame_may_reach(&self, ball: usize, s: f64, k: f64, from: f64, limit: f64) -> bool {
         let seg = &self.seg;
-        let o = &seg.osc;
-        if seg.forced.is_some() || !(o.w0sq > 0.0) || o.sigma < 0.0 {
-            return true;
-        }
-        let reach = (seg.x0 * seg.x0 + seg.v0 * seg.v0 / o.w0sq).sqrt();
-        let speed = (seg.v0 * seg.v0 + o.w0sq * seg.x0 * seg.x0).sqrt();
+        let Some(reach) = seg.reach else { return true };
+        let speed = seg.osc.w0() * reach;
         let (x, v) = (self.x[ball], self.v[ball]);
         let line = |t: f64| s * (x + v * (t - self.t)) + k;
         let nearest = line(from).min(line(limit));

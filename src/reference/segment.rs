@@ -20,6 +20,9 @@ pub(super) struct Segment {
     /// ([`Oscillator::zero_phase`], an `atan2` each), computed once; `None` for a solution
     /// that is identically zero. The velocity's and the jerk's only in free vibration.
     phases: [Option<f64>; 3],
+    /// Unforced, the farthest the frame goes from 0 in this segment
+    /// ([`Oscillator::envelope`] of its start); `None` when forced or unbounded.
+    pub(super) reach: Option<f64>,
 }
 
 /// Zeros of a segment's motion that the reference looks for.
@@ -85,7 +88,8 @@ impl Segment {
         let (hx, hv) = forced.map_or((x0, v0), |f| f.h0);
         let a0 = osc.accel(hx, hv);
         let j0 = -2.0 * osc.sigma * a0 - osc.w0sq * hv;
-        let mut seg = Segment { t0, x0, v0, a0, j0, osc, forced, phases: [None; 3] };
+        let reach = if forced.is_none() { osc.envelope(x0, v0) } else { None };
+        let mut seg = Segment { t0, x0, v0, a0, j0, osc, forced, phases: [None; 3], reach };
         if osc.damped_omega().is_some() {
             let which: &[Zeros] = if forced.is_none() { &[Zeros::Acceleration, Zeros::Velocity, Zeros::Jerk] } else { &[Zeros::Acceleration] };
             for &z in which {
