@@ -346,6 +346,28 @@ pub fn fits_in_memory(need: f64) -> Result<(), f64> {
     }
 }
 
+/// The rules a run's budgets keep (`--max-steps`, `--max-wall-time` and their Python
+/// keywords): at least one step, a positive and finite number of seconds. The rule broken, for
+/// the caller to name its field.
+pub fn check_budgets(max_steps: Option<u64>, max_wall_s: Option<f64>) -> Result<(), (Budget, String)> {
+    if max_steps == Some(0) {
+        return Err((Budget::Steps, "must be at least 1".into()));
+    }
+    match max_wall_s {
+        Some(w) if !(w > 0.0 && w.is_finite()) => Err((Budget::WallTime, format!("must be a positive number of seconds (got {w})"))),
+        _ => Ok(()),
+    }
+}
+
+/// Which budget a rule is about ([`check_budgets`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Budget {
+    /// Integration steps.
+    Steps,
+    /// Seconds of computing.
+    WallTime,
+}
+
 /// Refuses, with the numbers, a run whose series would not fit in the memory left
 /// ([`fits_in_memory`]).
 pub fn check_memory(scene: &Scene) -> Result<(), String> {

@@ -419,14 +419,10 @@ fn run(
         let name = if max_steps.is_some() { "max_steps" } else { "max_wall_time" };
         return Err(SceneError::new_err(format!("{name}: applies to the compliant model, not to `{model}`")));
     }
-    if max_steps == Some(0) {
-        return Err(SceneError::new_err("max_steps: must be at least 1"));
-    }
-    if let Some(w) = max_wall_time {
-        if !(w > 0.0 && w.is_finite()) {
-            return Err(SceneError::new_err(format!("max_wall_time: must be a positive number of seconds (got {w})")));
-        }
-    }
+    lpc_damper::run::check_budgets(max_steps, max_wall_time).map_err(|(budget, rule)| {
+        let name = if budget == lpc_damper::run::Budget::Steps { "max_steps" } else { "max_wall_time" };
+        SceneError::new_err(format!("{name}: {rule}"))
+    })?;
     if !budgeted {
         return Ok(Run::of(py.detach(|| model.simulate(&s)).map_err(model_error)?));
     }
@@ -605,10 +601,16 @@ fn sweep<'py>(
 fn frf<'py>(py: Python<'py>, scene: &Scene, frequencies: Vec<f64>, model: &str) -> PyResult<Bound<'py, PyDict>> {
     let model = parse_model(model)?;
     let s = scene.damper(&Settings::default())?;
-    for (i, f) in frequencies.iter().enumerate() {
-        if !(f.is_finite() && *f > 0.0) {
-            return Err(SceneError::new_err(format!("frequencies[{i}]: must be positive and finite (got {f})")));
-        }
+    let path = &scene.loaded.path;
+    if s.forcing.is_none() {
+        return Err(SceneError::new_err(format!("{path}: `forcing` is missing: a frequency response needs a forced scene")));
+    }
+    // Each frequency by the scene file's own rules for `forcing.frequency`.
+    for (i, &f) in frequencies.iter().enumerate() {
+        Overrides { forcing_frequency: Some(f), ..Overrides::default() }.apply(s.clone(), path).map_err(|e| match e {
+            RustSceneError::Invalid { rule, .. } => SceneError::new_err(format!("{path}: `frequencies[{i}]` {rule}")),
+            other => scene_error(other),
+        })?;
     }
     let points = batched(py, frequencies.len(), |range| Ok(frfs::frf(&s, &frequencies[range], model, &|| {})))?;
     let d = PyDict::new(py);

@@ -213,3 +213,14 @@ def test_a_budget_stops_the_contact_model_and_keeps_the_run_so_far(scenes):
         lpc.run(scene, max_steps=10)
     with pytest.raises(lpc.SceneError, match="max_wall_time"):
         lpc.run(scene, model="compliant", max_wall_time=-1.0)
+
+
+def test_frf_needs_a_forced_scene_and_valid_frequencies(scenes):
+    """Regression: `frf` on a scene without `[forcing]` panicked inside the library
+    (PanicException); it is a SceneError, and each frequency keeps the file's rules."""
+    with pytest.raises(lpc.SceneError, match="forcing"):
+        lpc.frf(lpc.load_scene(scenes / "lpc-lsl.toml"), [3.0])
+    forced = lpc.load_scene(scenes / "forced-lsl.toml")
+    for bad in (-1.0, 0.0, float("nan")):
+        with pytest.raises(lpc.SceneError, match=r"frequencies\[1\]"):
+            lpc.frf(forced, [3.0, bad])

@@ -171,10 +171,10 @@ fn run_app(scene: &Scene, settings: StepSettings, record: Record, max_wall_s: Op
     let world = app.world_mut();
     while world.resource::<StepClock>().t < scene.horizon * (1.0 - 1e-12) {
         world.run_schedule(DamperStep);
-        let clock = world.resource::<StepClock>();
-        if let Some(budget) = max_wall_s.filter(|_| clock.steps % BUDGET_STEPS == 0) {
+        if let Some(budget) = max_wall_s {
+            let clock = world.resource::<StepClock>();
             let wall_s = start.elapsed().as_secs_f64();
-            if wall_s > budget {
+            if clock.steps % BUDGET_STEPS == 0 && wall_s > budget {
                 return Err(ModelError::OverBudget(format!(
                     "scene `{}`: the contact model stopped at t = {} s after {} steps and {wall_s:.1} s of computing: more than {budget} s of computing",
                     scene.name,

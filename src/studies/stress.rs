@@ -357,8 +357,12 @@ fn compliant_overlap_bound(scene: &Scene, run: &Run) -> f64 {
         + 2.0 * (contact::max_overlap(m_max, u_max, k) + (m_all * a_max / k).powf(2.0 / 3.0))
 }
 
-fn validate(file: &SceneFile) -> Option<Scene> {
-    scene::from_file(file.clone(), "stress", "stress").ok()?.scene
+/// The damper scene of `file`, or why the scene's rules reject it.
+fn validate(file: &SceneFile) -> Result<Scene, String> {
+    scene::from_file(file.clone(), "stress", "stress")
+        .map_err(|e| e.to_string())?
+        .scene
+        .ok_or_else(|| "no damper scene".to_string())
 }
 
 /// Smaller and simpler variants of a scene file, for shrinking.
@@ -404,7 +408,7 @@ pub fn shrink(model: Model, file: &SceneFile, check_name: &str, max_wall_s: Opti
     let mut current = file.clone();
     'outer: for _ in 0..200 {
         for candidate in simplifications(&current) {
-            if let Some(scene) = validate(&candidate) {
+            if let Ok(scene) = validate(&candidate) {
                 if matches!(judge_run(model, &scene, max_wall_s), Err(f) if f.check == check_name) {
                     current = candidate;
                     continue 'outer;
@@ -437,16 +441,12 @@ pub fn stress(model: Model, seed: u64, count: u64, draws: Draws, progress: &(dyn
                 refused_during_run,
                 stopped,
             };
-            let scene = match scene::from_file(file.clone(), "stress", "stress").map(|l| l.scene) {
-                Ok(Some(scene)) => scene,
+            let scene = match validate(&file) {
+                Ok(scene) => scene,
                 // An extreme draw the scene's rules reject: the user gets that refusal.
-                Ok(None) => {
+                Err(why) => {
                     progress();
-                    return outcome(None, None, Some("no damper scene".into()), false, None);
-                }
-                Err(e) => {
-                    progress();
-                    return outcome(None, None, Some(e.to_string()), false, None);
+                    return outcome(None, None, Some(why), false, None);
                 }
             };
             let (failure, refused, refused_during_run, stopped) = match judge_run(model, &scene, draws.max_wall_s) {

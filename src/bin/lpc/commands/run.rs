@@ -60,15 +60,10 @@ const QUIET_FOR: std::time::Duration = std::time::Duration::from_secs(1);
 /// `--out` as far as it got before the error is reported.
 fn run_compliant(a: &Args, scene: &lpc_damper::scene::Scene) -> Result<lpc_damper::run::Run> {
     use lpc_damper::compliant::{self, CompliantError, Options, Progress};
-    let invalid = |flag: &str, rule: String| crate::args::invalid(&a.scene, flag, rule);
-    if a.max_steps == Some(0) {
-        return Err(invalid("--max-steps", "must be at least 1".into()).into());
-    }
-    if let Some(w) = a.max_wall_time {
-        if !(w > 0.0 && w.is_finite()) {
-            return Err(invalid("--max-wall-time", format!("must be a positive number of seconds (got {w})")).into());
-        }
-    }
+    lpc_damper::run::check_budgets(a.max_steps, a.max_wall_time).map_err(|(budget, rule)| {
+        let flag = if budget == lpc_damper::run::Budget::Steps { "--max-steps" } else { "--max-wall-time" };
+        crate::args::invalid(&a.scene, flag, rule)
+    })?;
     let options = Options {
         max_steps: a.max_steps.unwrap_or(compliant::MAX_STEPS),
         max_wall_s: a.max_wall_time,

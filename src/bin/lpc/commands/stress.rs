@@ -44,16 +44,11 @@ pub struct Args {
 }
 
 pub fn run(a: Args) -> Result<ExitStatus> {
-    if let Some(w) = a.max_wall_time {
-        if !(w > 0.0 && w.is_finite()) {
-            let e = lpc_damper::scene::SceneError::Invalid {
-                file: "(command line)".into(),
-                field: "--max-wall-time".into(),
-                rule: format!("must be a positive number of seconds (got {w})"),
-            };
-            return Err(e.into());
-        }
-    }
+    lpc_damper::run::check_budgets(None, a.max_wall_time).map_err(|(_, rule)| lpc_damper::scene::SceneError::Invalid {
+        file: "(command line)".into(),
+        field: "--max-wall-time".into(),
+        rule,
+    })?;
     let draws = lpc_damper::studies::stress::Draws {
         max_horizon: a.max_horizon,
         forced: a.forced,
