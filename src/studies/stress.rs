@@ -47,6 +47,9 @@ pub struct Outcome {
     /// (a typed stop, `--max-wall-time`).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub stopped: Option<String>,
+    /// Seconds of computing the run and its checks took (on one core; shrinking a failure
+    /// not included): the slow tail stays visible.
+    pub wall_s: f64,
 }
 
 /// What `lpc stress` draws and how long each run may take.
@@ -432,7 +435,8 @@ pub fn stress(model: Model, seed: u64, count: u64, draws: Draws, progress: &(dyn
             } else {
                 random_scene_file(s, draws.max_horizon, draws.forced)
             };
-            let outcome = |failure: Option<Failure>, minimal_scene, refused, refused_during_run, stopped| Outcome {
+            let start = std::time::Instant::now();
+            let outcome = |failure: Option<Failure>, minimal_scene, refused, refused_during_run, stopped, wall_s| Outcome {
                 seed: s,
                 model,
                 failure,
@@ -440,13 +444,14 @@ pub fn stress(model: Model, seed: u64, count: u64, draws: Draws, progress: &(dyn
                 refused,
                 refused_during_run,
                 stopped,
+                wall_s,
             };
             let scene = match validate(&file) {
                 Ok(scene) => scene,
                 // An extreme draw the scene's rules reject: the user gets that refusal.
                 Err(why) => {
                     progress();
-                    return outcome(None, None, Some(why), false, None);
+                    return outcome(None, None, Some(why), false, None, start.elapsed().as_secs_f64());
                 }
             };
             let (failure, refused, refused_during_run, stopped) = match judge_run(model, &scene, draws.max_wall_s) {
@@ -455,11 +460,12 @@ pub fn stress(model: Model, seed: u64, count: u64, draws: Draws, progress: &(dyn
                 Ok(Passed::Stopped(why)) => (None, None, false, Some(why)),
                 Err(f) => (Some(f), None, false, None),
             };
+            let wall_s = start.elapsed().as_secs_f64();
             let minimal_scene = failure
                 .as_ref()
                 .map(|f| toml::to_string(&shrink(model, &file, f.check, draws.max_wall_s)).unwrap_or_default());
             progress();
-            outcome(failure, minimal_scene, refused, refused_during_run, stopped)
+            outcome(failure, minimal_scene, refused, refused_during_run, stopped, wall_s)
         })
         .collect()
 }

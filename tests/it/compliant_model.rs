@@ -5,9 +5,13 @@
 //! reference to within what finite contact durations explain, touching chains work, and runs
 //! are repeatable.
 //!
-//! Tolerances: the integrator keeps each step's error below `tol = 1e-9` of the contact's
-//! scales (its Hertz length and speed); an impact takes about 10^2 steps, so quantities set
-//! by one impact are good to about 1e-7 relative and are checked at 1e-6.
+//! Tolerances: the integrator keeps each step's error below `tol = 1e-9` of the scene's
+//! scales (the Hertz length at its speed scale, and that speed); an impact takes about 10^2
+//! steps, so quantities set by one impact at the scene's speed are good to about 1e-7 relative
+//! and are checked at 1e-6.
+//!
+//! Issue 18: packed and pressed contacts cost what their motion needs (the packed column and a
+//! plastic light ball between heavy ones, each once stopped by millions of explicit steps).
 
 use crate::common;
 use lpc_damper::studies::compare::errors;
@@ -347,4 +351,73 @@ fn lpc_run_writes_the_run_a_budget_stopped() {
     let o = crate::common::lpc(["run".as_ref(), scene.as_os_str(), "--max-steps".as_ref(), "5000".as_ref()]);
     assert_eq!(o.status.code(), Some(2));
     assert!(String::from_utf8_lossy(&o.stderr).contains("applies to the compliant model"));
+}
+
+/// `scene` with its horizon cut to `horizon`.
+fn cut(mut scene: Scene, horizon: f64) -> Scene {
+    scene.horizon = horizon;
+    scene
+}
+
+/// Two runs of one scene at tolerances `tol` and `tol / 10`: the coarser one's impact loss and
+/// final state are integration error away from the finer one's. Chaos amplifies a step's error
+/// over a long run, so these runs are short.
+fn converges(scene: &Scene, tol: f64, max_steps: u64) -> (Run, Run) {
+    let coarse = compliant::simulate_with(scene, Options { tolerance: tol, max_steps, ..Default::default() }).unwrap();
+    let fine = compliant::simulate_with(scene, Options { tolerance: tol / 10.0, max_steps, ..Default::default() }).unwrap();
+    for r in [&coarse, &fine] {
+        assert!(r.energy.balance_error.abs() <= r.events as f64 * tol, "{}: balance {:e} after {} steps", scene.name, r.energy.balance_error, r.events);
+    }
+    (coarse, fine)
+}
+
+/// The packed column (45 balls, no gaps, e = 0.07) pressed by its frame: its first 0.1 s took
+/// more than 38 million explicit steps (the old run stopped at 50 million at t = 0.13 s),
+/// every one held to nanoseconds by contacts damped at up to 1e9 per second. Now the steps
+/// follow the motion; the answer is the same at a tenth of the tolerance.
+#[test]
+fn packed_column_costs_what_its_motion_needs() {
+    let scene = cut(parse(PACKED_COLUMN, "packed.toml", "packed").unwrap().scene.unwrap(), 0.1);
+    let (coarse, fine) = converges(&scene, DEFAULT_TOLERANCE, 2_000_000);
+    assert!(coarse.events < 1_000_000, "{} steps", coarse.events);
+    let e0 = coarse.energy.initial;
+    assert!((coarse.energy.impact_loss - fine.energy.impact_loss).abs() <= 1e-6 * e0, "{:?} vs {:?}", coarse.energy, fine.energy);
+    assert!((coarse.energy.damping_loss - fine.energy.damping_loss).abs() <= 1e-6 * e0);
+    // A column trembling in place is a few contacts, not one impact per tremble.
+    assert!(coarse.impacts.len() < 10 * scene.balls.len(), "{} impacts", coarse.impacts.len());
+}
+
+/// A plastic (e = 0) light ball (0.36 g) between two 110 g balls in a swinging frame (stress
+/// seed 31368): 11.9 s of computing for 0.53 s before; a few hundred thousand steps now.
+#[test]
+fn plastic_light_ball_between_heavy_ones_is_cheap_and_converged() {
+    let toml = r#"
+name = "pressed-plastic"
+[frame]
+mass = 1.35
+stiffness = 422.516621135352
+damping = 1.1220729756471255
+initial_displacement = "-7.289504835503309 Rr"
+[balls]
+arrangement = "LSLL"
+large_mass = 0.11
+mass_ratio = 302.82669420812323
+density = 8000.0
+restitution = 0.0
+gap = "0.008351146603002789 Rr"
+clearance = "0.8617691946490968 Rr"
+[run]
+horizon = 0.5318965555637503
+sample_dt = 0.00026594827778187515
+"#;
+    let scene = parse(toml, "plastic.toml", "plastic").unwrap().scene.unwrap();
+    let (coarse, fine) = converges(&scene, DEFAULT_TOLERANCE, 1_000_000);
+    assert!(coarse.events < 500_000, "{} steps", coarse.events);
+    let e0 = coarse.energy.initial;
+    assert!((coarse.energy.impact_loss - fine.energy.impact_loss).abs() <= 1e-6 * e0, "{:?} vs {:?}", coarse.energy, fine.energy);
+    assert_eq!(coarse.impacts.len(), fine.impacts.len());
+    // Momentum passes through the plastic contacts: the heavy balls' final speeds agree.
+    for (a, b) in coarse.final_velocities.iter().zip(&fine.final_velocities) {
+        assert!((a - b).abs() <= 1e-5 * coarse.final_velocities.iter().fold(0.0f64, |m, v| m.max(v.abs())), "{a} vs {b}");
+    }
 }

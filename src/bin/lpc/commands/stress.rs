@@ -94,6 +94,17 @@ pub fn run(a: Args) -> Result<ExitStatus> {
                     stopped,
                     failed
                 );
+                let mut walls: Vec<(f64, u64)> = outcomes.iter().filter(|o| o.model == model).map(|o| (o.wall_s, o.seed)).collect();
+                walls.sort_by(|a, b| a.0.total_cmp(&b.0));
+                if let Some(&(slowest, seed)) = walls.last() {
+                    let at = |q: f64| walls[((walls.len() - 1) as f64 * q).round() as usize].0;
+                    println!(
+                        "  computing time per scene (one core): median {:.3} s, 95 % {:.3} s, slowest {:.3} s (seed {seed})",
+                        at(0.5),
+                        at(0.95),
+                        slowest
+                    );
+                }
             }
             println!("({:.1} s)", start.elapsed().as_secs_f64());
         }
