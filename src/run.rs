@@ -63,6 +63,10 @@ pub struct Series {
     pub x: Vec<Vec<f64>>,
     /// Ball velocities, `[ball][sample]`, m/s.
     pub v: Vec<Vec<f64>>,
+    /// The series keeps every `every`-th sample of the run (1, or 0 for a series built by
+    /// hand: all of them): more when the whole series would not fit in memory
+    /// ([`series_every`]). The metrics always see every sample.
+    pub every: usize,
 }
 
 impl Series {
@@ -75,6 +79,7 @@ impl Series {
             a: Vec::with_capacity(samples),
             x: (0..balls).map(|_| Vec::with_capacity(samples)).collect(),
             v: (0..balls).map(|_| Vec::with_capacity(samples)).collect(),
+            every: 1,
         }
     }
     /// Number of samples.
@@ -104,6 +109,8 @@ pub enum Record {
 #[derive(Debug, Clone)]
 pub struct Recorder {
     series: Option<Series>,
+    /// Samples taken so far (kept in the series or not).
+    taken: usize,
     /// `None` when the model computes the metrics itself ([`Recorder::untallied`]).
     tally: Option<SampleTally>,
     masses: Vec<f64>,
@@ -112,8 +119,16 @@ pub struct Recorder {
 impl Recorder {
     /// A recorder for a run of `scene` that keeps what `record` asks for.
     pub fn new(scene: &Scene, record: Record) -> Self {
+        // A run that skipped check_memory and cannot fit thins as far as the rule goes.
+        Self::thinned(scene, record, series_every(scene).unwrap_or(MAX_SERIES_EVERY))
+    }
+    /// [`Recorder::new`] keeping every `every`-th sample in the series.
+    fn thinned(scene: &Scene, record: Record, every: usize) -> Self {
+        let series = (record == Record::Series)
+            .then(|| Series { every, ..Series::with_capacity(scene.balls.len(), scene.sample_count().div_ceil(every)) });
         Recorder {
-            series: (record == Record::Series).then(|| Series::with_capacity(scene.balls.len(), scene.sample_count())),
+            series,
+            taken: 0,
             tally: Some(SampleTally::new(scene)),
             masses: scene.balls.iter().map(|b| b.mass).collect(),
         }
@@ -134,7 +149,9 @@ impl Recorder {
         let a = scene.frame_acceleration(t, xs, vs);
         let wants_energy = self.tally.as_ref().is_some_and(|t| t.wants_energy());
         let mut kinetic = 0.0;
-        if let Some(s) = &mut self.series {
+        let kept = self.series.as_mut().filter(|s| self.taken % s.every.max(1) == 0);
+        self.taken += 1;
+        if let Some(s) = kept {
             s.t.push(t);
             s.xs.push(xs);
             s.vs.push(vs);
@@ -368,14 +385,40 @@ pub enum Budget {
     WallTime,
 }
 
-/// Refuses, with the numbers, a run whose series would not fit in the memory left
-/// ([`fits_in_memory`]).
+/// Most a series is thinned to fit in memory ([`series_every`]): a series thinner than a
+/// hundredth of the one asked for is not that series any more, and a scene that needs more
+/// is refused with the numbers, for its user to choose the sampling.
+pub const MAX_SERIES_EVERY: usize = 100;
+
+/// The decimation rule: the series of a run of `scene` keeps every `k`-th sample, `k` the
+/// smallest that makes it fit in [`MEMORY_SHARE`] of the memory left ([`fits_in_memory`]);
+/// 1 when the whole series fits. Its metrics still see every sample, and `lpc run` says so.
+/// `Err` with the memory left when even `k` = [`MAX_SERIES_EVERY`] would not fit.
+pub fn series_every(scene: &Scene) -> Result<usize, f64> {
+    let need = series_bytes(scene);
+    fits_in_memory(need).map(|()| 1).or_else(|available| thinning(need, available, scene.sample_count()))
+}
+
+/// The rule of [`series_every`] for a series of `samples` samples taking `need` bytes, with
+/// `available` bytes left.
+fn thinning(need: f64, available: f64, samples: usize) -> Result<usize, f64> {
+    let k = (need / (MEMORY_SHARE * available)).ceil();
+    if k <= MAX_SERIES_EVERY as f64 {
+        Ok((k as usize).clamp(1, samples.max(1)))
+    } else {
+        Err(available)
+    }
+}
+
+/// Refuses, with the numbers, a run whose series would not fit in the memory left even
+/// thinned as far as [`series_every`] goes.
 pub fn check_memory(scene: &Scene) -> Result<(), String> {
     let need = series_bytes(scene);
-    fits_in_memory(need).map_err(|available| {
+    series_every(scene).map(|_| ()).map_err(|available| {
         format!(
             "scene `{}`: its series would take {} of memory ({} samples x {} balls, {} bytes each), more than {:.0} % \
-             of the {} this process can still use; raise run.sample_dt, shorten the horizon or use fewer balls",
+             of the {} this process can still use even keeping one sample in {MAX_SERIES_EVERY}; raise run.sample_dt, \
+             shorten the horizon or use fewer balls",
             scene.name,
             bytes_for_people(need),
             crate::scene::human(scene.sample_count() as f64),
@@ -394,5 +437,45 @@ pub fn bytes_for_people(b: f64) -> String {
         b if b >= 1e9 => format!("{:.1} GB", b / 1e9),
         b if b >= 1e6 => format!("{:.0} MB", b / 1e6),
         b => format!("{:.0} kB", b / 1e3),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The thinning rule: the smallest factor that fits, never past the samples there are,
+    /// and a refusal past [`MAX_SERIES_EVERY`].
+    #[test]
+    fn a_series_thins_by_the_smallest_factor_that_fits() {
+        let gb = 1e9;
+        // 2.5 GB into 80 % of 1 GB: a third of the samples (0.83 GB).
+        assert_eq!(thinning(2.5 * gb, gb, 5001), Ok(4));
+        assert_eq!(thinning(2.4 * gb, gb, 5001), Ok(3));
+        assert_eq!(thinning(80.0 * gb, gb, 5001), Ok(100));
+        assert_eq!(thinning(80.1 * gb, gb, 5001), Err(gb));
+        assert_eq!(thinning(10.0 * gb, gb, 3), Ok(3));
+    }
+
+    /// A thinned series keeps samples 0, k, 2k, ... and its metrics are those of every sample.
+    #[test]
+    fn a_thinned_series_keeps_every_kth_sample_and_all_the_metrics() {
+        let scene = crate::scene::load_scene(crate::scene::scenes_dir().join("lpc-lsl.toml")).unwrap();
+        let feed = |mut r: Recorder| {
+            for k in 0..scene.sample_count() {
+                let t = k as f64 * scene.sample_dt;
+                let (xs, vs) = (0.01 * (9.0 * t).cos() * (-0.3 * t).exp(), -0.09 * (9.0 * t).sin() * (-0.3 * t).exp());
+                r.sample(&scene, t, xs, vs, |i| (0.1 * i as f64 + xs, vs));
+            }
+            r.finish()
+        };
+        let (all, all_metrics) = feed(Recorder::thinned(&scene, Record::Series, 1));
+        let (thin, thin_metrics) = feed(Recorder::thinned(&scene, Record::Series, 7));
+        assert_eq!(thin.every, 7);
+        assert_eq!(thin.len(), scene.sample_count().div_ceil(7));
+        for (j, k) in (0..all.len()).step_by(7).enumerate() {
+            assert_eq!((thin.t[j], thin.xs[j], thin.x[2][j]), (all.t[k], all.xs[k], all.x[2][k]));
+        }
+        assert_eq!(thin_metrics, all_metrics);
     }
 }

@@ -10,28 +10,45 @@ use crate::scene::Scene;
 
 /// Writes `bytes` to `path` atomically (temporary file + rename).
 pub fn write_atomic(path: &Path, bytes: &[u8]) -> std::io::Result<()> {
+    write_atomic_with(path, |w| w.write_all(bytes))
+}
+
+/// Writes to `path` atomically what `write` puts into the (buffered) writer it is given, so a
+/// large file is streamed to disk instead of built in memory first.
+pub fn write_atomic_with(path: &Path, write: impl FnOnce(&mut dyn Write) -> std::io::Result<()>) -> std::io::Result<()> {
     let dir = path.parent().filter(|p| !p.as_os_str().is_empty()).unwrap_or(Path::new("."));
     std::fs::create_dir_all(dir)?;
     let name = path.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default();
     let tmp = dir.join(format!(".{name}.tmp-{}", std::process::id()));
-    {
-        let mut f = std::fs::File::create(&tmp)?;
-        f.write_all(bytes)?;
-        f.sync_all()?;
+    let written = (|| {
+        let mut f = std::io::BufWriter::new(std::fs::File::create(&tmp)?);
+        write(&mut f)?;
+        f.into_inner().map_err(|e| e.into_error())?.sync_all()
+    })();
+    if let Err(e) = written {
+        let _ = std::fs::remove_file(&tmp);
+        return Err(e);
     }
     std::fs::rename(&tmp, path)
 }
 
 /// `series.csv`: `t, xs, vs, a`, then `x` and `v` of each ball.
 pub fn series_csv(run: &Run) -> Vec<u8> {
+    let mut bytes = Vec::new();
+    write_series_csv(run, &mut bytes).expect("writing to memory");
+    bytes
+}
+
+/// [`series_csv`] into `out`, row by row: its text is several times the series' memory.
+pub fn write_series_csv(run: &Run, out: &mut dyn Write) -> std::io::Result<()> {
     let s = &run.series;
-    let mut w = csv::Writer::from_writer(Vec::with_capacity(s.len() * (40 + 40 * s.x.len())));
+    let mut w = csv::Writer::from_writer(out);
     let mut header = vec!["t".to_string(), "xs".into(), "vs".into(), "a".into()];
     for i in 0..s.x.len() {
         header.push(format!("x{}", i + 1));
         header.push(format!("v{}", i + 1));
     }
-    w.write_record(&header).expect("writing to memory");
+    w.write_record(&header)?;
     let mut row = Vec::with_capacity(header.len());
     for k in 0..s.len() {
         row.clear();
@@ -40,9 +57,9 @@ pub fn series_csv(run: &Run) -> Vec<u8> {
             row.push(s.x[i][k].to_string());
             row.push(s.v[i][k].to_string());
         }
-        w.write_record(&row).expect("writing to memory");
+        w.write_record(&row)?;
     }
-    w.into_inner().expect("writing to memory")
+    w.flush()
 }
 
 /// `impacts.csv`: `t, body_a, body_b, approach_speed, energy_lost, peak_force,
@@ -80,7 +97,7 @@ pub fn table_csv(header: &[String], rows: impl IntoIterator<Item = Vec<Option<f6
 /// Writes `series.csv`, `impacts.csv` and `summary.json` of `run` into `dir`.
 pub fn write_run_dir(run: &Run, dir: &Path) -> std::io::Result<()> {
     std::fs::create_dir_all(dir)?;
-    write_atomic(&dir.join("series.csv"), &series_csv(run))?;
+    write_atomic_with(&dir.join("series.csv"), |w| write_series_csv(run, w))?;
     write_atomic(&dir.join("impacts.csv"), &impacts_csv(run))?;
     let json = serde_json::to_vec_pretty(&RunSummary::of(run)).expect("summary serialises");
     write_atomic(&dir.join("summary.json"), &json)

@@ -74,6 +74,10 @@ pub struct RunSummary {
     pub noise: Noise,
     /// Computing time, s.
     pub wall_time_s: f64,
+    /// Present when the series keeps only every `k`-th sample, to fit in memory
+    /// ([`crate::run::series_every`]); the metrics use every sample.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub series_every: Option<usize>,
 }
 
 impl RunSummary {
@@ -107,6 +111,7 @@ impl RunSummary {
             },
             noise: noise(run),
             wall_time_s: run.wall_time_s,
+            series_every: (run.series.every > 1).then_some(run.series.every),
         }
     }
 }

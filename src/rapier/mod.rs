@@ -93,7 +93,10 @@ pub fn settings(scene: &Scene) -> StepSettings {
 /// slowly the more unequal the masses it couples: a light ball squeezed between a heavy one
 /// and a wall sinks into the wall with too few iterations (docs/BENCHMARKS.md, "Stress runs").
 pub fn default_iterations(scene: &Scene) -> usize {
-    DEFAULT_SOLVER_ITERATIONS * (neighbour_mass_ratio(scene).log10().ceil().max(1.0) as usize)
+    // Past 16 decades the light ball's momentum is below the heavy one's round-off: more
+    // iterations cannot couple them (and an infinite ratio must not ask for infinitely many).
+    let decades = neighbour_mass_ratio(scene).log10().ceil();
+    DEFAULT_SOLVER_ITERATIONS * if decades.is_nan() { 1 } else { decades.clamp(1.0, 16.0) as usize }
 }
 
 /// The largest mass ratio of two neighbouring balls (1 for fewer than two balls).

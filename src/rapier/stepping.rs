@@ -90,7 +90,7 @@ fn aligned_step(scene: &crate::scene::Scene, x: &[f64], v: &[f64], frame: Option
         let vw = Vec3::new(vs as f32, 0.0, 0.0);
         // Walls as half-spaces moving with the frame's current velocity (its change over the
         // step is why the last approach is a short step).
-        let walls = [(0, xs as f32, Vec3::X), (n - 1, (xs + c.length) as f32, -Vec3::X)];
+        let walls = [(0, xs as f32, Vec3::X), (n.saturating_sub(1), (xs + c.length) as f32, -Vec3::X)];
         for (i, surface, normal) in walls.into_iter().filter(|_| n > 0) {
             let (p, v) = state(i);
             let r = scene.balls[i].radius as f32;

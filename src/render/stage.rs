@@ -45,7 +45,8 @@ impl Layout {
         let length = scene.container.map_or_else(
             || {
                 let (lo, hi) = scene.initial_positions.iter().fold((f64::MAX, f64::MIN), |(a, b), &x| (a.min(x), b.max(x)));
-                (hi - lo) as f32 + 4.0 * radius
+                // No balls at all: an empty stretch of a few radii, not `MIN - MAX`.
+                if lo <= hi { (hi - lo) as f32 + 4.0 * radius } else { 4.0 * radius }
             },
             |c| c.length as f32,
         );

@@ -244,7 +244,7 @@ impl Scene {
     /// the horizon (a relative 1e-12 of slack, so a horizon that is a whole number of steps
     /// in exact arithmetic keeps its last sample after rounding).
     pub fn sample_count(&self) -> usize {
-        (self.horizon / self.sample_dt * (1.0 + 1e-12)).floor() as usize + 1
+        ((self.horizon / self.sample_dt * (1.0 + 1e-12)).floor() as usize).saturating_add(1)
     }
 
     /// Initial mechanical energy: spring energy plus balls' kinetic energy.
@@ -845,6 +845,9 @@ fn build_damper(f: &SceneFile, name: &str, v: &Validator) -> Result<Scene, Scene
             (le, lc)
         }
     };
+    if !length.is_finite() {
+        return Err(v.err("balls.gap", &format!("and the clearance make the container {} m long, more than a number can hold", human(length))));
+    }
     let mut positions = Vec::with_capacity(balls.len());
     let mut x = xs0 + gap;
     for ball in &balls {
@@ -917,7 +920,7 @@ fn arrangement_balls(
     v: &Validator,
 ) -> Result<Vec<Ball>, SceneError> {
     let small_mass = large_mass / mass_ratio;
-    match a {
+    let balls: Vec<Ball> = match a {
         Arrangement::Letters(s) => s
             .chars()
             .filter(|c| !c.is_whitespace() && *c != '-')
@@ -926,7 +929,7 @@ fn arrangement_balls(
                 'S' => Ok(Ball { mass: small_mass, radius: ball_radius(small_mass, density), kind: BallKind::Small }),
                 other => Err(v.err(field, &format!("has the unknown letter `{other}`: use L (large) and S (small)"))),
             })
-            .collect(),
+            .collect::<Result<_, _>>()?,
         Arrangement::List(list) => list
             .iter()
             .enumerate()
@@ -935,8 +938,23 @@ fn arrangement_balls(
                 let rho = v.positive(&format!("{field}[{i}].density"), b.density.unwrap_or(density))?;
                 Ok(Ball { mass: m, radius: ball_radius(m, rho), kind: BallKind::Custom })
             })
-            .collect(),
+            .collect::<Result<_, _>>()?,
+    };
+    // What the typed values make must be numbers too: a mass below the smallest normal f64,
+    // or a radius beyond the largest, is not a ball any model can move.
+    if balls.iter().any(|b| b.kind == BallKind::Small) && !small_mass.is_normal() {
+        return Err(v.err(
+            "balls.mass_ratio",
+            &format!("makes the small balls' mass large_mass / mass_ratio = {} kg, too small for a number to hold", human(small_mass)),
+        ));
     }
+    if let Some(b) = balls.iter().find(|b| !(b.mass.is_normal() && b.radius.is_normal())) {
+        return Err(v.err(
+            field,
+            &format!("has a ball of mass {} kg and radius {} m (from its density): not a size a number can hold", human(b.mass), human(b.radius)),
+        ));
+    }
+    Ok(balls)
 }
 
 fn build_chain(c: &format::ChainFile, run: &format::RunFile, name: &str, v: &Validator) -> Result<Vec<ChainCase>, SceneError> {

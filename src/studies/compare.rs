@@ -24,31 +24,70 @@ pub struct Errors {
     pub impact_count_diff: i64,
 }
 
-/// Errors of `run` against `reference`; both must be sampled at the same times.
+/// Errors of `run` against `reference` at the samples both series hold: every sample of the
+/// scene, or, when a series had to keep only every k-th of them to fit in memory (each run
+/// judges that for itself), the ones they share.
 pub fn errors(run: &Run, reference: &Run) -> Errors {
     let (a, r) = (&run.series, &reference.series);
-    let len = a.len().min(r.len());
-    assert!(
-        (0..len).all(|k| (a.t[k] - r.t[k]).abs() <= 1e-9 * run.sample_dt),
-        "runs sampled at different times"
-    );
-    let mut sq = 0.0;
+    let tol = 1e-9 * run.sample_dt;
+    let (mut i, mut j) = (0, 0);
+    let (mut sq, mut shared) = (0.0, 0usize);
     let mut early: f64 = 0.0;
-    for k in 0..len {
-        let d = a.xs[k] - r.xs[k];
-        sq += d * d;
-        if r.t[k] <= EARLY_WINDOW {
-            early = early.max(d.abs());
+    while i < a.len() && j < r.len() {
+        if a.t[i] < r.t[j] - tol {
+            i += 1;
+        } else if r.t[j] < a.t[i] - tol {
+            j += 1;
+        } else {
+            let d = a.xs[i] - r.xs[j];
+            sq += d * d;
+            shared += 1;
+            if r.t[j] <= EARLY_WINDOW {
+                early = early.max(d.abs());
+            }
+            i += 1;
+            j += 1;
         }
     }
     let (ma, mr) = (metrics(run), metrics(reference));
     let put_in = reference.energy.initial.abs() + reference.energy.forcing_work.abs();
     let initial = if put_in != 0.0 { put_in } else { 1.0 };
     Errors {
-        rms_xs: if len > 0 { (sq / len as f64).sqrt() } else { 0.0 },
+        rms_xs: if shared > 0 { (sq / shared as f64).sqrt() } else { 0.0 },
         max_xs_early: early,
         settling_time_diff: ma.settling_time.zip(mr.settling_time).map(|(a, r)| a - r),
         impact_loss_diff: (run.energy.impact_loss - reference.energy.impact_loss) / initial,
         impact_count_diff: run.impacts.len() as i64 - reference.impacts.len() as i64,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::run::Series;
+
+    /// A run of `samples` samples of `xs = k` (k the sample index), keeping every `every`-th.
+    fn thinned(samples: usize, every: usize, offset: f64) -> Run {
+        let mut series = Series::with_capacity(0, samples);
+        series.every = every;
+        for k in (0..samples).step_by(every) {
+            series.t.push(k as f64 * 1e-3);
+            series.xs.push(k as f64 + offset);
+            series.vs.push(0.0);
+            series.a.push(0.0);
+        }
+        Run { series, sample_dt: 1e-3, ..Run::empty("thinned", crate::run::Model::Reference) }
+    }
+
+    /// Runs thinned by different factors (each judges its memory for itself) are compared
+    /// at the samples they share, not index by index.
+    #[test]
+    fn thinned_runs_compare_at_their_shared_samples() {
+        let e = errors(&thinned(1001, 2, 0.5), &thinned(1001, 3, 0.0));
+        // Shared: every 6th sample, each off by 0.5.
+        assert_eq!(e.rms_xs, 0.5);
+        assert_eq!(e.max_xs_early, 0.5);
+        let same = errors(&thinned(1001, 1, 0.0), &thinned(1001, 1, 0.0));
+        assert_eq!(same.rms_xs, 0.0);
     }
 }

@@ -104,7 +104,7 @@ pub fn forced_at(scene: &Scene, frequency: f64) -> Scene {
     let decay = s.frame.map_or(0.0, |f| if f.damping > 0.0 { 3.0 * 2.0 * f.mass / f.damping } else { 0.0 });
     s.horizon = s.horizon.max(4.0 * BLOCK_PERIODS as f64 * period).max(decay);
     s.sample_dt = s.sample_dt.min(period / SAMPLES_PER_PERIOD);
-    s.name = format!("{}[f={frequency} Hz]", scene.name);
+    s.name = format!("{}[f={} Hz]", scene.name, crate::scene::human(frequency));
     s
 }
 
@@ -119,6 +119,15 @@ pub fn steady_peaks(scene: &Scene, model: Model) -> Result<(SteadyState, f64, Ve
     let period = 1.0 / scene.forcing.expect("a forced scene").frequency;
     let mut s = scene.clone();
     for doubling in 0..=MAX_DOUBLINGS {
+        // The horizon and step chosen here (and each doubling) keep the scene file's rules.
+        crate::scene::validate_sample_dt(s.horizon, s.sample_dt).map_err(|rule| {
+            ModelError::Refused(format!(
+                "scene `{}`: reading its steady response needs {} s of motion sampled every {} s: run.sample_dt {rule}",
+                s.name,
+                crate::scene::human(s.horizon),
+                crate::scene::human(s.sample_dt)
+            ))
+        })?;
         let run = model.simulate(&s)?;
         let peaks = period_peaks(&run, period);
         let reading = steady_reading(&run, &peaks, period);
@@ -208,6 +217,18 @@ pub fn frf_ensemble(members: &[Member], frequencies: &[f64], model: Model, progr
             }
         })
         .collect()
+}
+
+/// Most frequencies one response curve takes.
+pub const MAX_FREQUENCIES: usize = 10_000;
+
+/// The rule of a response curve's frequency count (`--steps` of `lpc frf` and `lpc optimize`).
+pub fn check_frequency_count(steps: usize) -> Result<(), String> {
+    if (1..=MAX_FREQUENCIES).contains(&steps) {
+        Ok(())
+    } else {
+        Err(format!("must lie in 1..={MAX_FREQUENCIES} (got {steps})"))
+    }
 }
 
 /// `steps` frequencies evenly spaced from `from` to `to` (just `from` when `steps` is 1).

@@ -10,6 +10,9 @@ use crate::args::{load_scene, print_json, progress_bar, TableFormat};
 use crate::table::{right, Table};
 use crate::exit::{CommandError, ExitStatus, Result};
 
+/// Most runs per setting: the median of a thousand is as steady as timing gets.
+const MAX_REPEAT: usize = 1000;
+
 #[derive(clap::Args)]
 pub struct Args {
     /// Scene files (default: the paper's damper scenes).
@@ -54,6 +57,10 @@ pub fn run(a: Args) -> Result<ExitStatus> {
     }
     for &it in &a.solver_iterations {
         Overrides { solver_iterations: Some(it), ..Overrides::default() }.validate_rapier()?;
+    }
+    if !(1..=MAX_REPEAT).contains(&a.repeat) {
+        let rule = format!("must lie in 1..={MAX_REPEAT} (got {})", a.repeat);
+        return Err(crate::args::invalid(std::path::Path::new("(command line)"), "--repeat", rule).into());
     }
     let plan = lpc_damper::studies::bench::Plan {
         models: a.models.clone(),

@@ -56,8 +56,8 @@ pub fn run(a: Args) -> Result<ExitStatus> {
     let scene = nominal.scene.clone();
     let (from, to) = parse_range(&a.freq, &a.scene, "--freq")?;
     let invalid = |field: &str, rule: String| invalid(&a.scene, field, rule);
-    if a.steps == 0 || a.steps > 10_000 {
-        return Err(invalid("--steps", format!("must lie in 1..=10000 (got {})", a.steps)).into());
+    if let Err(rule) = lpc_damper::studies::frf::check_frequency_count(a.steps) {
+        return Err(invalid("--steps", rule).into());
     }
     let forcing = Overrides {
         forcing_kind: a.kind.map(|k| match k {
@@ -139,7 +139,7 @@ pub fn run(a: Args) -> Result<ExitStatus> {
                 ]);
             }
             for p in points.iter().filter(|p| p.error.is_some()) {
-                println!("{} Hz failed: {}", p.frequency, p.error.as_deref().unwrap_or_default());
+                println!("{} Hz failed: {}", lpc_damper::scene::human(p.frequency), p.error.as_deref().unwrap_or_default());
             }
             if let Some(dir) = &a.out {
                 println!("wrote frf.json, frf.csv, frf.png, frf.svg to {}", dir.display());
@@ -198,7 +198,7 @@ fn frf_ensemble(a: &Args, scene: &scene::Scene, members: &lpc_damper::studies::e
                 ]);
             }
             for b in bands.iter().filter(|b| b.error.is_some()) {
-                println!("{} Hz failed: {}", b.frequency, b.error.as_deref().unwrap_or_default());
+                println!("{} Hz failed: {}", lpc_damper::scene::human(b.frequency), b.error.as_deref().unwrap_or_default());
             }
         }
     }

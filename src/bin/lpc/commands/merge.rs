@@ -47,6 +47,9 @@ fn read_shard(dir: &Path) -> std::result::Result<Shard, SceneError> {
     };
     let info: ShardInfo = serde_json::from_slice(&read("shard.json")?)
         .map_err(|e| bad(dir, "shard.json", format!("is not a shard's description: {e}")))?;
+    if info.stop < info.start {
+        return Err(bad(dir, "shard.json", format!("ends (member {}) before it starts ({})", info.stop, info.start)));
+    }
     let bytes = read("members.csv")?;
     let mut reader = csv::Reader::from_reader(bytes.as_slice());
     let header: Vec<String> = reader
@@ -55,6 +58,11 @@ fn read_shard(dir: &Path) -> std::result::Result<Shard, SceneError> {
         .iter()
         .map(String::from)
         .collect();
+    // The table ends with the summary's metrics, in order: the merged summary reads them there.
+    let tail = header.len().checked_sub(SUMMARY_METRICS.len()).map(|k| &header[k..]);
+    if tail.is_none_or(|t| t.iter().zip(SUMMARY_METRICS).any(|(h, m)| h.as_str() != *m)) {
+        return Err(bad(dir, "members.csv", format!("does not end with the metrics columns {}", SUMMARY_METRICS.join(", "))));
+    }
     let mut rows = vec![];
     for (r, record) in reader.records().enumerate() {
         let record = record.map_err(|e| bad(dir, "members.csv", e.to_string()))?;

@@ -96,7 +96,8 @@ pub fn run(a: Args) -> Result<ExitStatus> {
         ObjectiveArg::ResonantAmplitude => {
             let text = a.freq.as_deref().ok_or_else(|| invalid("--freq", "is needed for the resonant amplitude".into()))?;
             let (from, to) = parse_range(text, &a.scene, "--freq")?;
-            Objective::ResonantAmplitude { from, to, steps: a.steps.max(1) }
+            lpc_damper::studies::frf::check_frequency_count(a.steps).map_err(|rule| invalid("--steps", rule))?;
+            Objective::ResonantAmplitude { from, to, steps: a.steps }
         }
     };
     let robust = match a.ensemble.ensemble {

@@ -60,10 +60,12 @@ const QUIET_FOR: std::time::Duration = std::time::Duration::from_secs(1);
 /// `--out` as far as it got before the error is reported.
 fn run_compliant(a: &Args, scene: &lpc_damper::scene::Scene) -> Result<lpc_damper::run::Run> {
     use lpc_damper::compliant::{self, CompliantError, Options, Progress};
+    use lpc_damper::scene::human;
     lpc_damper::run::check_budgets(a.max_steps, a.max_wall_time).map_err(|(budget, rule)| {
         let flag = if budget == lpc_damper::run::Budget::Steps { "--max-steps" } else { "--max-wall-time" };
         crate::args::invalid(&a.scene, flag, rule)
     })?;
+    lpc_damper::run::check_memory(scene).map_err(lpc_damper::model::ModelError::Refused)?;
     let options = Options {
         max_steps: a.max_steps.unwrap_or(compliant::MAX_STEPS),
         max_wall_s: a.max_wall_time,
@@ -86,6 +88,28 @@ fn run_compliant(a: &Args, scene: &lpc_damper::scene::Scene) -> Result<lpc_dampe
                         indicatif::ProgressStyle::with_template("compliant [{bar:30}] {msg} ({elapsed}, about {eta} to go)").expect("valid template"),
                     );
                     shown = true;
+                    // The announcement, on a terminal or in a log: what the whole run will cost
+                    // at the rate of its first second (a pack's cost shows only once it runs).
+                    let (t, steps, elapsed) = (progress.time(), progress.steps(), start.elapsed().as_secs_f64());
+                    if t > 0.0 {
+                        let whole = scene.horizon / t;
+                        let line = format!(
+                            "compliant: `{}` is a long run: t = {:.4e} of {} s after {:.1} s and {} steps; at this rate about {} \
+                             steps and {} s in all (--max-steps, --max-wall-time bound it)",
+                            scene.name,
+                            t,
+                            human(scene.horizon),
+                            elapsed,
+                            steps,
+                            human((steps as f64 * whole).round()),
+                            human((elapsed * whole).round()),
+                        );
+                        if bar.is_hidden() {
+                            eprintln!("{line}");
+                        } else {
+                            bar.println(line);
+                        }
+                    }
                 }
                 let t = progress.time();
                 bar.set_position((1000.0 * t / scene.horizon).clamp(0.0, 1000.0) as u64);
@@ -123,6 +147,15 @@ pub fn run(a: Args) -> Result<ExitStatus> {
         return Err(crate::args::invalid(&a.scene, flag, format!("applies to the compliant model, not to `{}`", a.model)).into());
     }
     let run = if a.model == Model::Compliant { run_compliant(&a, &scene)? } else { a.model.simulate(&scene)? };
+    if run.series.every > 1 {
+        eprintln!(
+            "note: scene `{}`: the series keeps every {}th sample (one every {} s) so that it fits in the memory left; \
+             the metrics use every sample",
+            scene.name,
+            run.series.every,
+            lpc_damper::scene::human(scene.sample_dt * run.series.every as f64)
+        );
+    }
     let summary = RunSummary::of(&run);
     if let Some(dir) = &a.out {
         write_run_dir(&run, dir).with_context(|| format!("writing outputs to {}", dir.display()))?;

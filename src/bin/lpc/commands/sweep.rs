@@ -190,7 +190,7 @@ fn write_sweep(
 /// `q` quantile.
 fn sweep_ensembles(a: &Args, nominal: &Nominal, axes: &[Axis], parameters: &[String], grid: &[GridScene], q: f64) -> Result<ExitStatus> {
     let per_point = a.ensemble.ensemble.unwrap_or(1);
-    let bar = progress_bar(grid.len() * per_point, "sweep");
+    let bar = progress_bar(grid.len().saturating_mul(per_point), "sweep");
     let start = std::time::Instant::now();
     let mut points = vec![];
     for g in grid {
