@@ -32,9 +32,9 @@ pub(super) struct Stage {
     /// `h gamma`.
     hg: f64,
     partials: Vec<Partials>,
-    /// Thomas factors over the balls: the modified superdiagonal and the pivots.
+    /// Thomas factors over the balls: the modified superdiagonal and the pivots' inverses.
     upper: Vec<f64>,
-    pivot: Vec<f64>,
+    inverse_pivot: Vec<f64>,
     /// Off-diagonal between ball `i` and `i + 1` (`-w`).
     off: Vec<f64>,
     /// The frame's column over the balls, and `T^-1` of it.
@@ -156,10 +156,10 @@ impl System<'_> {
         }
         // Thomas factorisation of the balls' tridiagonal part.
         stage.upper.clear();
-        stage.pivot.clear();
+        stage.inverse_pivot.clear();
         for i in 0..n {
             let pivot = diag[i] - if i > 0 { stage.off[i - 1] * stage.upper[i - 1] } else { 0.0 };
-            stage.pivot.push(pivot);
+            stage.inverse_pivot.push(1.0 / pivot);
             stage.upper.push(if i + 1 < n { stage.off[i] / pivot } else { 0.0 });
         }
         stage.border_solved.clone_from(&stage.border);
@@ -171,11 +171,11 @@ impl System<'_> {
 
     /// Solves the balls' tridiagonal system in place, on `border_solved` or on `rhs`.
     fn thomas(stage: &mut Stage, border: bool) {
-        let n = stage.pivot.len();
+        let n = stage.inverse_pivot.len();
         let x = if border { &mut stage.border_solved } else { &mut stage.rhs };
         for i in 0..n {
             let prev = if i > 0 { stage.off[i - 1] * x[i - 1] } else { 0.0 };
-            x[i] = (x[i] - prev) / stage.pivot[i];
+            x[i] = (x[i] - prev) * stage.inverse_pivot[i];
         }
         for i in (0..n.saturating_sub(1)).rev() {
             x[i] -= stage.upper[i] * x[i + 1];

@@ -783,26 +783,25 @@ impl<'s, 'a> Driver<'s, 'a> {
         for (q, pair) in sys.pairs.iter().enumerate() {
             let Some(c) = self.contacts[q].as_mut() else { continue };
             let v_max0 = c.v_max;
-            let at = |th: f64| -> (f64, f64) {
+            // Force, overlap rate and overlap at `th`.
+            let at = |th: f64| -> (f64, f64, f64) {
                 let (d, rate) = sys.overlap(pair, |i| dense(i, th));
-                (contact::force(pair.k, sys.alpha(v_max0, rate), d, rate), rate)
+                (contact::force(pair.k, sys.alpha(v_max0, rate), d, rate), rate, d)
             };
             let mut best = (f64::NEG_INFINITY, 0usize);
             let mut rates = 0.0f64;
-            let overlap = |th: f64| sys.overlap(pair, |i| dense(i, th)).0;
-            let mut d_prev = overlap(0.0);
+            let mut d_prev = 0.0;
             for j in 0..=SCAN_POINTS {
                 let th = j as f64 / SCAN_POINTS as f64;
+                let (f, rate, d) = at(th);
                 // The contact's last exit: where the overlap last fell to zero in this step.
-                let d = if j == 0 { d_prev } else { overlap(th) };
-                if d_prev > 0.0 && d <= 0.0 {
+                if j > 0 && d_prev > 0.0 && d <= 0.0 {
                     let lo = (j - 1) as f64 / SCAN_POINTS as f64;
-                    c.exit = Some(t0 + h * bracketed_root(|x| -overlap(x), lo, th, 1e-15));
+                    c.exit = Some(t0 + h * bracketed_root(|x| -at(x).2, lo, th, 1e-15));
                 } else if d > 0.0 {
                     c.exit = None;
                 }
                 d_prev = d;
-                let (f, rate) = at(th);
                 rates = rates.max(rate);
                 if f > best.0 {
                     best = (f, j);

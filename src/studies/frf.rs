@@ -177,6 +177,26 @@ pub struct FrfBand {
     pub error: Option<String>,
 }
 
+/// Refuses, with the numbers, an ensemble response whose runs' results (the last blocks'
+/// peaks of every member at every frequency, with and without the damper) would not fit in
+/// the memory left.
+pub fn check_ensemble_memory(members: usize, frequencies: usize) -> Result<(), String> {
+    let runs = 2.0 * members as f64 * frequencies as f64;
+    let per_run = (std::mem::size_of::<(usize, usize, bool)>()
+        + std::mem::size_of::<Result<(Vec<f64>, SteadyState), ModelError>>()
+        + 2 * BLOCK_PERIODS * std::mem::size_of::<f64>()) as f64;
+    crate::run::fits_in_memory(runs * per_run).map_err(|available| {
+        format!(
+            "is {members} over {frequencies} frequencies: {} runs whose results would take {} of memory, more than {:.0} % of \
+             the {} left; use fewer members or frequencies",
+            crate::scene::human(runs),
+            crate::run::bytes_for_people(runs * per_run),
+            100.0 * crate::run::MEMORY_SHARE,
+            crate::run::bytes_for_people(available)
+        )
+    })
+}
+
 /// The frequency response over `members`: each run per frequency with and without the damper,
 /// as [`frf`] runs the nominal scene (the horizon doubling until steady, or to its limit),
 /// every run in parallel.

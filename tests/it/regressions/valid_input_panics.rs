@@ -9,7 +9,8 @@
 //!   solver iterations overflowed;
 //! - `lpc frf` lengthened a scene past the 2e7-sample rule without checking it
 //!   (`sample_count` overflowed at a frequency of 1e-16 Hz);
-//! - `lpc merge` sliced a `members.csv` without its metrics columns out of bounds.
+//! - `lpc merge` sliced a `members.csv` without its metrics columns out of bounds;
+//! - `lpc frf --ensemble 1000000 --steps 10000` allocated 2e10 runs' results (an abort).
 
 use std::process::Output;
 
@@ -47,6 +48,11 @@ fn command_line_counts_and_ranges_are_bounded() {
     );
     let lsl = lpc_damper::scene::scenes_dir().join("lpc-lsl.toml");
     ends_with(&lpc(["bench", lsl.to_str().unwrap(), "--repeat", &max]), 2, &["--repeat"]);
+    ends_with(
+        &lpc(["frf", forced.to_str().unwrap(), "--freq", "3..5", "--steps", "10000", "--ensemble", "1000000"]),
+        2,
+        &["--ensemble", "2e10 runs", "of memory"],
+    );
 }
 
 #[test]

@@ -83,6 +83,9 @@ pub fn run(a: Args) -> Result<ExitStatus> {
         .into());
     }
     let freqs = lpc_damper::studies::frf::frequencies(from, to, a.steps);
+    if let Some(count) = a.ensemble.ensemble {
+        lpc_damper::studies::frf::check_ensemble_memory(count, freqs.len()).map_err(|rule| invalid("--ensemble", rule))?;
+    }
     if let Some(members) = nominal.ensemble_of(a.ensemble, &nominal.file, &scene)? {
         return frf_ensemble(&a, &scene, &members, &freqs);
     }

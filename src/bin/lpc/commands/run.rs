@@ -146,16 +146,16 @@ pub fn run(a: Args) -> Result<ExitStatus> {
         let flag = if a.max_steps.is_some() { "--max-steps" } else { "--max-wall-time" };
         return Err(crate::args::invalid(&a.scene, flag, format!("applies to the compliant model, not to `{}`", a.model)).into());
     }
-    let run = if a.model == Model::Compliant { run_compliant(&a, &scene)? } else { a.model.simulate(&scene)? };
-    if run.series.every > 1 {
+    // Said before the run, which may be long: the series it will keep.
+    if let Ok(every @ 2..) = lpc_damper::run::series_every(&scene) {
         eprintln!(
-            "note: scene `{}`: the series keeps every {}th sample (one every {} s) so that it fits in the memory left; \
-             the metrics use every sample",
+            "note: scene `{}`: the series will keep every {every}th sample (one every {} s) so that it fits in the memory \
+             left; the metrics use every sample",
             scene.name,
-            run.series.every,
-            lpc_damper::scene::human(scene.sample_dt * run.series.every as f64)
+            lpc_damper::scene::human(scene.sample_dt * every as f64)
         );
     }
+    let run = if a.model == Model::Compliant { run_compliant(&a, &scene)? } else { a.model.simulate(&scene)? };
     let summary = RunSummary::of(&run);
     if let Some(dir) = &a.out {
         write_run_dir(&run, dir).with_context(|| format!("writing outputs to {}", dir.display()))?;
