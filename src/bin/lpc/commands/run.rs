@@ -149,7 +149,7 @@ pub fn run(a: Args) -> Result<ExitStatus> {
     // Said before the run, which may be long: the series it will keep.
     if let Ok(every @ 2..) = lpc_damper::run::series_every(&scene) {
         eprintln!(
-            "note: scene `{}`: the series will keep every {every}th sample (one every {} s) so that it fits in the memory \
+            "note: scene `{}`: the series will keep one sample in {every} (one every {} s) so that it fits in the memory \
              left; the metrics use every sample",
             scene.name,
             lpc_damper::scene::human(scene.sample_dt * every as f64)
