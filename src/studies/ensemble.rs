@@ -390,9 +390,20 @@ pub fn run_members(
         progress,
     )?;
     let mut out = EnsembleRuns::default();
+    let mut every = None;
     for (metrics, series) in runs {
         out.metrics.push(metrics);
         if let Some(s) = series {
+            // Each run thins its series by the memory left when it starts (run::series_every):
+            // a band needs every member sampled at the same times.
+            if *every.get_or_insert(s.every) != s.every {
+                return Err(ModelError::Refused(format!(
+                    "the members' series had to be thinned differently (one sample in {} and in {}) to fit in the memory \
+                     left, so their band would mix times; raise run.sample_dt or leave out --out",
+                    every.unwrap_or(1),
+                    s.every
+                )));
+            }
             if out.t.is_empty() {
                 out.t = s.t;
             }
