@@ -49,8 +49,9 @@ pub(super) struct Stage {
     damping_dv: f64,
     forcing_dx: f64,
     forcing_dv: f64,
-    /// Scratch: the right-hand side over the balls.
+    /// Scratch: the right-hand side over the balls, and the balls' diagonal.
     rhs: Vec<f64>,
+    diag: Vec<f64>,
 }
 
 impl System<'_> {
@@ -113,7 +114,9 @@ impl System<'_> {
         stage.hg = hg;
         stage.partials.clear();
         stage.partials.extend(self.pairs.iter().enumerate().map(|(q, p)| self.partials(p, y, dy, v_max[q])));
-        let mut diag: Vec<f64> = self.mass.iter().map(|m| m / hg).collect();
+        let mut diag = std::mem::take(&mut stage.diag);
+        diag.clear();
+        diag.extend(self.mass.iter().map(|m| m / hg));
         stage.off.clear();
         stage.off.resize(n.saturating_sub(1), 0.0);
         stage.border.clear();
@@ -167,6 +170,7 @@ impl System<'_> {
         let coupling: f64 = stage.border.iter().zip(&stage.border_solved).map(|(c, w)| c * w).sum();
         stage.schur = frame_diag - coupling;
         stage.rhs.resize(n, 0.0);
+        stage.diag = diag;
     }
 
     /// Solves the balls' tridiagonal system in place, on `border_solved` or on `rhs`.

@@ -488,10 +488,12 @@ struct Driver<'s, 'a> {
     sys: &'s System<'a>,
     options: Options,
     rk: Dopri5,
-    /// The stiff integrator, its factored stage matrix, and the forcing's time derivative.
+    /// The stiff integrator, its factored stage matrix, the forcing's time derivative and a
+    /// scratch state for it.
     rodas: Rodas4,
     stage: jacobian::Stage,
     ft: Vec<f64>,
+    ft_ahead: Vec<f64>,
     /// Whether the last attempted step was a RODAS4 step.
     stiff: bool,
     /// Accepted RODAS4 steps.
@@ -535,6 +537,7 @@ impl<'s, 'a> Driver<'s, 'a> {
             rodas: Rodas4::new(sys.len()),
             stage: jacobian::Stage::default(),
             ft: vec![0.0; sys.len()],
+            ft_ahead: vec![0.0; sys.len()],
             stiff: false,
             stiff_steps: 0,
             t: 0.0,
@@ -568,10 +571,9 @@ impl<'s, 'a> Driver<'s, 'a> {
                 // Only the excitation depends on time: a central difference over a ten-thousandth
                 // of its radian period is exact to about 1e-9 of it.
                 let dt = 1e-4 / g.omega();
-                let mut ahead = vec![0.0; self.y.len()];
-                sys.rhs(self.t + dt, &self.y, &mut ahead, v_max);
+                sys.rhs(self.t + dt, &self.y, &mut self.ft_ahead, v_max);
                 sys.rhs(self.t - dt, &self.y, &mut self.ft, v_max);
-                for (d, a) in self.ft.iter_mut().zip(&ahead) {
+                for (d, a) in self.ft.iter_mut().zip(&self.ft_ahead) {
                     *d = (a - *d) / (2.0 * dt);
                 }
                 Some(&self.ft[..])
