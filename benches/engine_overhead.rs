@@ -1,6 +1,6 @@
 //! What the Bevy plug-in costs per physics step against a bare Rapier pipeline stepping the
-//! same scene (lpc-lsl, fixed 0.5 ms steps, same integration parameters, same restitution per
-//! contact, same exact kinematic frame). `cargo bench --bench engine_overhead`.
+//! same scene (lpc-lsl, fixed 0.5 ms steps, same integration parameters, plastic contacts as the
+//! plug-in's Rapier sees them, same exact kinematic frame). `cargo bench --bench engine_overhead`.
 
 use bevy_rapier3d::rapier::prelude::*;
 use criterion::{criterion_group, criterion_main, BatchSize, Criterion};
@@ -12,19 +12,6 @@ use lpc_damper::scene::{load_scene, scenes_dir, Scene};
 
 const STEPS: usize = 2000;
 const DT: f64 = 5e-4;
-
-struct Restitution {
-    e: f32,
-    wall_e: Vec<f32>,
-}
-
-impl PhysicsHooks for Restitution {
-    fn modify_solver_contacts(&self, ctx: &mut ContactModificationContext) {
-        // user_data: 0 for walls, ball index + 1 for balls.
-        let (a, b) = (ctx.colliders[ctx.collider1].user_data, ctx.colliders[ctx.collider2].user_data);
-        *ctx.restitution = if a == 0 || b == 0 { self.wall_e[(a.max(b) - 1) as usize] } else { self.e };
-    }
-}
 
 /// The plug-in's scene in a bare Rapier world, with the same exact frame drive and m dv
 /// feedback as the plug-in, stepped `STEPS` times.
@@ -39,7 +26,6 @@ struct Bare {
     joints: ImpulseJointSet,
     multibody: MultibodyJointSet,
     ccd: CCDSolver,
-    hooks: Restitution,
     frame: RigidBodyHandle,
     balls: Vec<RigidBodyHandle>,
     masses: Vec<f64>,
@@ -64,7 +50,6 @@ fn bare(scene: &Scene) -> Bare {
             ColliderBuilder::cuboid(half, 0.03, 0.03)
                 .translation(Vector::new(centre, 0.0, 0.0))
                 .friction(0.0)
-                .active_hooks(ActiveHooks::MODIFY_SOLVER_CONTACTS)
                 .user_data(0),
             frame,
             &mut bodies,
@@ -82,7 +67,6 @@ fn bare(scene: &Scene) -> Bare {
             ColliderBuilder::ball(b.radius as f32)
                 .mass(b.mass as f32)
                 .friction(0.0)
-                .active_hooks(ActiveHooks::MODIFY_SOLVER_CONTACTS)
                 .user_data(i as u128 + 1),
             h,
             &mut bodies,
@@ -90,11 +74,6 @@ fn bare(scene: &Scene) -> Bare {
         balls.push(h);
     }
     let params = integration_parameters(scene, StepSettings::fixed(DT, 4));
-    let wall_e = scene
-        .balls
-        .iter()
-        .map(|b| lpc_damper::rapier::hooks::wall_restitution(scene.restitution, f.mass, b.mass).unwrap() as f32)
-        .collect();
     Bare {
         pipeline: PhysicsPipeline::new(),
         params,
@@ -106,7 +85,6 @@ fn bare(scene: &Scene) -> Bare {
         joints: ImpulseJointSet::new(),
         multibody: MultibodyJointSet::new(),
         ccd: CCDSolver::new(),
-        hooks: Restitution { e: scene.restitution as f32, wall_e },
         frame,
         balls,
         masses: scene.balls.iter().map(|b| b.mass).collect(),
@@ -131,7 +109,7 @@ impl Bare {
             &mut self.joints,
             &mut self.multibody,
             &mut self.ccd,
-            &self.hooks,
+            &(),
             &(),
         );
         let mut dp = 0.0;

@@ -18,6 +18,7 @@
 #![warn(missing_docs)]
 
 pub mod compliant;
+pub mod impact_law;
 pub mod metrics;
 pub mod model;
 pub mod oscillator;

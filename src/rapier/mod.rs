@@ -2,18 +2,17 @@
 //! kinematic body moved by the exact damped-oscillator step, and every ball-wall impact is fed
 //! back into the frame as the opposite of the balls' momentum change.
 //!
-//! Where it departs from the impulse model (docs/MODEL.md §3-4), and why:
-//! - Rapier bounces a contact only on the step in which it is new (it carried no impulse the
-//!   step before); a contact that stays loaded is treated plastically. Balls that touch, or
-//!   whose gap closes within one step of another impact, therefore do not exchange momentum
-//!   pairwise in sequence as in Eq. 9-10: the chain shares it at once and partly sticks.
-//! - Each impact lands at the end of the step in which it happens, so it is up to `dt` late; the
-//!   frame's motion between impulses is exact.
-//! - Restitution is one end-of-step pass; a ball-wall contact gets `e' = (e ms - m)/(ms + m)`
-//!   so that the rigid-wall bounce plus the frame feedback equal Eq. 9-10. A ball heavier than
-//!   `e ms` cannot be modelled so and the scene is refused.
+//! Where it departs from the impulse model (docs/MODEL.md §3-4, "Rapier"), and why:
+//! - Rapier only keeps bodies apart (every contact plastic); the plug-in resolves impacts with
+//!   Eq. 9-10 and the frame's finite mass, one pair at a time (`impacts`), because Rapier
+//!   bounces a contact only in the step it is new, solves a touching chain at once, and sees
+//!   the kinematic frame as infinitely heavy.
+//! - Steps end as pairs come into contact (`stepping`); with fixed steps an impact lands at the
+//!   end of the step in which it happens, up to `dt` late. The frame's motion between impulses
+//!   is exact.
+//! - Velocities are f32.
 
-pub mod hooks;
+pub mod impacts;
 pub mod plugin;
 pub mod record;
 pub mod resources;
@@ -25,7 +24,7 @@ use bevy::prelude::*;
 
 use crate::model::ModelError;
 use crate::run::{EnergyAccount, Record, Run};
-use crate::scene::{Body, Scene};
+use crate::scene::Scene;
 pub use plugin::{DamperSet, DamperStep, LpcDamperPlugins};
 pub use resources::{Bodies, DamperScene, FrameState, Recording, StepClock, StepPlan, StepSettings};
 pub use crate::scene::Stepping;
@@ -104,25 +103,6 @@ pub fn neighbour_mass_ratio(scene: &Scene) -> f64 {
     scene.balls.windows(2).map(|w| (w[0].mass / w[1].mass).max(w[1].mass / w[0].mass)).fold(1.0, f64::max)
 }
 
-/// Refuses scenes the kinematic-frame coupling cannot reproduce.
-pub fn can_represent(scene: &Scene) -> Result<(), ModelError> {
-    if let Some(f) = scene.frame {
-        for (i, b) in scene.balls.iter().enumerate() {
-            if hooks::wall_restitution(scene.restitution, f.mass, b.mass).is_none() {
-                return Err(ModelError::Refused(format!(
-                    "scene `{}`: {} ({} kg) is heavier than e x frame mass ({} kg): a kinematic frame cannot give \
-                     the two-body bounce of Eq. 9-10 for it; use --model reference",
-                    scene.name,
-                    Scene::body_name(Body::Ball(i)),
-                    crate::scene::human(b.mass),
-                    crate::scene::human(scene.restitution * f.mass)
-                )));
-            }
-        }
-    }
-    Ok(())
-}
-
 /// A headless app (no window, renderer or audio) simulating `scene`: one Rapier step per
 /// `app.update()`, never paced to real time.
 pub fn headless_app(scene: &Scene, settings: StepSettings) -> App {
@@ -165,7 +145,6 @@ pub fn simulate_within(scene: &Scene, record: Record, max_wall_s: Option<f64>) -
 const BUDGET_STEPS: u64 = 256;
 
 fn run_app(scene: &Scene, settings: StepSettings, record: Record, max_wall_s: Option<f64>) -> Result<Run, ModelError> {
-    can_represent(scene)?;
     let start = Instant::now();
     let mut app = headless_app_recording(scene, settings, record);
     // The first update spawns the scene, lets bevy_rapier create its bodies and takes the

@@ -8,7 +8,7 @@ use bevy::prelude::*;
 use bevy_rapier3d::prelude::*;
 use bevy_rapier3d::rapier::dynamics::IntegrationParameters;
 
-use super::hooks::{ContactRole, RestitutionConfig, RestitutionHooks};
+use super::impacts::resolve_impacts;
 use super::record::{feedback, record_samples};
 use super::resources::*;
 use super::stepping::plan_step;
@@ -28,6 +28,8 @@ pub struct DamperStep;
 /// once, for the lean [`DamperStep`] schedule and for Bevy's main schedules.
 #[derive(SystemSet, Debug, Clone, Copy, PartialEq, Eq, Hash)]
 pub enum DamperSet {
+    /// Before the Rapier step: resolve the impacts of touching pairs that approach.
+    Impacts,
     /// Before the Rapier step: choose its length.
     Plan,
     /// Before the Rapier step: move the kinematic frame to where the oscillator will be.
@@ -72,14 +74,14 @@ impl Plugin for DamperSchedulePlugin {
     fn build(&self, app: &mut App) {
         use DamperSet::*;
         app.init_schedule(DamperStep)
-            .configure_sets(DamperStep, (Plan, DriveFrame, Step, Feedback, Record).chain())
-            .configure_sets(Update, (Plan, DriveFrame).chain())
+            .configure_sets(DamperStep, (Impacts, Plan, DriveFrame, Step, Feedback, Record).chain())
+            .configure_sets(Update, (Impacts, Plan, DriveFrame).chain())
             .configure_sets(PostUpdate, (Feedback, Record).chain().after(PhysicsSet::Writeback));
     }
 }
 
-/// Rapier with fixed steps, centimetre tolerances, no gravity and the restitution hook; it
-/// plans each step and takes it.
+/// Rapier with fixed steps, centimetre tolerances and no gravity; it plans each step and
+/// takes it.
 pub struct ContactPhysicsPlugin {
     /// For the speed scale of the prediction distance and the frame mass of the hook.
     pub scene: Scene,
@@ -93,11 +95,7 @@ impl Plugin for ContactPhysicsPlugin {
         let rapier_configuration = RapierConfiguration { gravity: Vec3::ZERO, ..RapierConfiguration::new(LENGTH_UNIT) };
         app.insert_resource(TimestepMode::Fixed { dt: self.settings.dt as f32, substeps: 1 })
             .insert_resource(self.settings)
-            .insert_resource(RestitutionConfig {
-                restitution: self.scene.restitution,
-                frame_mass: self.scene.frame.map_or(f64::INFINITY, |f| f.mass),
-            })
-            .add_plugins(RapierPhysicsPlugin::<RestitutionHooks>::default().with_custom_initialization(
+            .add_plugins(RapierPhysicsPlugin::<()>::default().with_custom_initialization(
                 RapierContextInitialization::InitializeDefaultRapierContext { integration_parameters, rapier_configuration },
             ))
             .insert_resource(StepPlan { h: self.settings.dt, horizon: self.scene.horizon })
@@ -106,7 +104,7 @@ impl Plugin for ContactPhysicsPlugin {
                 DamperStep,
                 (
                     plan_step.in_set(DamperSet::Plan),
-                    bevy_rapier3d::plugin::systems::step_simulation::<RestitutionHooks>.in_set(DamperSet::Step),
+                    bevy_rapier3d::plugin::systems::step_simulation::<()>.in_set(DamperSet::Step),
                 ),
             );
     }
@@ -144,6 +142,9 @@ impl Plugin for SceneSpawnPlugin {
     }
 }
 
+/// Every contact Rapier solves is plastic: the plug-in gives the bounces (`super::impacts`).
+const PLASTIC: Restitution = Restitution { coefficient: 0.0, combine_rule: CoefficientCombineRule::Max };
+
 fn spawn_scene(mut commands: Commands, scene: Res<DamperScene>, settings: Res<StepSettings>) {
     let scene = &scene.0;
     let mut bodies = Bodies::default();
@@ -164,11 +165,10 @@ fn spawn_scene(mut commands: Commands, scene: Res<DamperScene>, settings: Res<St
                 for centre in [-half, c.length as f32 + half] {
                     walls.push(
                         p.spawn((
-                            ContactRole::Wall,
                             Transform::from_xyz(centre, 0.0, 0.0),
                             Collider::cuboid(half, side, side),
                             Friction { coefficient: 0.0, combine_rule: CoefficientCombineRule::Min },
-                            ActiveHooks::MODIFY_SOLVER_CONTACTS,
+                            PLASTIC,
                         ))
                         .id(),
                     );
@@ -178,12 +178,9 @@ fn spawn_scene(mut commands: Commands, scene: Res<DamperScene>, settings: Res<St
         bodies.frame = Some(frame);
         bodies.walls = Some((walls[0], walls[1]));
     }
-    for (i, (ball, (&x, &v))) in
-        scene.balls.iter().zip(scene.initial_positions.iter().zip(&scene.initial_velocities)).enumerate()
-    {
+    for (ball, (&x, &v)) in scene.balls.iter().zip(scene.initial_positions.iter().zip(&scene.initial_velocities)) {
         let id = commands
             .spawn((
-                ContactRole::Ball { index: i, mass: ball.mass },
                 RigidBody::Dynamic,
                 Transform::from_xyz(x as f32, 0.0, 0.0),
                 Velocity::linear(Vec3::new(v as f32, 0.0, 0.0)),
@@ -192,7 +189,7 @@ fn spawn_scene(mut commands: Commands, scene: Res<DamperScene>, settings: Res<St
                 Friction { coefficient: 0.0, combine_rule: CoefficientCombineRule::Min },
                 LockedAxes::ROTATION_LOCKED | LockedAxes::TRANSLATION_LOCKED_Y | LockedAxes::TRANSLATION_LOCKED_Z,
                 Sleeping::disabled(),
-                ActiveHooks::MODIFY_SOLVER_CONTACTS,
+                PLASTIC,
             ))
             .id();
         if settings.ccd {
@@ -278,7 +275,9 @@ impl Plugin for RecordPlugin {
         let record = self.record;
         app.add_systems(Startup, move |commands: Commands, scene: Res<DamperScene>| init_recording(commands, scene, record))
             .add_systems(PostUpdate, (feedback.in_set(DamperSet::Feedback), record_samples.in_set(DamperSet::Record)))
-            .add_systems(DamperStep, (feedback.in_set(DamperSet::Feedback), record_samples.in_set(DamperSet::Record)));
+            .add_systems(DamperStep, (feedback.in_set(DamperSet::Feedback), record_samples.in_set(DamperSet::Record)))
+            .add_systems(Update, resolve_impacts.in_set(DamperSet::Impacts))
+            .add_systems(DamperStep, resolve_impacts.in_set(DamperSet::Impacts));
     }
 }
 

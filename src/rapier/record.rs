@@ -6,8 +6,8 @@ use bevy::prelude::*;
 use bevy_rapier3d::prelude::*;
 use bevy_rapier3d::rapier::dynamics::RigidBodyHandle;
 
-use super::hooks::RestitutionConfig;
 use super::resources::{Bodies, DamperScene, FrameState, Recording, StepClock, StepPlan, StepSettings};
+use super::impacts::{pair_bodies, resolve_touching, Instant, PairImpact};
 use crate::run::Impact;
 use crate::scene::{Body, Scene};
 
@@ -53,6 +53,7 @@ pub struct Scratch {
     active: Vec<bool>,
     j: Vec<f64>,
     shares: Vec<f64>,
+    resolved: Vec<PairImpact>,
 }
 
 /// The after-step system, in named phases: read the balls (projecting sunk ones back), find
@@ -65,7 +66,6 @@ pub fn feedback(
     plan: Res<StepPlan>,
     settings: Res<StepSettings>,
     scene: Res<DamperScene>,
-    hook: Res<RestitutionConfig>,
     bodies: Option<Res<Bodies>>,
     frame: Option<ResMut<FrameState>>,
     mut rec: ResMut<Recording>,
@@ -81,7 +81,7 @@ pub fn feedback(
     clock.steps += 1;
     clock.t += plan.h;
     let Ok((sim, colliders, mut set)) = context.single_mut() else { return };
-    let Scratch { x: x_new, v: v_new, dp, active, j, handles, shares } = &mut *scratch;
+    let Scratch { x: x_new, v: v_new, dp, active, j, handles, shares, resolved } = &mut *scratch;
     if handles.len() != n {
         handles.clear();
         handles.extend(bodies.balls.iter().map(|e| set.entity2body()[e]));
@@ -95,7 +95,19 @@ pub fn feedback(
 
     let (frame_start, frame_end) = frame.as_ref().map_or(((0.0, 0.0), (0.0, 0.0)), |f| (f.start, f.before_impulses));
     let wall_v = (frame_end.0 - frame_start.0) / plan.h; // the kinematic velocity Rapier used
-    if restore_skipped_bounces(scene, &hook, rec, wall_v, j, v_new) {
+    let replaced = only_new_contacts(scene, rec, wall_v, j);
+    if replaced {
+        // Rapier only stopped pairs that closed in the step: the balls flew free until then.
+        // Discard its simultaneous plastic solve and resolve the impacts one pair at a time.
+        v_new.copy_from_slice(&rec.v);
+        let mut vs = frame_end.1;
+        let walls = scene.frame.zip(scene.container).map(|(f, c)| (frame_end.0, &mut vs, f.mass, c.length));
+        let mut now = Instant { x: x_new, v: v_new, frame: walls };
+        let floor = super::impacts::approach_floor(scene);
+        resolve_touching(scene, &mut now, |_| floor, resolved);
+        write_velocities(&mut set, handles, &bodies.balls, &mut velocities, v_new);
+        step_impulses(scene, v_new, &rec.v, active, dp, j);
+    } else if restore_bounces(scene, rec, wall_v, frame_end.1, j, dp, v_new) {
         write_velocities(&mut set, handles, &bodies.balls, &mut velocities, v_new);
         step_impulses(scene, v_new, &rec.v, active, dp, j);
     }
@@ -114,7 +126,11 @@ pub fn feedback(
         last_impulse: &mut rec.last_impulse,
         impulse_floor: rec.impulse_floor,
     };
-    attribute_impacts(ledger, scene, &step, &start, &rec.x, active, j, shares);
+    if replaced {
+        book_resolved(ledger, scene, &start, &rec.x, resolved, &mut rec.struck_at, clock.steps);
+    } else {
+        attribute_impacts(ledger, scene, &step, &start, &rec.x, active, j, shares);
+    }
     if settings.self_check && rec.failure.is_none() {
         rec.failure = self_check(scene, rec, x_new, v_new, frame_end.0, frame_post, forcing_work, t0 + plan.h);
     }
@@ -209,21 +225,93 @@ fn body_velocity(v: &[f64], frame_v: f64, body: isize) -> f64 {
     }
 }
 
-/// Phase 3: Rapier bounces a contact only when it carried no impulse the step before; rapier
-/// 0.35.0 leaves a stale impulse on a pair that separates within the prediction distance, so a
-/// genuinely new contact can be solved plastically. Where a pair that carried no impulse last
-/// step (by m dv) approached and was not bounced, apply the bounce Rapier skipped. Returns
-/// whether any velocity changed.
-fn restore_skipped_bounces(
+/// Phase 3a: whether every pair Rapier loaded in the step closed in it (carried no impulse the
+/// step before, approached at its start): then Rapier did nothing but stop them, and the
+/// plug-in may replace its solve.
+fn only_new_contacts(scene: &Scene, rec: &Recording, wall_v: f64, j: &[f64]) -> bool {
+    let n = scene.balls.len();
+    let mut any = false;
+    for p in 0..=n {
+        if j[p] <= rec.impulse_floor {
+            continue;
+        }
+        let (a, b) = (p as isize - 1, p as isize);
+        let u = body_velocity(&rec.v, wall_v, a) - body_velocity(&rec.v, wall_v, b);
+        if rec.last_impulse[p] > rec.impulse_floor {
+            return false;
+        }
+        any |= u > 0.0;
+    }
+    any
+}
+
+/// Phase 5 of a replaced solve: the impacts the plug-in resolved, each timed where its gap at
+/// the step's start closes at its approach speed.
+fn book_resolved(
+    ledger: ImpactLedger<'_>,
     scene: &Scene,
-    hook: &RestitutionConfig,
+    start: &StepStart,
+    x_before: &[f64],
+    resolved: &[PairImpact],
+    struck_at: &mut [Option<u64>],
+    step: u64,
+) {
+    let n = scene.balls.len();
+    let length = scene.container.map_or(0.0, |c| c.length);
+    let ImpactLedger { impacts, last_impact, last_impulse, .. } = ledger;
+    // The pairs are separating now: none carries a contact into the next step.
+    last_impulse.iter_mut().for_each(|j| *j = 0.0);
+    for hit in resolved {
+        let p = hit.pair;
+        let (a, b) = pair_bodies(p, n);
+        let edge = |body: isize, right: bool| -> f64 {
+            if body < 0 {
+                start.frame_x
+            } else if body >= n as isize {
+                start.frame_x + length
+            } else {
+                let r = scene.balls[body as usize].radius;
+                x_before[body as usize] + if right { r } else { -r }
+            }
+        };
+        let gap = edge(p as isize, false) - edge(p as isize - 1, true);
+        struck_at[p] = Some(step);
+        last_impact[p] = Some(impacts.len());
+        impacts.push(Impact {
+            t: start.t + (gap / hit.approach_speed).clamp(0.0, start.h),
+            a,
+            b,
+            approach_speed: hit.approach_speed,
+            energy_lost: hit.energy_lost,
+            impulses: 1,
+            peak_force: None,
+            contact_duration: None,
+        });
+    }
+}
+
+/// Phase 3: contacts that closed inside the step. Rapier holds every contact plastically (the
+/// plug-in resolves the impacts that land on a step's boundary before the step, `super::impacts`);
+/// a pair that carried no impulse last step, approached at the step's start and was loaded in
+/// it closed inside the step (fixed stepping, or an approach the planner could not end a step
+/// on). Give it the bounce of Eq. 9-10: the impulse that leaves it separating at `e` times its
+/// approach once the frame has taken the opposite of the balls' momentum change. Returns
+/// whether any velocity changed.
+#[allow(clippy::too_many_arguments)]
+fn restore_bounces(
+    scene: &Scene,
     rec: &Recording,
     wall_v: f64,
+    frame_v: f64,
     j: &[f64],
+    dp: &[f64],
     v_new: &mut [f64],
 ) -> bool {
     let n = scene.balls.len();
     let mass = |i: usize| scene.balls[i].mass;
+    let inv_frame = scene.frame.map_or(0.0, |f| 1.0 / f.mass);
+    // The frame's velocity once it has taken the step's impulses (and the bounces added here).
+    let mut frame_after = frame_v - dp.iter().sum::<f64>() * inv_frame;
     let mut corrected = false;
     for p in 0..=n {
         let (a, b) = (p as isize - 1, p as isize);
@@ -231,35 +319,27 @@ fn restore_skipped_bounces(
         if !(j[p] > rec.impulse_floor && rec.last_impulse[p] <= rec.impulse_floor && u > 0.0) {
             continue;
         }
-        let u_after = body_velocity(v_new, wall_v, a) - body_velocity(v_new, wall_v, b);
-        let (inv_a, inv_b) = (
-            if a >= 0 { 1.0 / mass(a as usize) } else { 0.0 },
-            if b < n as isize { 1.0 / mass(b as usize) } else { 0.0 },
-        );
-        let e = if a < 0 || b >= n as isize {
-            let ball = if a < 0 { b } else { a } as usize;
-            super::hooks::wall_restitution(hook.restitution, hook.frame_mass, mass(ball)).unwrap_or(0.0)
-        } else {
-            hook.restitution
-        };
-        // Rapier's own bounce leaves u_after = -e u; a plastic solve leaves about 0.
-        if u_after > -0.5 * e * u {
-            let dj = (e * u + u_after) / (inv_a + inv_b);
-            if a >= 0 {
-                v_new[a as usize] -= dj * inv_a;
-            }
-            if b < n as isize {
-                v_new[b as usize] += dj * inv_b;
-            }
-            corrected = true;
+        let u_after = body_velocity(v_new, frame_after, a) - body_velocity(v_new, frame_after, b);
+        let inv = |body: isize| if body < 0 || body >= n as isize { inv_frame } else { 1.0 / mass(body as usize) };
+        let dj = (scene.restitution * u + u_after) / (inv(a) + inv(b));
+        if dj <= 0.0 {
+            continue;
         }
+        // dj pushes `a` back and `b` on; a wall's share reaches the frame through `dp`.
+        for (body, sign) in [(a, -1.0), (b, 1.0)] {
+            if body >= 0 && body < n as isize {
+                v_new[body as usize] += sign * dj * inv(body);
+                frame_after -= sign * dj * inv_frame;
+            }
+        }
+        corrected = true;
     }
     corrected
 }
 
 /// Phase 3b: the corrected velocities into Rapier's bodies (rounded to what Rapier carries on
 /// with) and into the balls' `Velocity` components.
-fn write_velocities(
+pub(super) fn write_velocities(
     set: &mut RapierRigidBodySet,
     handles: &[RigidBodyHandle],
     balls: &[Entity],

@@ -86,11 +86,10 @@ pub struct StepClock {
     pub t: f64,
 }
 
-/// The fastest speed the scene is expected to reach: the frame's initial peak speed and the
-/// balls' initial speeds, doubled for what impacts can add.
+/// The fastest speed the scene is expected to reach: its motion speed (free swing, forced
+/// response, the balls' initial speeds), doubled for what impacts can add.
 pub fn speed_scale(scene: &Scene) -> f64 {
-    let frame = scene.frame.map_or(0.0, |f| (f.stiffness / f.mass).sqrt() * scene.initial_displacement.abs());
-    2.0 * scene.initial_velocities.iter().fold(frame, |m, v| m.max(v.abs()))
+    2.0 * scene.motion_speed()
 }
 
 /// The length of the step about to be taken, s.
@@ -123,6 +122,9 @@ pub struct Recording {
     pub last_impulse: Vec<f64>,
     /// Index in `impacts` of each pair's latest impact.
     pub last_impact: Vec<Option<usize>>,
+    /// The step count at which the plug-in last resolved an impact of each pair: a pair struck
+    /// again at the next step's start is one persistent contact, not a new impact.
+    pub struck_at: Vec<Option<u64>>,
     /// Next sample to write.
     pub next_sample: usize,
     /// Number of samples over the horizon.
@@ -152,6 +154,7 @@ impl Recording {
             prev_v: scene.initial_velocities.clone(),
             last_impulse: vec![0.0; n + 1],
             last_impact: vec![None; n + 1],
+            struck_at: vec![None; n + 1],
             next_sample: 0,
             sample_count: samples,
             impulse_floor: 1e-6 * m_min * speed_scale(scene).max(1e-6),

@@ -1,9 +1,10 @@
 //! Choosing each physics step. `Fixed` takes steps of `dt`. `Aligned` ends a step at the
 //! next contact, found with parry's time-of-impact queries, and otherwise takes steps of up to
 //! `dt`. Between impacts balls fly freely and the frame moves in closed form, so long steps
-//! lose nothing there, while each contact lands at a step boundary: Rapier then sees contacts
-//! one at a time, as new contacts that bounce, instead of several per step that it would treat
-//! plastically. Rapier still resolves every contact.
+//! lose nothing there, while each contact lands at a step boundary, where the plug-in resolves
+//! it with the two-body law before Rapier's next step (`super::impacts`). With `Fixed` steps a
+//! contact closes inside a step; Rapier holds it plastically and the plug-in adds the bounce
+//! afterwards (`super::record`), the impact up to a step late.
 
 use bevy::prelude::*;
 use bevy_rapier3d::parry::math::Pose;
@@ -14,8 +15,7 @@ use bevy_rapier3d::prelude::*;
 use super::resources::{DamperScene, FrameState, Recording, StepClock, StepPlan, StepSettings};
 use crate::scene::Stepping;
 
-/// Shortest step: a contact found at time-of-impact `toi` ends a step of `toi + MIN_STEP`, so
-/// that it closes within the step.
+/// Shortest step, s.
 pub const MIN_STEP: f64 = 1e-6;
 /// A wall contact is approached with a final step no longer than this, so that the wall's
 /// mean velocity over that step (what Rapier's contact sees) is its velocity at the impact.
@@ -28,7 +28,8 @@ pub const APPROACH_STEP: f64 = 2e-5;
 /// and bounces it before it touches. Approaching geometrically keeps every step clear of that
 /// until the one that ends at the contact.
 pub const APPROACH_RATIO: f64 = 2.2;
-/// Pairs closer than this are already in contact: Rapier handles them as resting contacts.
+/// Pairs closer than this are touching, m: a step ends when a pair approaching comes within
+/// half of it, and the plug-in resolves the impact before the next step (`super::impacts`).
 pub const TOUCHING: f32 = 1e-6;
 
 /// Sets the next step's length (and Rapier's fixed timestep to it).
@@ -63,7 +64,13 @@ fn aligned_step(scene: &crate::scene::Scene, x: &[f64], v: &[f64], frame: Option
     let n = x.len();
     let state = |i: usize| (Vec3::new(x[i] as f32, 0.0, 0.0), Vec3::new(v[i] as f32, 0.0, 0.0));
     // Look far enough ahead to start the geometric approach in time.
-    let options = ShapeCastOptions::with_max_time_of_impact((2.0 * APPROACH_RATIO * longest) as f32);
+    // The time at which a pair comes within half the touching distance, so that the step
+    // ends before Rapier's contact solve can touch the impact.
+    let options = ShapeCastOptions {
+        max_time_of_impact: (2.0 * APPROACH_RATIO * longest) as f32,
+        target_distance: 0.5 * TOUCHING,
+        ..Default::default()
+    };
     let mut ball_toi = f64::INFINITY;
     for i in 1..n {
         let ((p1, v1), (p2, v2)) = (state(i - 1), state(i));
@@ -113,7 +120,7 @@ fn aligned_step(scene: &crate::scene::Scene, x: &[f64], v: &[f64], frame: Option
     }
     let (toi, limit) = if wall_toi < ball_toi { (wall_toi, APPROACH_STEP.min(longest)) } else { (ball_toi, longest) };
     let h = if toi <= limit {
-        toi + MIN_STEP
+        toi
     } else {
         (toi / APPROACH_RATIO).min(longest)
     };

@@ -27,7 +27,6 @@
 mod events;
 mod exact;
 mod geometry;
-pub mod impact_law;
 mod output;
 mod search;
 mod segment;
@@ -42,7 +41,7 @@ use std::time::Instant;
 
 use crate::run::{EnergyAccount, Impact, Record, Recorder, Run};
 use crate::scene::{Body, Scene};
-pub use impact_law::impact_law;
+pub use crate::impact_law::impact_law;
 pub use crate::oscillator::Oscillator;
 use crate::oscillator::{gauss_legendre, Harmonic, ROUNDOFF_ULPS};
 
@@ -154,11 +153,6 @@ pub fn simulate_within(scene: &Scene, record: Record, max_wall_s: Option<f64>) -
     Ok(run)
 }
 
-/// Speed scale of base motion (`w Y`), 0 otherwise.
-fn base_motion_speed(scene: &Scene) -> f64 {
-    scene.forcing.filter(|g| g.kind == crate::scene::ForcingKind::Base).map_or(0.0, |g| g.omega() * g.amplitude)
-}
-
 /// Which wall a stuck ball is held by.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 enum Hold {
@@ -256,7 +250,6 @@ impl<'a> Solver<'a> {
             }
         };
         let length_scale = span_len.max(xs0.abs()).max(scene.balls.iter().map(|b| b.radius).fold(0.0, f64::max)).max(1e-9);
-        let bare_omega = osc.w0sq.sqrt();
         let time_scale = scene.frame.map_or(scene.horizon, |f| {
             let p = f.damped_period();
             if p > 0.0 {
@@ -266,11 +259,7 @@ impl<'a> Solver<'a> {
             }
         });
         let load = scene.harmonic_load();
-        let forced_speed =
-            load.map_or(0.0, |(p, q, w)| osc.harmonic_response(p, q, w).amplitude() * w + base_motion_speed(scene));
-        let speed_scale = (bare_omega * xs0.abs()).max(forced_speed)
-            .max(scene.initial_velocities.iter().fold(0.0, |m: f64, v| m.max(v.abs())))
-            .max(length_scale / scene.horizon);
+        let speed_scale = scene.motion_speed().max(length_scale / scene.horizon);
         let samples = scene.sample_count();
         // Where its metrics are exact the reference tallies no samples, and takes none unless
         // the series is kept.

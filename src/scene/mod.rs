@@ -259,6 +259,22 @@ impl Scene {
                 .sum::<f64>()
     }
 
+    /// The fastest motion the scene sets going, m/s: the frame's free swing from its initial
+    /// displacement (`w0 |xs0|`), its steady forced response (`w X`, plus `w Y` of a moving
+    /// base) and the balls' initial speeds. Impacts can add to it; models scale their
+    /// tolerances by it.
+    pub fn motion_speed(&self) -> f64 {
+        let frame = self.frame.map_or(0.0, |f| {
+            let osc = crate::oscillator::Oscillator::new(f.mass, f.damping, f.stiffness);
+            let forced = self.harmonic_load().map_or(0.0, |(p, q, w)| {
+                let base = self.forcing.filter(|g| g.kind == ForcingKind::Base).map_or(0.0, |g| g.omega() * g.amplitude);
+                osc.harmonic_response(p, q, w).amplitude() * w + base
+            });
+            (osc.w0sq.sqrt() * self.initial_displacement.abs()).max(forced)
+        });
+        self.initial_velocities.iter().fold(frame, |m: f64, v| m.max(v.abs()))
+    }
+
     /// The frame's harmonic load `(P, Q, w)` (see [`Forcing::harmonic_load`]), when forced.
     pub fn harmonic_load(&self) -> Option<(f64, f64, f64)> {
         let (f, g) = (self.frame?, self.forcing?);

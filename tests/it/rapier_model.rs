@@ -48,8 +48,9 @@ fn one_ball_ball_impact_follows_eq_9_10() {
     assert_relative_eq!(run.final_velocities[0], v1, max_relative = F32_SOLVE);
     assert_relative_eq!(run.final_velocities[1], v2, max_relative = F32_SOLVE);
     assert_relative_eq!(run.impacts[0].energy_lost, lost, max_relative = 1e-4);
-    // Aligned stepping puts the impact on a step boundary: its time is the exact one.
-    assert_relative_eq!(run.impacts[0].t, 0.001 / 0.5, max_relative = 1e-5);
+    // Aligned stepping ends a step as the gap closes to within the touching distance: the
+    // impact's time is the exact one to within the shortest step.
+    assert!((run.impacts[0].t - 0.001 / 0.5).abs() <= lpc_damper::rapier::stepping::MIN_STEP, "{:?}", run.impacts);
 }
 
 #[test]
@@ -130,10 +131,22 @@ fn lsl_meets_the_rms_target() {
     assert!(e.rms_xs <= 0.5e-3, "rms {:e} m", e.rms_xs);
 }
 
+/// Issue 14: a ball heavier than `e` times the frame was refused (no restitution against a
+/// kinematic wall gives Eq. 9-10 for it); the plug-in now resolves wall impacts with the
+/// frame's mass. Each impact conserves momentum, and the run follows the reference.
 #[test]
-fn heavy_ball_is_refused_with_a_reason() {
+fn heavy_ball_gets_the_two_body_law() {
     let frame = Frame { mass: 0.1, stiffness: 865.0, damping: 1.0 };
-    let scene = damper(frame, 0.01, &[0.11], 0.9, 0.004, 0.03, 1.0);
-    let err = Model::Rapier.simulate(&scene).unwrap_err().to_string();
-    assert!(err.contains("ball1") && err.contains("heavier"), "{err}");
+    let scene = damper(frame, 0.01, &[0.11], 0.9, 0.004, 0.005, 1.0);
+    let run = Model::Rapier.simulate(&scene).unwrap();
+    let reference = Model::Reference.simulate(&scene).unwrap();
+    assert!(!run.impacts.is_empty());
+    for (a, b) in run.impacts.iter().zip(&reference.impacts).take(3) {
+        assert_eq!((a.a, a.b), (b.a, b.b));
+        // The wall's velocity is taken at the end of the last approach step (at most
+        // `APPROACH_STEP` = 20 us): this light frame accelerates at up to 86 m/s^2, 1.7 mm/s
+        // over such a step, 5e-3 of a 0.36 m/s approach (measured: 1.2e-4 and 2.6e-3 in energy).
+        assert!((a.approach_speed / b.approach_speed - 1.0).abs() <= 5e-3, "{a:?} {b:?}");
+        assert!((a.energy_lost / b.energy_lost - 1.0).abs() <= 1e-2, "{a:?} {b:?}");
+    }
 }

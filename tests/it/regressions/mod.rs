@@ -5,6 +5,7 @@ mod check_bad_scene_exit_status;
 mod closed_pipe;
 mod ensemble_without_tolerances;
 mod forced_ball_through_wall;
+mod issue_14_touching_chain;
 mod loaded_contact_sinks;
 mod plugin_driven_by_app_update;
 mod series_beyond_memory;

@@ -1,5 +1,5 @@
-//! The paper's impact law (docs/MODEL.md §3, Eq. 9-10): kinematic coefficient of restitution,
-//! momentum conserved, `(1 - e^2)/2 * mu * (v1 - v2)^2` of kinetic energy lost.
+//! The impact law of the impulse models (docs/MODEL.md §3, Eq. 9-10): kinematic coefficient of
+//! restitution, momentum conserved, `(1 - e^2)/2 * mu * (v1 - v2)^2` of kinetic energy lost.
 
 /// Velocities after an impact of body 1 (mass `m1`, velocity `v1`) with body 2, and the energy
 /// lost. Either mass may be infinite (a rigid wall). `e` is the coefficient of restitution.

@@ -1,0 +1,312 @@
+//! Before each Rapier step: the impacts of touching pairs that approach, resolved by the plug-in
+//! with the two-body law of docs/MODEL.md §3 (Eq. 9-10), one pair at a time, the fastest
+//! approach first, until no touching pair approaches (the sequential reading of simultaneous
+//! impacts, as in the reference).
+//!
+//! Rapier itself is left only what it does well, keeping bodies apart: every contact it solves
+//! is plastic (restitution 0). Three things it cannot do, and why the plug-in does them here:
+//! - a chain of touching balls struck at one end: Rapier's solve is simultaneous, so the pairs
+//!   that touched at rest keep a relative velocity of zero and the chain moves off as one block
+//!   instead of passing the momentum along as Newton's cradle does (and stays glued for good:
+//!   on `forced-lsl` at 3 Hz the three balls became one lump after 6 s);
+//! - a contact that persists: Rapier bounces a contact only in the step it is new, so a ball
+//!   that stays within its prediction distance of a wall is struck plastically ever after;
+//! - a wall impact with the frame's finite mass: the frame is kinematic in Rapier, infinitely
+//!   heavy, and no restitution against it gives Eq. 9-10 for a ball heavier than `e` times the
+//!   frame, or for `e = 0`; here the frame's mass enters the law itself.
+//!
+//! Pairs that carried a contact impulse in the last step and approach slower than the frame's
+//! acceleration can explain over a step are persistent contacts (a ball riding the wall, a
+//! squeezed pack): Rapier holds them plastically, which is the reference's persistent-contact
+//! rule (docs/MODEL.md §4) at the scale of a step.
+
+use bevy::prelude::*;
+use bevy_rapier3d::prelude::*;
+
+use super::resources::{Bodies, DamperScene, FrameState, Recording, StepClock, StepPlan};
+use crate::impact_law::impact_law;
+use crate::run::Impact;
+use crate::scene::{Body, Scene};
+
+/// Pairs closer than this are touching, m (the same tolerance the step planner aims at).
+pub const TOUCHING: f64 = super::stepping::TOUCHING as f64;
+/// Pair impacts resolved at one instant at most, per pair of the chain: a light ball squeezed
+/// between heavy bodies bounces ever faster (inelastic collapse); past this the rest of the
+/// approach is left to Rapier's plastic solve.
+pub const MAX_SEQUENTIAL_PER_PAIR: usize = 64;
+
+/// One impact resolved before a step.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct PairImpact {
+    /// Pair index: between body `pair - 1` and body `pair` (body `-1` the left wall, `n` the right).
+    pub pair: usize,
+    /// Relative speed of approach before, m/s.
+    pub approach_speed: f64,
+    /// Kinetic energy lost, J.
+    pub energy_lost: f64,
+    /// Gap across the pair when resolved (at most [`TOUCHING`]; negative if overlapping), m.
+    pub gap: f64,
+}
+
+/// The bodies at one instant: the balls' positions and velocities, and the frame's
+/// displacement, velocity and mass when there are walls.
+pub struct Instant<'a> {
+    /// Ball positions, m.
+    pub x: &'a [f64],
+    /// Ball velocities, m/s (changed in place).
+    pub v: &'a mut [f64],
+    /// `(xs, vs, ms, container length)` when the balls are in a container on a frame.
+    pub frame: Option<(f64, &'a mut f64, f64, f64)>,
+}
+
+impl Instant<'_> {
+    fn n(&self) -> usize {
+        self.x.len()
+    }
+
+    /// Gap across `pair`, m (`None` for a wall pair without walls).
+    fn gap(&self, scene: &Scene, pair: usize) -> Option<f64> {
+        let n = self.n();
+        let r = |i: usize| scene.balls[i].radius;
+        match (pair, &self.frame) {
+            (0, Some((xs, ..))) if n > 0 => Some(self.x[0] - r(0) - xs),
+            (p, Some((xs, _, _, length))) if p == n && n > 0 => Some(xs + length - self.x[n - 1] - r(n - 1)),
+            (p, _) if p > 0 && p < n => Some(self.x[p] - r(p) - self.x[p - 1] - r(p - 1)),
+            _ => None,
+        }
+    }
+
+    /// Mass and velocity of body `body` (-1 and n are the frame).
+    fn body(&self, scene: &Scene, body: isize) -> (f64, f64) {
+        if body < 0 || body as usize >= self.n() {
+            let (_, vs, ms, _) = self.frame.as_ref().expect("a wall pair has a frame");
+            (*ms, **vs)
+        } else {
+            (scene.balls[body as usize].mass, self.v[body as usize])
+        }
+    }
+
+    fn set_velocity(&mut self, body: isize, v: f64) {
+        if body < 0 || body as usize >= self.n() {
+            if let Some((_, vs, ..)) = self.frame.as_mut() {
+                **vs = v;
+            }
+        } else {
+            self.v[body as usize] = v;
+        }
+    }
+}
+
+/// Resolves the impacts of the touching pairs of `now` that approach faster than
+/// `threshold(pair)`, fastest first, each with Eq. 9-10; returns them in the order resolved.
+pub fn resolve_touching(
+    scene: &Scene,
+    now: &mut Instant<'_>,
+    threshold: impl Fn(usize) -> f64,
+    out: &mut Vec<PairImpact>,
+) {
+    out.clear();
+    let n = now.n();
+    let touching = |p: &usize| now.gap(scene, *p).is_some_and(|g| g <= TOUCHING);
+    let count = (0..=n).filter(touching).count();
+    let budget = MAX_SEQUENTIAL_PER_PAIR * count;
+    for _ in 0..budget {
+        let fastest = (0..=n)
+            .filter(|p| now.gap(scene, *p).is_some_and(|g| g <= TOUCHING))
+            .map(|p| {
+                let ((_, va), (_, vb)) = (now.body(scene, p as isize - 1), now.body(scene, p as isize));
+                (p, va - vb)
+            })
+            .filter(|&(p, u)| u > threshold(p))
+            .max_by(|a, b| a.1.total_cmp(&b.1));
+        let Some((p, u)) = fastest else { return };
+        let gap = now.gap(scene, p).unwrap_or(0.0);
+        let (a, b) = (p as isize - 1, p as isize);
+        let ((ma, va), (mb, vb)) = (now.body(scene, a), now.body(scene, b));
+        let (va2, vb2, lost) = impact_law(ma, va, mb, vb, scene.restitution);
+        now.set_velocity(a, va2);
+        now.set_velocity(b, vb2);
+        out.push(PairImpact { pair: p, approach_speed: u, energy_lost: lost, gap });
+    }
+}
+
+/// The body on the left (`a`) and right (`b`) of `pair` in a chain of `n` balls.
+pub fn pair_bodies(pair: usize, n: usize) -> (Body, Body) {
+    let body = |i: isize| {
+        if i < 0 {
+            Body::LeftWall
+        } else if i as usize >= n {
+            Body::RightWall
+        } else {
+            Body::Ball(i as usize)
+        }
+    };
+    (body(pair as isize - 1), body(pair as isize))
+}
+
+/// Persistent contacts approach slower than this many times what the frame's largest
+/// acceleration builds over the last step.
+pub const PERSISTENT_APPROACH: f64 = 2.0;
+/// Approaches slower than this fraction of the scene's speed scale are round-off (f32
+/// velocities in Rapier).
+pub const APPROACH_FLOOR: f64 = 1e-6;
+
+/// Approaches slower than this are round-off, m/s.
+pub fn approach_floor(scene: &Scene) -> f64 {
+    APPROACH_FLOOR * super::resources::speed_scale(scene)
+}
+
+/// The system: resolves the impacts of the touching pairs at the start of the step, writes
+/// the new velocities into Rapier's bodies and the balls' `Velocity`, the frame's into its
+/// state, and books the impacts.
+#[allow(clippy::too_many_arguments)]
+pub fn resolve_impacts(
+    clock: Res<StepClock>,
+    plan: Res<StepPlan>,
+    scene: Res<DamperScene>,
+    mut frame: Option<ResMut<FrameState>>,
+    bodies: Option<Res<Bodies>>,
+    mut rec: ResMut<Recording>,
+    mut sets: Query<&mut RapierRigidBodySet>,
+    mut velocities: Query<&mut Velocity>,
+    mut resolved: Local<Vec<PairImpact>>,
+) {
+    let Some(bodies) = bodies else { return };
+    let scene = &scene.0;
+    let n = scene.balls.len();
+    let floor = approach_floor(scene);
+    let stick = floor.max(PERSISTENT_APPROACH * super::peak_frame_acceleration(scene) * plan.h);
+    let Recording { x, v, last_impulse, impulse_floor, impacts, last_impact, struck_at, impact_loss, .. } = &mut *rec;
+    let threshold = |p: usize| if last_impulse[p] > *impulse_floor { stick } else { floor };
+    let walls = frame.as_deref_mut().zip(scene.frame).zip(scene.container);
+    let mut now = Instant { x, v, frame: walls.map(|((f, sf), c)| (f.now.0, &mut f.now.1, sf.mass, c.length)) };
+    resolve_touching(scene, &mut now, threshold, &mut resolved);
+    if resolved.is_empty() {
+        return;
+    }
+    for hit in resolved.iter() {
+        *impact_loss += hit.energy_lost;
+        let persists = struck_at[hit.pair].is_some_and(|s| s + 1 >= clock.steps);
+        struck_at[hit.pair] = Some(clock.steps);
+        if let (true, Some(k)) = (persists, last_impact[hit.pair]) {
+            impacts[k].energy_lost += hit.energy_lost;
+            impacts[k].impulses += 1;
+            continue;
+        }
+        let (a, b) = pair_bodies(hit.pair, n);
+        last_impact[hit.pair] = Some(impacts.len());
+        impacts.push(Impact {
+            // The steps end just short of contact: the impact is when the gap closes.
+            t: clock.t + hit.gap.max(0.0) / hit.approach_speed,
+            a,
+            b,
+            approach_speed: hit.approach_speed,
+            energy_lost: hit.energy_lost,
+            impulses: 1,
+            peak_force: None,
+            contact_duration: None,
+        });
+    }
+    // Before the first step bevy_rapier has not made the bodies yet: it will from `Velocity`.
+    if let Ok(mut set) = sets.single_mut() {
+        let handles: Vec<_> = bodies.balls.iter().map(|e| set.entity2body().get(e).copied()).collect();
+        if handles.iter().all(Option::is_some) {
+            let handles: Vec<_> = handles.into_iter().flatten().collect();
+            super::record::write_velocities(&mut set, &handles, &bodies.balls, &mut velocities, v);
+            return;
+        }
+    }
+    for (ball, &vi) in bodies.balls.iter().zip(v.iter()) {
+        if let Ok(mut velocity) = velocities.get_mut(*ball) {
+            velocity.linear.x = vi as f32;
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::scene::{Ball, BallKind, Container, Frame, Scene};
+    use approx::assert_relative_eq;
+
+    /// Three steel balls of `mass`, touching, in a container on a frame of `frame_mass`.
+    fn touching_balls(masses: &[f64], e: f64, frame_mass: f64) -> Scene {
+        let balls: Vec<Ball> = masses
+            .iter()
+            .map(|&m| Ball { mass: m, radius: crate::scene::ball_radius(m, 8000.0), kind: BallKind::Custom })
+            .collect();
+        let mut x = 0.0;
+        let positions = balls
+            .iter()
+            .map(|b| {
+                x += 2.0 * b.radius;
+                x - b.radius
+            })
+            .collect();
+        Scene {
+            name: "touching".into(),
+            frame: Some(Frame { mass: frame_mass, stiffness: 100.0, damping: 0.0 }),
+            container: Some(Container { length: x + 0.01, gap: 0.0, clearance: 0.01 }),
+            initial_velocities: vec![0.0; balls.len()],
+            reference_radius: balls[0].radius,
+            balls,
+            restitution: e,
+            initial_displacement: 0.0,
+            initial_positions: positions,
+            horizon: 1.0,
+            sample_dt: 1e-3,
+            rapier: Default::default(),
+            compliant: Default::default(),
+            forcing: None,
+        }
+    }
+
+    /// A ball strikes two equal balls touching at rest at e = 1: the momentum passes along
+    /// (Newton's cradle), where a simultaneous solve would move the two off as one block.
+    #[test]
+    fn touching_chain_passes_the_momentum_along() {
+        let s = touching_balls(&[0.11, 0.11, 0.11], 1.0, 1.35);
+        let (x, mut v) = (s.initial_positions.clone(), vec![0.5, 0.0, 0.0]);
+        let mut out = Vec::new();
+        resolve_touching(&s, &mut Instant { x: &x, v: &mut v, frame: None }, |_| 0.0, &mut out);
+        assert_eq!(out.iter().map(|i| i.pair).collect::<Vec<_>>(), vec![1, 2]);
+        assert_eq!(v, vec![0.0, 0.0, 0.5]);
+        assert_eq!(out.iter().map(|i| i.energy_lost).sum::<f64>(), 0.0);
+    }
+
+    /// A wall impact uses the frame's mass: a ball heavier than `e` times the frame (which no
+    /// restitution against a kinematic wall can give) gets Eq. 9-10, momentum conserved.
+    #[test]
+    fn wall_impact_uses_the_frame_mass() {
+        let s = touching_balls(&[0.11], 0.5, 0.05);
+        let length = s.container.unwrap().length;
+        let (x, mut v, mut vs) = (s.initial_positions.clone(), vec![-0.3], 0.2);
+        let mut out = Vec::new();
+        resolve_touching(&s, &mut Instant { x: &x, v: &mut v, frame: Some((0.0, &mut vs, 0.05, length)) }, |_| 0.0, &mut out);
+        let (vf, vb, lost) = impact_law(0.05, 0.2, 0.11, -0.3, 0.5);
+        assert_eq!(out, vec![PairImpact { pair: 0, approach_speed: 0.5, energy_lost: lost, gap: 0.0 }]);
+        assert_eq!((v[0], vs), (vb, vf));
+        assert_relative_eq!(0.11 * v[0] + 0.05 * vs, 0.11 * -0.3 + 0.05 * 0.2, max_relative = 1e-15);
+    }
+
+    /// A plastic (e = 0) ball squeezed between another and the wall: the sequence ends with
+    /// nothing approaching, all three at one velocity, momentum kept. (Each cycle of the
+    /// sequence leaves `m2 / (m1 + m2)` of the approach: 1/2 here, so the budget of 64 cycles
+    /// converges to round-off; a ball 10 times lighter would leave 0.91^64 = 2e-3 of it to
+    /// Rapier's plastic solve.)
+    #[test]
+    fn plastic_squeeze_ends_at_a_common_velocity() {
+        let s = touching_balls(&[0.11, 0.11], 0.0, 1.35);
+        let length = s.container.unwrap().length;
+        let (x, mut v, mut vs) = (s.initial_positions.clone(), vec![0.0, -0.4], 0.0);
+        let mut out = Vec::new();
+        resolve_touching(&s, &mut Instant { x: &x, v: &mut v, frame: Some((0.0, &mut vs, 1.35, length)) }, |_| 0.0, &mut out);
+        let common = 0.11 * -0.4 / (0.11 + 0.11 + 1.35);
+        assert_relative_eq!(v[0], common, max_relative = 1e-12);
+        assert_relative_eq!(v[1], common, max_relative = 1e-12);
+        assert_relative_eq!(vs, common, max_relative = 1e-12);
+        let lost: f64 = out.iter().map(|i| i.energy_lost).sum();
+        let ke = |m: f64, v: f64| 0.5 * m * v * v;
+        assert_relative_eq!(lost, ke(0.11, -0.4) - ke(0.11 + 0.11 + 1.35, common), max_relative = 1e-12);
+    }
+}
