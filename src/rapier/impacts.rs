@@ -66,14 +66,7 @@ impl Instant<'_> {
 
     /// Gap across `pair`, m (`None` for a wall pair without walls).
     fn gap(&self, scene: &Scene, pair: usize) -> Option<f64> {
-        let n = self.n();
-        let r = |i: usize| scene.balls[i].radius;
-        match (pair, &self.frame) {
-            (0, Some((xs, ..))) if n > 0 => Some(self.x[0] - r(0) - xs),
-            (p, Some((xs, _, _, length))) if p == n && n > 0 => Some(xs + length - self.x[n - 1] - r(n - 1)),
-            (p, _) if p > 0 && p < n => Some(self.x[p] - r(p) - self.x[p - 1] - r(p - 1)),
-            _ => None,
-        }
+        pair_gap(scene, self.x, self.frame.as_ref().map(|(xs, _, _, length)| (*xs, *length)), pair)
     }
 
     /// Mass and velocity of body `body` (-1 and n are the frame).
@@ -105,6 +98,17 @@ pub fn resolve_touching(
     threshold: impl Fn(usize) -> f64,
     out: &mut Vec<PairImpact>,
 ) {
+    resolve_touching_with(scene, scene.restitution, now, threshold, out)
+}
+
+/// [`resolve_touching`] with restitution `e` (0 holds the pairs together).
+pub fn resolve_touching_with(
+    scene: &Scene,
+    e: f64,
+    now: &mut Instant<'_>,
+    threshold: impl Fn(usize) -> f64,
+    out: &mut Vec<PairImpact>,
+) {
     out.clear();
     let n = now.n();
     let touching = |p: &usize| now.gap(scene, *p).is_some_and(|g| g <= TOUCHING);
@@ -123,10 +127,23 @@ pub fn resolve_touching(
         let gap = now.gap(scene, p).unwrap_or(0.0);
         let (a, b) = (p as isize - 1, p as isize);
         let ((ma, va), (mb, vb)) = (now.body(scene, a), now.body(scene, b));
-        let (va2, vb2, lost) = impact_law(ma, va, mb, vb, scene.restitution);
+        let (va2, vb2, lost) = impact_law(ma, va, mb, vb, e);
         now.set_velocity(a, va2);
         now.set_velocity(b, vb2);
         out.push(PairImpact { pair: p, approach_speed: u, energy_lost: lost, gap });
+    }
+}
+
+/// Gap across `pair` for balls at `x` and walls at `(xs, container length)`, m (`None` for a
+/// wall pair without walls).
+pub fn pair_gap(scene: &Scene, x: &[f64], walls: Option<(f64, f64)>, pair: usize) -> Option<f64> {
+    let n = x.len();
+    let r = |i: usize| scene.balls[i].radius;
+    match (pair, walls) {
+        (0, Some((xs, _))) if n > 0 => Some(x[0] - r(0) - xs),
+        (p, Some((xs, length))) if p == n && n > 0 => Some(xs + length - x[n - 1] - r(n - 1)),
+        (p, _) if p > 0 && p < n => Some(x[p] - r(p) - x[p - 1] - r(p - 1)),
+        _ => None,
     }
 }
 

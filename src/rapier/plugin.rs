@@ -142,6 +142,17 @@ impl Plugin for SceneSpawnPlugin {
     }
 }
 
+/// How much smaller Rapier's balls are than the scene's, m: four f32 steps of the largest
+/// coordinate. Balls that touch in the scene then do not overlap in f32, where Rapier would push
+/// them apart and make energy from round-off (a packed column at rest started moving). Impacts
+/// are found and resolved on the scene's radii (`super::stepping`, `super::impacts`); only
+/// Rapier's resting contacts sit this much deeper.
+pub fn collider_skin(scene: &Scene) -> f64 {
+    let extent = scene.container.map_or(0.0, |c| c.length) + scene.initial_displacement.abs();
+    let reach = scene.initial_positions.iter().zip(&scene.balls).map(|(x, b)| x.abs() + b.radius).fold(extent, f64::max);
+    4.0 * f32::EPSILON as f64 * reach
+}
+
 /// Every contact Rapier solves is plastic: the plug-in gives the bounces (`super::impacts`).
 const PLASTIC: Restitution = Restitution { coefficient: 0.0, combine_rule: CoefficientCombineRule::Max };
 
@@ -178,13 +189,14 @@ fn spawn_scene(mut commands: Commands, scene: Res<DamperScene>, settings: Res<St
         bodies.frame = Some(frame);
         bodies.walls = Some((walls[0], walls[1]));
     }
+    let skin = collider_skin(scene);
     for (ball, (&x, &v)) in scene.balls.iter().zip(scene.initial_positions.iter().zip(&scene.initial_velocities)) {
         let id = commands
             .spawn((
                 RigidBody::Dynamic,
                 Transform::from_xyz(x as f32, 0.0, 0.0),
                 Velocity::linear(Vec3::new(v as f32, 0.0, 0.0)),
-                Collider::ball(ball.radius as f32),
+                Collider::ball((ball.radius - skin) as f32),
                 ColliderMassProperties::Mass(ball.mass as f32),
                 Friction { coefficient: 0.0, combine_rule: CoefficientCombineRule::Min },
                 LockedAxes::ROTATION_LOCKED | LockedAxes::TRANSLATION_LOCKED_Y | LockedAxes::TRANSLATION_LOCKED_Z,
@@ -228,7 +240,7 @@ fn init_frame(mut commands: Commands, scene: Res<DamperScene>) {
 
 /// Moves the frame to where the closed form puts it at the end of the coming step; Rapier
 /// gives it the step's mean velocity for its contacts. (Before the first step Rapier has not
-/// created the body yet; the walls are far from every ball then.)
+/// created the body yet: that step is `MIN_STEP` long, see `stepping::plan_step`.)
 pub fn drive_frame(
     plan: Res<StepPlan>,
     clock: Res<StepClock>,
@@ -273,7 +285,9 @@ impl Plugin for RecordPlugin {
         // Passed in the system, not as a resource: adding a resource reorders what Bevy
         // iterates, and the contact model's chaotic runs follow any change of order.
         let record = self.record;
-        app.add_systems(Startup, move |commands: Commands, scene: Res<DamperScene>| init_recording(commands, scene, record))
+        app.add_systems(Startup, move |commands: Commands, scene: Res<DamperScene>, settings: Res<StepSettings>| {
+            init_recording(commands, scene, settings, record)
+        })
             .add_systems(PostUpdate, (feedback.in_set(DamperSet::Feedback), record_samples.in_set(DamperSet::Record)))
             .add_systems(DamperStep, (feedback.in_set(DamperSet::Feedback), record_samples.in_set(DamperSet::Record)))
             .add_systems(Update, resolve_impacts.in_set(DamperSet::Impacts))
@@ -281,7 +295,7 @@ impl Plugin for RecordPlugin {
     }
 }
 
-fn init_recording(mut commands: Commands, scene: Res<DamperScene>, record: Record) {
+fn init_recording(mut commands: Commands, scene: Res<DamperScene>, settings: Res<StepSettings>, record: Record) {
     commands.insert_resource(StepClock::default());
-    commands.insert_resource(Recording::new(&scene.0, record));
+    commands.insert_resource(Recording::new(&scene.0, record, settings.dt));
 }

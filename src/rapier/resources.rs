@@ -136,11 +136,16 @@ pub struct Recording {
     pub failure: Option<String>,
     /// The scene's mechanical energy at t = 0, J.
     pub initial_energy: f64,
+    /// Energy that f32 positions cannot resolve, J: every ball moving by one f32 step of the
+    /// container's extent per longest step. Rapier pushing apart balls that touch within
+    /// round-off (a packed column at rest) makes about this much; energy checks are judged
+    /// above it.
+    pub energy_floor: f64,
 }
 
 impl Recording {
     /// An empty recording for `scene` that keeps what `record` asks for.
-    pub fn new(scene: &Scene, record: Record) -> Self {
+    pub fn new(scene: &Scene, record: Record, longest_step: f64) -> Self {
         let n = scene.balls.len();
         let samples = scene.sample_count();
         let m_min = scene.balls.iter().map(|b| b.mass).fold(f64::INFINITY, f64::min);
@@ -160,6 +165,11 @@ impl Recording {
             impulse_floor: 1e-6 * m_min * speed_scale(scene).max(1e-6),
             failure: None,
             initial_energy: scene.initial_energy(),
+            energy_floor: {
+                let extent = scene.container.map_or(0.0, |c| c.length) + scene.initial_displacement.abs();
+                let v = f32::EPSILON as f64 * extent / longest_step;
+                0.5 * scene.balls.iter().map(|b| b.mass).sum::<f64>() * v * v
+            },
         }
     }
 }

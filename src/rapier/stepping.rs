@@ -50,6 +50,12 @@ pub fn plan_step(
             h = aligned_step(&scene.0, &rec.x, &rec.v, frame.as_deref(), settings.dt);
         }
     }
+    // bevy_rapier creates the bodies during the first update, after the frame is driven: the
+    // walls stay where they start for that step. Keep it too short for the frame to move
+    // (a ball that fits its container exactly was struck by the walls' jump a step later).
+    if clock.steps == 0 {
+        h = MIN_STEP;
+    }
     // Land exactly on the horizon rather than leave a sliver of a step.
     if remaining <= h * (1.0 + 1e-9) {
         h = remaining.max(MIN_STEP);
