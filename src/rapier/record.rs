@@ -264,24 +264,14 @@ fn book_resolved(
     step: u64,
 ) {
     let n = scene.balls.len();
-    let length = scene.container.map_or(0.0, |c| c.length);
+    let walls = scene.frame.and(scene.container).map(|c| (start.frame_x, c.length));
     let ImpactLedger { impacts, last_impact, last_impulse, .. } = ledger;
     // The pairs are separating now: none carries a contact into the next step.
     last_impulse.iter_mut().for_each(|j| *j = 0.0);
     for hit in resolved {
         let p = hit.pair;
         let (a, b) = pair_bodies(p, n);
-        let edge = |body: isize, right: bool| -> f64 {
-            if body < 0 {
-                start.frame_x
-            } else if body >= n as isize {
-                start.frame_x + length
-            } else {
-                let r = scene.balls[body as usize].radius;
-                x_before[body as usize] + if right { r } else { -r }
-            }
-        };
-        let gap = edge(p as isize, false) - edge(p as isize - 1, true);
+        let gap = pair_gap(scene, x_before, walls, p).unwrap_or(0.0);
         struck_at[p] = Some(step);
         last_impact[p] = Some(impacts.len());
         impacts.push(Impact {
@@ -463,17 +453,7 @@ fn attribute_impacts(
     shares: &mut Vec<f64>,
 ) {
     let n = scene.balls.len();
-    let length = scene.container.map_or(0.0, |c| c.length);
-    let edge = |body: isize, right: bool| -> f64 {
-        if body < 0 {
-            start.frame_x
-        } else if body >= n as isize {
-            start.frame_x + length
-        } else {
-            let r = scene.balls[body as usize].radius;
-            x_before[body as usize] + if right { r } else { -r }
-        }
-    };
+    let walls = scene.frame.and(scene.container).map(|c| (start.frame_x, c.length));
     // Each pair's share of the step's loss, `j (u + u') / 2`; the shares sum to the step's
     // loss. Rapier solves touching contacts together, and the split of one simultaneous solve
     // among its pairs is not physical (a pair can appear to gain while the step loses): when
@@ -488,7 +468,6 @@ fn attribute_impacts(
     let split = total >= 0.0 && gross > 0.0 && shares.iter().any(|x| *x < 0.0);
     let ImpactLedger { impacts, last_impact, last_impulse, impulse_floor } = ledger;
     for p in 0..=n {
-        let (a, b) = (p as isize - 1, p as isize);
         if !active[p] && j[p] == 0.0 {
             last_impulse[p] = 0.0;
             continue;
@@ -497,12 +476,12 @@ fn attribute_impacts(
         let lost = if split { shares[p].max(0.0) * total / gross } else { shares[p] };
         let starts = j[p] > impulse_floor && last_impulse[p] <= impulse_floor && u > 0.0;
         if starts {
-            let gap = edge(b, false) - edge(a, true);
+            let gap = pair_gap(scene, x_before, walls, p).unwrap_or(0.0);
             last_impact[p] = Some(impacts.len());
             impacts.push(Impact {
                 t: start.t + (gap / u).clamp(0.0, start.h),
-                a: body_of(a, n),
-                b: body_of(b, n),
+                a: pair_bodies(p, n).0,
+                b: pair_bodies(p, n).1,
                 approach_speed: u,
                 energy_lost: lost,
                 impulses: 1,
@@ -610,16 +589,6 @@ pub fn project_inside(x: &mut [f64], balls: &[crate::scene::Ball], left: f64, le
         edge = x[i] - b.radius;
     }
     moved
-}
-
-fn body_of(body: isize, n: usize) -> Body {
-    if body < 0 {
-        Body::LeftWall
-    } else if body as usize >= n {
-        Body::RightWall
-    } else {
-        Body::Ball(body as usize)
-    }
 }
 
 /// Writes the samples that fall in the step just taken: the frame exactly (closed form from the
