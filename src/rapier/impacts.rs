@@ -161,8 +161,8 @@ pub fn pair_bodies(pair: usize, n: usize) -> (Body, Body) {
     (body(pair as isize - 1), body(pair as isize))
 }
 
-/// Persistent contacts approach slower than this many times what the frame's largest
-/// acceleration builds over the last step.
+/// Persistent contacts approach slower than this many times what the frame's acceleration
+/// builds over the last step.
 pub const PERSISTENT_APPROACH: f64 = 2.0;
 /// Approaches slower than this fraction of the scene's speed scale are round-off (f32
 /// velocities in Rapier).
@@ -192,7 +192,12 @@ pub fn resolve_impacts(
     let scene = &scene.0;
     let n = scene.balls.len();
     let floor = approach_floor(scene);
-    let stick = floor.max(PERSISTENT_APPROACH * super::peak_frame_acceleration(scene) * plan.h);
+    // What the frame's acceleration now builds over the last step: a slower approach of a
+    // loaded pair is the wall or the chain pressing on, not a new impact.
+    let acceleration = frame.as_deref().zip(scene.frame).map_or(0.0, |(f, sf)| {
+        (scene.frame_force(clock.t, f.now.0, f.now.1) / sf.mass).abs()
+    });
+    let stick = floor.max(PERSISTENT_APPROACH * acceleration * plan.h);
     let Recording { x, v, last_impulse, impulse_floor, impacts, last_impact, struck_at, impact_loss, .. } = &mut *rec;
     let threshold = |p: usize| if last_impulse[p] > *impulse_floor { stick } else { floor };
     let walls = frame.as_deref_mut().zip(scene.frame).zip(scene.container);
