@@ -134,6 +134,43 @@ pub fn resolve_touching_with(
     }
 }
 
+/// Where resolved impacts are booked.
+pub struct Ledger<'a> {
+    /// The run's impacts.
+    pub impacts: &'a mut Vec<Impact>,
+    /// Each pair's latest impact.
+    pub last_impact: &'a mut [Option<usize>],
+    /// The step in which each pair was last struck.
+    pub struck_at: &'a mut [Option<u64>],
+}
+
+/// Books `hit`, at time `t`, in step `step`: a pair struck again in the same step or the next
+/// (a sequence at one instant, a squeeze) adds to its latest impact, as one persistent
+/// contact; otherwise it is a new impact.
+pub fn book(ledger: Ledger<'_>, n: usize, hit: &PairImpact, t: f64, step: u64) {
+    let Ledger { impacts, last_impact, struck_at, .. } = ledger;
+    let p = hit.pair;
+    let persists = struck_at[p].is_some_and(|s| s + 1 >= step);
+    struck_at[p] = Some(step);
+    if let (true, Some(k)) = (persists, last_impact[p]) {
+        impacts[k].energy_lost += hit.energy_lost;
+        impacts[k].impulses += 1;
+        return;
+    }
+    let (a, b) = pair_bodies(p, n);
+    last_impact[p] = Some(impacts.len());
+    impacts.push(Impact {
+        t,
+        a,
+        b,
+        approach_speed: hit.approach_speed,
+        energy_lost: hit.energy_lost,
+        impulses: 1,
+        peak_force: None,
+        contact_duration: None,
+    });
+}
+
 /// Gap across `pair` for balls at `x` and walls at `(xs, container length)`, m (`None` for a
 /// wall pair without walls).
 pub fn pair_gap(scene: &Scene, x: &[f64], walls: Option<(f64, f64)>, pair: usize) -> Option<f64> {
@@ -199,35 +236,54 @@ pub fn resolve_impacts(
     });
     let stick = floor.max(PERSISTENT_APPROACH * acceleration * plan.h);
     let Recording { x, v, last_impulse, impulse_floor, impacts, last_impact, struck_at, impact_loss, .. } = &mut *rec;
-    let threshold = |p: usize| if last_impulse[p] > *impulse_floor { stick } else { floor };
+    // Pairs within a run the walls hold ride the frame: persistent too.
+    let [left, right] = frame.as_deref().map_or([0, 0], |f| f.held);
+    let in_held = |p: usize| p < left.min(n) || p > n - right.min(n);
+    let threshold = |p: usize| if last_impulse[p] > *impulse_floor || in_held(p) { stick } else { floor };
     let walls = frame.as_deref_mut().zip(scene.frame).zip(scene.container);
     let mut now = Instant { x, v, frame: walls.map(|((f, sf), c)| (f.now.0, &mut f.now.1, sf.mass, c.length)) };
     resolve_touching(scene, &mut now, threshold, &mut resolved);
-    if resolved.is_empty() {
+    // A struck held run is free again: the feedback decides afresh what the walls hold.
+    let touches_held = |p: usize| in_held(p) || (left > 0 && p == left) || (right > 0 && p == n - right);
+    if resolved.iter().any(|hit| touches_held(hit.pair)) {
+        if let Some(f) = frame.as_deref_mut() {
+            f.held = [0, 0];
+        }
+    }
+    // A held run rides the frame: it takes the frame's velocity now, momentum kept (the balls
+    // were within the sticking speed of it), the kinetic energy given up booked.
+    let mut merged = false;
+    if let (Some(f), Some(sf)) = (frame.as_deref_mut(), scene.frame) {
+        let [l, r] = [f.held[0].min(n), f.held[1].min(n)];
+        let carried = (0..l).chain(n - r..n);
+        let (mass, momentum) = carried.clone().fold((sf.mass, sf.mass * f.now.1), |(m, p), i| {
+            (m + scene.balls[i].mass, p + scene.balls[i].mass * v[i])
+        });
+        if mass > sf.mass {
+            let common = momentum / mass;
+            let ke = |m: f64, u: f64| 0.5 * m * u * u;
+            let mut lost = ke(sf.mass, f.now.1) - ke(sf.mass, common);
+            for i in carried {
+                lost += ke(scene.balls[i].mass, v[i]) - ke(scene.balls[i].mass, common);
+                v[i] = common;
+            }
+            f.now.1 = common;
+            *impact_loss += lost;
+            let wall_pair = if l > 0 { 0 } else { n };
+            if let Some(k) = last_impact[wall_pair] {
+                impacts[k].energy_lost += lost;
+            }
+            merged = true;
+        }
+    }
+    if resolved.is_empty() && !merged {
         return;
     }
     for hit in resolved.iter() {
         *impact_loss += hit.energy_lost;
-        let persists = struck_at[hit.pair].is_some_and(|s| s + 1 >= clock.steps);
-        struck_at[hit.pair] = Some(clock.steps);
-        if let (true, Some(k)) = (persists, last_impact[hit.pair]) {
-            impacts[k].energy_lost += hit.energy_lost;
-            impacts[k].impulses += 1;
-            continue;
-        }
-        let (a, b) = pair_bodies(hit.pair, n);
-        last_impact[hit.pair] = Some(impacts.len());
-        impacts.push(Impact {
-            // The steps end just short of contact: the impact is when the gap closes.
-            t: clock.t + hit.gap.max(0.0) / hit.approach_speed,
-            a,
-            b,
-            approach_speed: hit.approach_speed,
-            energy_lost: hit.energy_lost,
-            impulses: 1,
-            peak_force: None,
-            contact_duration: None,
-        });
+        // The steps end just short of contact: the impact is when the gap closes.
+        let t = clock.t + hit.gap.max(0.0) / hit.approach_speed;
+        book(Ledger { impacts, last_impact, struck_at }, n, hit, t, clock.steps);
     }
     // Before the first step bevy_rapier has not made the bodies yet: it will from `Velocity`.
     if let Ok(mut set) = sets.single_mut() {

@@ -227,7 +227,9 @@ fn init_frame(mut commands: Commands, scene: Res<DamperScene>) {
     if let Some(f) = scene.0.frame {
         let x0 = (scene.0.initial_displacement, 0.0);
         commands.insert_resource(FrameState {
+            bare: Driven::new(Oscillator::new(f.mass, f.damping, f.stiffness), scene.0.harmonic_load()),
             motion: Driven::new(Oscillator::new(f.mass, f.damping, f.stiffness), scene.0.harmonic_load()),
+            held: [0, 0],
             t_start: 0.0,
             start: x0,
             before_impulses: x0,
@@ -254,6 +256,14 @@ pub fn drive_frame(
     let (t0, t1) = (clock.t, clock.t + plan.h);
     frame.start = (x, v);
     frame.t_start = t0;
+    // Balls held against a wall ride the frame: their mass joins its oscillator for the step.
+    let n = scene.0.balls.len();
+    let [left, right] = frame.held;
+    let held_mass: f64 = scene.0.balls[..left.min(n)].iter().chain(&scene.0.balls[n - right.min(n)..]).map(|b| b.mass).sum();
+    frame.motion = match scene.0.frame {
+        Some(f) if held_mass > 0.0 => Driven::new(Oscillator::new(f.mass + held_mass, f.damping, f.stiffness), scene.0.harmonic_load()),
+        _ => frame.bare,
+    };
     let motion = frame.motion;
     frame.before_impulses = motion.state(x, v, t0, t1);
     if motion.xp.is_none() {

@@ -91,9 +91,14 @@ pub fn feedback(
         project_sunk_balls(&mut set, handles, x_new, scene, f.before_impulses.0, c.length);
     }
     mark_pairs_in_contact(sim, colliders, &set, &bodies, n, active);
+    let (frame_start, frame_end) = frame.as_ref().map_or(((0.0, 0.0), (0.0, 0.0)), |f| (f.start, f.before_impulses));
+    let held = frame.as_ref().map_or([0, 0], |f| f.held);
+    let carried = carry_held_balls(n, held, frame_end.1, active, &mut rec.v, v_new);
+    if carried != [0, 0] {
+        write_velocities(&mut set, handles, &bodies.balls, &mut velocities, v_new);
+    }
     step_impulses(scene, v_new, &rec.v, active, dp, j);
 
-    let (frame_start, frame_end) = frame.as_ref().map_or(((0.0, 0.0), (0.0, 0.0)), |f| (f.start, f.before_impulses));
     let wall_v = (frame_end.0 - frame_start.0) / plan.h; // the kinematic velocity Rapier used
     let walls_at_start = scene.frame.and(scene.container).map(|c| (frame_start.0, c.length));
     let closed_in_step = |p: usize| pair_gap(scene, &rec.x, walls_at_start, p).is_some_and(|g| g > TOUCHING);
@@ -118,9 +123,17 @@ pub fn feedback(
         step_impulses(scene, v_new, &rec.v, active, dp, j);
     }
 
+    if carried != [0, 0] && share_frame_impulse(scene, carried, frame_end.1, dp, v_new) {
+        write_velocities(&mut set, handles, &bodies.balls, &mut velocities, v_new);
+        step_impulses(scene, v_new, &rec.v, active, dp, j);
+    }
     let forcing_work = frame.as_ref().map_or(0.0, |f| f.forcing_work);
     let (frame_pre, frame_post) = match frame {
-        Some(mut f) => feed_frame(&mut f, scene, dp),
+        Some(mut f) => {
+            let fed = feed_frame(&mut f, scene, dp);
+            f.held = held_runs(scene, x_new, v_new, (f.now, t0 + plan.h, plan.h));
+            fed
+        }
         None => (0.0, 0.0),
     };
     let step = StepVelocities { before: &rec.v, after: v_new, frame_before: frame_pre, frame_after: frame_post };
@@ -231,6 +244,82 @@ fn body_velocity(v: &[f64], frame_v: f64, body: isize) -> f64 {
     }
 }
 
+/// Phase 1c: balls held against a wall rode the frame this step (their mass in its
+/// oscillator): they were expected to end at the frame's velocity, which stands for their
+/// velocity before the step's impulses. Where nothing struck the held run from its open end,
+/// they end there too (Rapier left them at the walls' mean velocity over the step); otherwise
+/// what Rapier gave them is an impulse like any other. Returns whether a velocity changed.
+fn carry_held_balls(n: usize, held: [usize; 2], frame_v: f64, active: &[bool], before: &mut [f64], v_new: &mut [f64]) -> [usize; 2] {
+    let [left, right] = [held[0].min(n), held[1].min(n)];
+    let mut carried = [0, 0];
+    for (side, balls, open_pair) in [(0, 0..left, left), (1, n - right..n, n - right)] {
+        if balls.is_empty() {
+            continue;
+        }
+        let struck = open_pair > 0 && open_pair < n && active[open_pair];
+        if !struck {
+            carried[side] = balls.len();
+        }
+        for i in balls {
+            before[i] = frame_v;
+            if !struck {
+                v_new[i] = frame_v;
+            }
+        }
+    }
+    carried
+}
+
+/// Phase 3d: the balls carried this step are part of the frame: an impulse the frame takes from
+/// the other balls moves them too, `dv = -sum(dp) / (ms + carried mass)`. Sets their
+/// velocities so that the frame's feedback (`-sum(dp) / ms`, theirs included) gives the same
+/// `dv`. Returns whether a velocity changed.
+fn share_frame_impulse(scene: &Scene, carried: [usize; 2], frame_v: f64, dp: &[f64], v_new: &mut [f64]) -> bool {
+    let Some(f) = scene.frame else { return false };
+    let n = v_new.len();
+    let is_carried = |i: usize| i < carried[0] || i >= n - carried[1];
+    let (mut free_dp, mut carried_mass) = (0.0, 0.0);
+    for i in 0..n {
+        if is_carried(i) {
+            carried_mass += scene.balls[i].mass;
+        } else {
+            free_dp += dp[i];
+        }
+    }
+    if free_dp == 0.0 {
+        return false;
+    }
+    let dv = -free_dp / (f.mass + carried_mass);
+    for (i, v) in v_new.iter_mut().enumerate() {
+        if is_carried(i) {
+            *v = frame_v + dv;
+        }
+    }
+    true
+}
+
+/// Phase 6: the balls the walls hold next step: from each wall, the touching run of balls that
+/// moves with the frame (within what its acceleration builds in a step) while the frame's
+/// smooth force pushes the wall into it (docs/MODEL.md §4).
+fn held_runs(scene: &Scene, x: &[f64], v: &[f64], ((xs, vs), t, h): ((f64, f64), f64, f64)) -> [usize; 2] {
+    let (Some(f), Some(c)) = (scene.frame, scene.container) else { return [0, 0] };
+    let n = x.len();
+    let force = scene.frame_force(t, xs, vs);
+    let stick = super::impacts::approach_floor(scene)
+        .max(super::impacts::PERSISTENT_APPROACH * (force / f.mass).abs() * h);
+    let walls = Some((xs, c.length));
+    let holds = |ball: usize, pair: usize| {
+        pair_gap(scene, x, walls, pair).is_some_and(|g| g <= TOUCHING) && (v[ball] - vs).abs() <= stick
+    };
+    let mut held = [0, 0];
+    if force > 0.0 {
+        held[0] = (0..n).take_while(|&b| holds(b, b)).count();
+    } else if force < 0.0 {
+        held[1] = (0..n).rev().take_while(|&b| holds(b, b + 1)).count();
+    }
+    held
+}
+
 /// Phase 3a: whether Rapier's solve did nothing but stop pairs that closed in the step: no pair
 /// it loaded carried an impulse the step before, and at least one it loaded was apart at the
 /// step's start and approaching (the others touched at rest, loaded through the chain). Then
@@ -269,21 +358,9 @@ fn book_resolved(
     // The pairs are separating now: none carries a contact into the next step.
     last_impulse.iter_mut().for_each(|j| *j = 0.0);
     for hit in resolved {
-        let p = hit.pair;
-        let (a, b) = pair_bodies(p, n);
-        let gap = pair_gap(scene, x_before, walls, p).unwrap_or(0.0);
-        struck_at[p] = Some(step);
-        last_impact[p] = Some(impacts.len());
-        impacts.push(Impact {
-            t: start.t + (gap / hit.approach_speed).clamp(0.0, start.h),
-            a,
-            b,
-            approach_speed: hit.approach_speed,
-            energy_lost: hit.energy_lost,
-            impulses: 1,
-            peak_force: None,
-            contact_duration: None,
-        });
+        let gap = pair_gap(scene, x_before, walls, hit.pair).unwrap_or(0.0);
+        let t = start.t + (gap / hit.approach_speed).clamp(0.0, start.h);
+        super::impacts::book(super::impacts::Ledger { impacts, last_impact, struck_at }, n, hit, t, step);
     }
 }
 

@@ -62,7 +62,13 @@ pub struct FrameBody;
 #[derive(Resource, Debug, Clone, Copy)]
 pub struct FrameState {
     /// The bare frame's oscillator, with the scene's harmonic load.
+    pub bare: Driven,
+    /// This step's motion: the bare frame's, or the frame carrying the balls it holds.
     pub motion: Driven,
+    /// Balls held against the left and the right wall this step (counted from each wall): they
+    /// ride the frame, their mass part of its oscillator, as in the reference's persistent
+    /// contact (docs/MODEL.md §4).
+    pub held: [usize; 2],
     /// Time at the start of the current step, s.
     pub t_start: f64,
     /// Displacement and velocity at the start of the current step.

@@ -55,9 +55,9 @@ fn a_plastic_damper_loses_what_the_reference_loses() {
     let run = Model::Rapier.simulate(&scene).unwrap();
     let reference = Model::Reference.simulate(&scene).unwrap();
     let e0 = reference.energy.initial;
-    // Measured: 0.1 % of E0 apart at the default step and at half of it.
+    // Measured: 1e-4 of E0 apart (1e-3 before held balls joined the frame's mass).
     assert!(
-        (run.energy.impact_loss - reference.energy.impact_loss).abs() <= 5e-3 * e0,
+        (run.energy.impact_loss - reference.energy.impact_loss).abs() <= 1e-3 * e0,
         "impact loss {} J against the reference's {} J (E0 {e0} J)",
         run.energy.impact_loss,
         reference.energy.impact_loss
@@ -101,7 +101,8 @@ fn forced_single_ball_damper_matches_the_reference_in_steady_state() {
 /// A ball resting on the left wall is carried by the frame, released as the frame decelerates,
 /// and struck again by the walls: every strike gets the bounce of Eq. 9-10 with the frame's
 /// mass (before issue 14 a pair that stayed within Rapier's prediction distance was struck
-/// plastically), and the release matches the reference's.
+/// plastically), and the release matches the reference's (the held ball joins the frame's
+/// mass, as in the reference's persistent-contact rule).
 #[test]
 fn a_released_ball_struck_again_bounces_as_eq_9_10() {
     let mut scene = damper(PAPER_FRAME, -0.0185, &[0.11], 0.9, 0.0, 0.2, 1.5);
@@ -118,10 +119,11 @@ fn a_released_ball_struck_again_bounces_as_eq_9_10() {
         let law = 0.5 * (1.0 - 0.81) * mu * a.approach_speed * a.approach_speed;
         assert!((a.energy_lost / law - 1.0).abs() <= 1e-2, "{a:?}: Eq. 9-10 loses {law} J");
     }
-    // While carried, the ball is pushed plastically once a step, each push losing
-    // `mu (a h)^2 / 2` (a the frame's acceleration, h the step): `mu a^2 h T / 2` over the hold,
-    // 4.4e-4 J here (0.3 % of E0), which leaves the ball 1.2 % slower at its first strike.
+    // While carried, the ball rides the frame, its mass in the frame's oscillator, and loses
+    // nothing (pushed plastically once a step instead, it lost `mu a^2 h T / 2`, 4.4e-4 J here,
+    // and struck the far wall 1.2 % slower; now 9e-4 slower, the wall's velocity read at the
+    // end of the last approach step as in `heavy_ball_gets_the_two_body_law`).
     let (a, b) = (&got[0], &want[0]);
     assert_eq!((a.a, a.b), (b.a, b.b));
-    assert!((a.approach_speed / b.approach_speed - 1.0).abs() <= 2e-2, "{a:?} {b:?}");
+    assert!((a.approach_speed / b.approach_speed - 1.0).abs() <= 5e-3, "{a:?} {b:?}");
 }
