@@ -22,6 +22,7 @@
 
 use bevy::prelude::*;
 use bevy_rapier3d::prelude::*;
+use bevy_rapier3d::rapier::dynamics::RigidBodyHandle;
 
 use super::resources::{Bodies, DamperScene, FrameState, Recording, StepClock, StepPlan};
 use crate::impact_law::impact_law;
@@ -210,6 +211,12 @@ pub fn approach_floor(scene: &Scene) -> f64 {
     APPROACH_FLOOR * super::resources::speed_scale(scene)
 }
 
+/// The sticking speed over a step of `h` while the frame accelerates at `acceleration`:
+/// [`PERSISTENT_APPROACH`] times what it builds in the step, at least the round-off floor.
+pub fn sticking_speed(scene: &Scene, acceleration: f64, h: f64) -> f64 {
+    approach_floor(scene).max(PERSISTENT_APPROACH * acceleration.abs() * h)
+}
+
 /// The system: resolves the impacts of the touching pairs at the start of the step, writes
 /// the new velocities into Rapier's bodies and the balls' `Velocity`, the frame's into its
 /// state, and books the impacts.
@@ -224,6 +231,7 @@ pub fn resolve_impacts(
     mut sets: Query<&mut RapierRigidBodySet>,
     mut velocities: Query<&mut Velocity>,
     mut resolved: Local<Vec<PairImpact>>,
+    mut handles: Local<Vec<RigidBodyHandle>>,
 ) {
     let Some(bodies) = bodies else { return };
     let scene = &scene.0;
@@ -231,10 +239,9 @@ pub fn resolve_impacts(
     let floor = approach_floor(scene);
     // What the frame's acceleration now builds over the last step: a slower approach of a
     // loaded pair is the wall or the chain pressing on, not a new impact.
-    let acceleration = frame.as_deref().zip(scene.frame).map_or(0.0, |(f, sf)| {
-        (scene.frame_force(clock.t, f.now.0, f.now.1) / sf.mass).abs()
-    });
-    let stick = floor.max(PERSISTENT_APPROACH * acceleration * plan.h);
+    let acceleration =
+        frame.as_deref().zip(scene.frame).map_or(0.0, |(f, sf)| scene.frame_force(clock.t, f.now.0, f.now.1) / sf.mass);
+    let stick = sticking_speed(scene, acceleration, plan.h);
     let Recording { x, v, last_impulse, impulse_floor, impacts, last_impact, struck_at, impact_loss, .. } = &mut *rec;
     // Pairs within a run the walls hold ride the frame: persistent too.
     let [left, right] = frame.as_deref().map_or([0, 0], |f| f.held);
@@ -287,9 +294,11 @@ pub fn resolve_impacts(
     }
     // Before the first step bevy_rapier has not made the bodies yet: it will from `Velocity`.
     if let Ok(mut set) = sets.single_mut() {
-        let handles: Vec<_> = bodies.balls.iter().map(|e| set.entity2body().get(e).copied()).collect();
-        if handles.iter().all(Option::is_some) {
-            let handles: Vec<_> = handles.into_iter().flatten().collect();
+        if handles.len() != n {
+            handles.clear();
+            handles.extend(bodies.balls.iter().map_while(|e| set.entity2body().get(e).copied()));
+        }
+        if handles.len() == n {
             super::record::write_velocities(&mut set, &handles, &bodies.balls, &mut velocities, v);
             return;
         }

@@ -305,8 +305,7 @@ fn held_runs(scene: &Scene, x: &[f64], v: &[f64], ((xs, vs), t, h): ((f64, f64),
     let (Some(f), Some(c)) = (scene.frame, scene.container) else { return [0, 0] };
     let n = x.len();
     let force = scene.frame_force(t, xs, vs);
-    let stick = super::impacts::approach_floor(scene)
-        .max(super::impacts::PERSISTENT_APPROACH * (force / f.mass).abs() * h);
+    let stick = super::impacts::sticking_speed(scene, force / f.mass, h);
     let walls = Some((xs, c.length));
     let holds = |ball: usize, pair: usize| {
         pair_gap(scene, x, walls, pair).is_some_and(|g| g <= TOUCHING) && (v[ball] - vs).abs() <= stick
