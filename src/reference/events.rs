@@ -199,11 +199,13 @@ impl Solver<'_> {
     /// What `resolve` needs of pair `p` now: the speed at which it approaches when it touches
     /// (`None` when it does not touch, does not approach, or drifts off a wall that
     /// accelerates away, see [`Solver::reopens`]), and whether the frame presses it together.
+    #[inline(always)]
     pub(super) fn contact_now(&self, p: usize) -> Contact {
         self.contact_of(self.pair_now(p))
     }
 
     /// [`Solver::contact_now`] of a pair read already.
+    #[inline(always)]
     pub(super) fn contact_of(&self, pair: Option<PairNow>) -> Contact {
         let Some(PairNow { g, rate, tol, curvature }) = pair else {
             return Contact { approach: None, pressed: false, frame: false };

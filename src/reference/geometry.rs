@@ -51,7 +51,7 @@ impl Solver<'_> {
         left_frame != right_frame
     }
 
-    #[inline]
+    #[inline(always)]
     pub(super) fn gap(&self, p: usize) -> Gap {
         // The left body's right edge and the right body's left edge: a free ball's, or the
         // frame's (a wall, or a ball the frame holds, at an offset from `xs`).
@@ -75,7 +75,7 @@ impl Solver<'_> {
     }
 
     /// The frame's state at `t` in the current segment (the last one asked for is kept).
-    #[inline]
+    #[inline(always)]
     pub(super) fn frame_state(&self, t: f64) -> (f64, f64) {
         let (segment, last, xs, vs) = self.last_state.get();
         if segment == self.segment && last == t {
@@ -87,7 +87,7 @@ impl Solver<'_> {
     }
 
     /// Gap and its rate for a ball-frame pair at time `t` (the ball flies from `self.t`).
-    #[inline]
+    #[inline(always)]
     pub(super) fn frame_gap_at(&self, ball: usize, s: f64, k: f64, t: f64) -> (f64, f64) {
         let (xs, vs) = self.frame_state(t);
         let xb = self.x[ball] + self.v[ball] * (t - self.t);
@@ -110,6 +110,7 @@ impl Solver<'_> {
 
     /// The contact tolerance of a ball-frame gap `s (xb - xs) + k` of rate `rate` at `t` (see
     /// [`Solver::frame_gap_tolerance`]).
+    #[inline(always)]
     pub(super) fn frame_tolerance(&self, ball: usize, t: f64, xb: f64, xs: f64, k: f64, rate: f64) -> f64 {
         let eps = f64::EPSILON;
         self.tol
@@ -121,6 +122,7 @@ impl Solver<'_> {
 
     /// The contact tolerance of ball-ball pair `p` of rate `rate` now (see
     /// [`Solver::frame_gap_tolerance`]).
+    #[inline(always)]
     pub(super) fn ball_gap_tolerance(&self, p: usize, rate: f64) -> f64 {
         let (i, j) = (p - 1, p);
         let eps = f64::EPSILON;
@@ -134,6 +136,11 @@ impl Solver<'_> {
     /// Pair `p` now: its gap, the gap's rate, its contact tolerance and, for a ball-frame
     /// pair, the gap's curvature (positive when the wall accelerates away from the ball);
     /// `None` for a pair that moves as one body.
+    ///
+    /// Forced inline, as the gap and tolerance helpers it calls: every event reads every pair
+    /// (the postcondition, `resolve`), and as calls returning through memory these cost more
+    /// than their arithmetic (docs/BENCHMARKS.md, "Ensembles").
+    #[inline(always)]
     pub(super) fn pair_now(&self, p: usize) -> Option<PairNow> {
         match self.gap(p) {
             Gap::Fixed => None,
@@ -192,6 +199,7 @@ impl Solver<'_> {
     }
 
     /// The frame's position, velocity and acceleration ahead ([`Solver::accel_ahead`]) now.
+    #[inline(always)]
     pub(super) fn frame_now(&self) -> (f64, f64, f64) {
         if let Some(n) = self.now.get() {
             if n.segment == self.segment && n.t == self.t {

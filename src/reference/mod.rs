@@ -138,6 +138,9 @@ pub fn simulate_recording(scene: &Scene, record: Record) -> Result<Run, Referenc
     simulate_within(scene, record, None)
 }
 
+/// Impacts a run makes room for at its start (80 bytes each).
+const IMPACTS_RESERVED: usize = 256;
+
 /// Events between two looks at the computing-time budget.
 const BUDGET_EVENTS: u64 = 4096;
 
@@ -306,7 +309,8 @@ impl<'a> Solver<'a> {
             forcing_work: 0.0,
             load,
             impact_loss: 0.0,
-            impacts: Vec::new(),
+            // Room for a paper scene's impacts: growing a vector of them copies it each time.
+            impacts: Vec::with_capacity(IMPACTS_RESERVED),
             last_impact: vec![None; n + 1],
             events: 0,
             recorder: if exact.is_some() { recorder.untallied() } else { recorder },
