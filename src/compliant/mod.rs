@@ -58,9 +58,11 @@
 //!   `max_wall_s` seconds of computing, which keep the run so far and say what its steps cost
 //!   (the impacts so far, the last step, the open contacts, the stiffest of them:
 //!   [`CompliantError::OverBudget`]).
-//!   [`Progress`] shows a run as it goes.
+//!   [`Progress`] shows a run as it goes, and [`cost`] estimates from it what the whole run
+//!   will cost.
 
 pub mod contact;
+pub mod cost;
 pub mod integrator;
 mod jacobian;
 pub mod rosenbrock;

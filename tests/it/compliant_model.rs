@@ -304,25 +304,7 @@ fn a_step_limit_stops_the_run_and_keeps_it_so_far() {
 
 /// Issue 18's packed column (45 balls, no gaps, e = 0.07): the budget stops it and says what
 /// its steps cost (its open contacts and the stiffest of them).
-const PACKED_COLUMN: &str = r#"
-name = "packed-column"
-[frame]
-mass = 1.35
-stiffness = 55662.476667384384
-damping = 62.63313525734403
-initial_displacement = "-0.7917000580943232 Rr"
-[balls]
-arrangement = "SLLSSSSSLLLSLSSSSLSLLSSSLSSLSLSLSLSLSLLSLLLLS"
-large_mass = 0.11
-mass_ratio = 355.09605527615287
-density = 8000.0
-restitution = 0.07311002603701877
-gap = "0 Rr"
-clearance = "0 Rr"
-[run]
-horizon = 0.8086808531003047
-sample_dt = 0.00040434042655015234
-"#;
+const PACKED_COLUMN: &str = include_str!("../../examples/scenes/packed-column.toml");
 
 #[test]
 fn a_budget_says_what_the_steps_cost() {

@@ -53,13 +53,14 @@ pub struct Args {
 }
 
 /// How long a run goes before its progress is shown.
-const QUIET_FOR: std::time::Duration = std::time::Duration::from_secs(1);
+const QUIET_FOR_S: f64 = 1.0;
 
-/// The compliant model on `scene` within the budgets of `a`, with a progress bar (on a
-/// terminal) once it has run for [`QUIET_FOR`]; a run stopped by a budget is written to
-/// `--out` as far as it got before the error is reported.
+/// The compliant model on `scene` within the budgets of `a`. A long run says so early, with
+/// its estimated cost ([`lpc_damper::compliant::cost`], revised when it moves by more than
+/// twofold), and shows a progress bar (on a terminal) once it has run for [`QUIET_FOR_S`]; a run
+/// stopped by a budget is written to `--out` as far as it got before the error is reported.
 fn run_compliant(a: &Args, scene: &lpc_damper::scene::Scene) -> Result<lpc_damper::run::Run> {
-    use lpc_damper::compliant::{self, CompliantError, Options, Progress};
+    use lpc_damper::compliant::{self, cost, CompliantError, Options, Progress};
     use lpc_damper::scene::human;
     lpc_damper::run::check_budgets(a.max_steps, a.max_wall_time).map_err(|(budget, rule)| {
         let flag = if budget == lpc_damper::run::Budget::Steps { "--max-steps" } else { "--max-wall-time" };
@@ -75,46 +76,45 @@ fn run_compliant(a: &Args, scene: &lpc_damper::scene::Scene) -> Result<lpc_dampe
     let done = std::sync::atomic::AtomicBool::new(false);
     let result = std::thread::scope(|s| {
         s.spawn(|| {
-            let start = std::time::Instant::now();
             let bar = indicatif::ProgressBar::new(1000);
-            let mut shown = false;
-            while !done.load(std::sync::atomic::Ordering::Relaxed) {
-                std::thread::sleep(std::time::Duration::from_millis(100));
-                if start.elapsed() < QUIET_FOR {
-                    continue;
+            let shown = std::cell::Cell::new(false);
+            let say = |said: cost::Said| {
+                // Said on a terminal or in a log: what the whole run will cost.
+                let e = said.estimate;
+                let line = format!(
+                    "compliant: `{}` {}: about {} steps and {:.1} s of computing in all, at its recent rate (t = {:.3e} of {} s \
+                     after {:.2} s and {} steps; lately {} steps per simulated second, {:.2e} s each; a pack's cost can change \
+                     tenfold as it runs, so this is revised when it moves twofold; --max-steps and --max-wall-time bound it)",
+                    scene.name,
+                    if said.revision { "revised" } else { "is a long run" },
+                    human(e.steps.round()),
+                    e.seconds,
+                    said.t,
+                    human(scene.horizon),
+                    said.elapsed_s,
+                    said.steps,
+                    human(e.steps_per_simulated_second.round()),
+                    e.seconds_per_step,
+                );
+                if bar.is_hidden() || !shown.get() {
+                    eprintln!("{line}");
+                } else {
+                    bar.println(line);
                 }
-                if !shown {
+            };
+            let tick = |elapsed_s: f64, t: f64, steps: u64| {
+                if elapsed_s < QUIET_FOR_S {
+                    return;
+                }
+                if !shown.replace(true) {
                     bar.set_style(
                         indicatif::ProgressStyle::with_template("compliant [{bar:30}] {msg} ({elapsed}, about {eta} to go)").expect("valid template"),
                     );
-                    shown = true;
-                    // The announcement, on a terminal or in a log: what the whole run will cost
-                    // at the rate of its first second (a pack's cost shows only once it runs).
-                    let (t, steps, elapsed) = (progress.time(), progress.steps(), start.elapsed().as_secs_f64());
-                    if t > 0.0 {
-                        let whole = scene.horizon / t;
-                        let line = format!(
-                            "compliant: `{}` is a long run: t = {:.4e} of {} s after {:.1} s and {} steps; at this rate about {} \
-                             steps and {} s in all (--max-steps, --max-wall-time bound it)",
-                            scene.name,
-                            t,
-                            human(scene.horizon),
-                            elapsed,
-                            steps,
-                            human((steps as f64 * whole).round()),
-                            human((elapsed * whole).round()),
-                        );
-                        if bar.is_hidden() {
-                            eprintln!("{line}");
-                        } else {
-                            bar.println(line);
-                        }
-                    }
                 }
-                let t = progress.time();
                 bar.set_position((1000.0 * t / scene.horizon).clamp(0.0, 1000.0) as u64);
-                bar.set_message(format!("t = {t:.3e} of {:.3e} s, {} steps", scene.horizon, progress.steps()));
-            }
+                bar.set_message(format!("t = {t:.3e} of {:.3e} s, {steps} steps", scene.horizon));
+            };
+            cost::watch(&progress, scene.horizon, &done, say, tick);
             bar.finish_and_clear();
         });
         let result = compliant::simulate_watched(scene, options, Some(&progress));
