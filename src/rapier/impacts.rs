@@ -24,7 +24,7 @@ use bevy::prelude::*;
 use bevy_rapier3d::prelude::*;
 use bevy_rapier3d::rapier::dynamics::RigidBodyHandle;
 
-use super::resources::{Bodies, DamperScene, FrameState, Recording, StepClock, StepPlan};
+use super::resources::{held_balls, Bodies, DamperScene, FrameState, Recording, StepClock, StepPlan};
 use crate::impact_law::impact_law;
 use crate::run::Impact;
 use crate::scene::{Body, Scene};
@@ -149,7 +149,7 @@ pub struct Ledger<'a> {
 /// (a sequence at one instant, a squeeze) adds to its latest impact, as one persistent
 /// contact; otherwise it is a new impact.
 pub fn book(ledger: Ledger<'_>, n: usize, hit: &PairImpact, t: f64, step: u64) {
-    let Ledger { impacts, last_impact, struck_at, .. } = ledger;
+    let Ledger { impacts, last_impact, struck_at } = ledger;
     let p = hit.pair;
     let persists = struck_at[p].is_some_and(|s| s + 1 >= step);
     struck_at[p] = Some(step);
@@ -261,8 +261,7 @@ pub fn resolve_impacts(
     // were within the sticking speed of it), the kinetic energy given up booked.
     let mut merged = false;
     if let (Some(f), Some(sf)) = (frame.as_deref_mut(), scene.frame) {
-        let [l, r] = [f.held[0].min(n), f.held[1].min(n)];
-        let carried = (0..l).chain(n - r..n);
+        let carried = held_balls(f.held, n);
         let (mass, momentum) = carried.clone().fold((sf.mass, sf.mass * f.now.1), |(m, p), i| {
             (m + scene.balls[i].mass, p + scene.balls[i].mass * v[i])
         });
@@ -276,7 +275,7 @@ pub fn resolve_impacts(
             }
             f.now.1 = common;
             *impact_loss += lost;
-            let wall_pair = if l > 0 { 0 } else { n };
+            let wall_pair = if f.held[0] > 0 { 0 } else { n };
             if let Some(k) = last_impact[wall_pair] {
                 impacts[k].energy_lost += lost;
             }

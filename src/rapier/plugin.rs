@@ -257,13 +257,14 @@ pub fn drive_frame(
     frame.start = (x, v);
     frame.t_start = t0;
     // Balls held against a wall ride the frame: their mass joins its oscillator for the step.
-    let n = scene.0.balls.len();
-    let [left, right] = frame.held;
-    let held_mass: f64 = scene.0.balls[..left.min(n)].iter().chain(&scene.0.balls[n - right.min(n)..]).map(|b| b.mass).sum();
-    frame.motion = match scene.0.frame {
-        Some(f) if held_mass > 0.0 => Driven::new(Oscillator::new(f.mass + held_mass, f.damping, f.stiffness), scene.0.harmonic_load()),
-        _ => frame.bare,
-    };
+    let held_mass: f64 = held_balls(frame.held, scene.0.balls.len()).map(|i| scene.0.balls[i].mass).sum();
+    // Made again only when what the frame carries changes.
+    if frame.motion.osc.mass != frame.bare.osc.mass + held_mass {
+        frame.motion = match scene.0.frame {
+            Some(f) if held_mass > 0.0 => Driven::new(Oscillator::new(f.mass + held_mass, f.damping, f.stiffness), scene.0.harmonic_load()),
+            _ => frame.bare,
+        };
+    }
     let motion = frame.motion;
     frame.before_impulses = motion.state(x, v, t0, t1);
     if motion.xp.is_none() {

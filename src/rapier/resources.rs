@@ -83,6 +83,12 @@ pub struct FrameState {
     pub forcing_work: f64,
 }
 
+/// The balls `held` (counted from the left and the right wall, as [`FrameState::held`]) of a
+/// scene with `n` balls, by index.
+pub fn held_balls(held: [usize; 2], n: usize) -> impl Iterator<Item = usize> + Clone {
+    (0..held[0].min(n)).chain(n - held[1].min(n)..n)
+}
+
 /// Steps taken so far and the simulated time they cover.
 #[derive(Resource, Debug, Clone, Copy, Default)]
 pub struct StepClock {

@@ -47,13 +47,10 @@ impl Solver<'_> {
         if self.exact.is_none() {
             return;
         }
-        // The state now was read by the last event's contact check (`frame_now`); the
+        // The state now is kept by the last event's contact check (`frame_now`); the
         // searches since have evaluated other instants.
-        let now = match self.now.get() {
-            Some(n) if n.segment == self.segment && n.t == self.t => (n.xs, n.vs),
-            _ => self.frame_state(self.t),
-        };
-        let ends = [now, self.frame_state(until)];
+        let (xs, vs, _) = self.frame_now();
+        let ends = [(xs, vs), self.frame_state(until)];
         let Some(exact) = &mut self.exact else { return };
         let free_energy = if exact.wants_energy() {
             (0..self.n).filter(|&i| self.hold[i] == Hold::Free).map(|i| 0.5 * self.mass[i] * self.v[i] * self.v[i]).sum()
