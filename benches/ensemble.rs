@@ -11,7 +11,7 @@
 use criterion::{criterion_group, criterion_main, Criterion};
 use lpc_damper::scene::{load, scenes_dir};
 use lpc_damper::studies::ensemble::{draw, run_members, Ensemble};
-use lpc_damper::Model;
+use lpc_damper::model::{Model, RunOptions};
 
 fn lsl_with_tolerance() -> (lpc_damper::scene::Scene, Ensemble, Ensemble) {
     // The scene's own [tolerances]: gap 0.02 Rr.
@@ -27,7 +27,7 @@ fn ensembles(c: &mut Criterion) {
     let one_thread = rayon::ThreadPoolBuilder::new().num_threads(1).build().unwrap();
     let mut group = c.benchmark_group("reference");
     group.sample_size(20);
-    group.bench_function("single run with series", |b| b.iter(|| Model::Reference.simulate(&nominal).unwrap()));
+    group.bench_function("single run with series", |b| b.iter(|| Model::Reference.simulate(&nominal, &RunOptions::default()).unwrap()));
     group.bench_function("1000 members (global pool)", |b| b.iter(|| run_members(&big, Model::Reference, false, &|| {}).unwrap()));
     group.bench_function("1000 members (1 thread)", |b| {
         b.iter(|| one_thread.install(|| run_members(&big, Model::Reference, false, &|| {}).unwrap()))
@@ -36,7 +36,7 @@ fn ensembles(c: &mut Criterion) {
     for model in [Model::Rapier, Model::Compliant] {
         let mut group = c.benchmark_group(model.name());
         group.sample_size(10);
-        group.bench_function("single run with series", |b| b.iter(|| model.simulate(&nominal).unwrap()));
+        group.bench_function("single run with series", |b| b.iter(|| model.simulate(&nominal, &RunOptions::default()).unwrap()));
         group.bench_function("200 members (1 thread)", |b| {
             b.iter(|| one_thread.install(|| run_members(&small, model, false, &|| {}).unwrap()))
         });

@@ -37,7 +37,7 @@ fn main() -> anyhow::Result<()> {
     while app.world().get_resource::<StepClock>().is_none_or(|c| c.t < horizon) {
         app.update();
     }
-    let reference = lpc_damper::reference::simulate(&scene)?;
+    let reference = lpc_damper::Model::Reference.simulate(&scene, &lpc_damper::model::RunOptions::default())?;
     let at = |t: f64| reference.series.xs[((t / reference.sample_dt).round() as usize).min(reference.series.len() - 1)];
     println!("{:>8} {:>14} {:>14}", "t s", "rapier xs mm", "reference mm");
     for &(t, xs) in &app.world().resource::<Watch>().xs {

@@ -5,12 +5,14 @@
 //! collide with each other and with the walls. Several models of the same system read one
 //! scene format and write one output type, so they can be checked against each other.
 //!
-//! Data flows one way: `scenes/*.toml` → [`scene`] (parse + validate) → a model
-//! ([`reference`], [`rapier`], [`compliant`]) → [`run::Run`] → [`metrics`], [`output`], [`chain`], [`sweep`].
+//! Data flows one way: `scenes/*.toml` → [`scene`] (parse + validate) → a [`model`]
+//! ([`reference`], [`rapier`], [`compliant`], each behind [`model::Simulator`]) → [`run::Run`] →
+//! [`metrics`], [`studies`], [`output`].
 //!
 //! ```
+//! use lpc_damper::model::{Model, RunOptions};
 //! let scene = lpc_damper::scene::load_scene(lpc_damper::scene::scenes_dir().join("lpc-lsl.toml")).unwrap();
-//! let run = lpc_damper::reference::simulate(&scene).unwrap();
+//! let run = Model::Reference.simulate(&scene, &RunOptions::default()).unwrap();
 //! assert!(run.energy.balance_error.abs() < 1e-12);
 //! let m = lpc_damper::metrics::metrics(&run);
 //! assert!(m.peak_displacement < scene.initial_displacement);
@@ -27,6 +29,7 @@ pub mod rapier;
 #[cfg(feature = "render")]
 pub mod render;
 pub mod reference;
+mod registry;
 pub mod run;
 pub mod scene;
 pub mod studies;

@@ -4,10 +4,6 @@
 //! series (an ensemble member) has exactly the metrics of one that does.
 
 use crate::run::Run;
-use crate::scene::Scene;
-
-/// Fraction of `|xs0|` that counts as settled.
-pub const SETTLING_FRACTION: f64 = 0.05;
 
 /// The headline metrics of one run.
 #[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
@@ -119,137 +115,9 @@ pub fn metrics(run: &Run) -> Metrics {
     }
 }
 
-/// The metrics read from the motion itself: peaks of `|xs|` and `|a|` from one bare period on,
-/// RMS of `xs`, the settling time and the dissipation times (see [`Metrics`]). Every model
-/// reads them at its samples ([`SampleTally`]); the reference computes them exactly from its
-/// closed-form motion in free vibration.
-#[derive(Debug, Clone, Copy, PartialEq, Default)]
-pub struct MotionMetrics {
-    /// max |xs| for t >= T, m.
-    pub peak_displacement: f64,
-    /// max |a| for t >= T, m/s^2.
-    pub peak_acceleration: f64,
-    /// RMS of xs over the horizon, m.
-    pub rms_displacement: f64,
-    /// Last time |xs| >= 5 % of |xs0|, `None` when that still holds at the horizon.
-    pub settling_time: Option<f64>,
-    /// First times the energy has fallen to each of [`DISSIPATION_LEVELS`].
-    pub dissipation_times: [Option<f64>; 2],
-}
-
-/// Energy fractions left at which the dissipation times are read: 10 % and 1 %.
-pub const DISSIPATION_LEVELS: [f64; 2] = [0.1, 0.01];
-
-/// The metrics that read the sampled motion, accumulated sample by sample in time order:
-/// peaks of `|xs|` and `|a|` from one bare period on, the sum of `xs^2`, the last sample
-/// outside the settling band and the first samples at which the energy fell to each of
-/// [`DISSIPATION_LEVELS`].
-#[derive(Debug, Clone, Copy, PartialEq, Default)]
-pub struct SampleTally {
-    /// Peaks count from this time on (the bare frame's damped period), s.
-    from: f64,
-    /// `|xs|` at or above this is outside the settling band, m.
-    band: f64,
-    /// Initial mechanical energy when the dissipation times are watched (free vibration with
-    /// energy), else 0.
-    initial_energy: f64,
-    peak_displacement: f64,
-    peak_acceleration: f64,
-    sum_sq: f64,
-    samples: usize,
-    last_outside: Option<f64>,
-    last_is_outside: bool,
-    dissipated: [Option<f64>; 2],
-}
-
-impl SampleTally {
-    /// An empty tally for a run of `scene`.
-    pub fn new(scene: &Scene) -> Self {
-        let initial_energy = scene.initial_energy();
-        SampleTally {
-            from: scene.frame.map_or(0.0, |f| f.damped_period()),
-            band: SETTLING_FRACTION * scene.initial_displacement.abs(),
-            // Energy only falls in free vibration: a forced run has no dissipation time.
-            initial_energy: if scene.forcing.is_none() && initial_energy > 0.0 { initial_energy } else { 0.0 },
-            ..Default::default()
-        }
-    }
-    /// Whether the next sample's mechanical energy is still needed (a dissipation time is
-    /// still to be found): computing it costs a pass over the balls.
-    #[inline]
-    pub fn wants_energy(&self) -> bool {
-        self.initial_energy > 0.0 && self.dissipated[1].is_none()
-    }
-    /// Adds the sample at `t`: the frame's displacement and acceleration, and the mechanical
-    /// energy when [`SampleTally::wants_energy`] (ignored otherwise).
-    #[inline]
-    pub fn add(&mut self, t: f64, xs: f64, a: f64, energy: f64) {
-        if t >= self.from {
-            self.peak_displacement = self.peak_displacement.max(xs.abs());
-            self.peak_acceleration = self.peak_acceleration.max(a.abs());
-        }
-        self.sum_sq += xs * xs;
-        self.samples += 1;
-        self.last_is_outside = xs.abs() >= self.band;
-        if self.last_is_outside {
-            self.last_outside = Some(t);
-        }
-        if self.wants_energy() {
-            for (level, time) in DISSIPATION_LEVELS.iter().zip(&mut self.dissipated) {
-                if time.is_none() && energy <= level * self.initial_energy {
-                    *time = Some(t);
-                }
-            }
-        }
-    }
-    /// The metrics tallied.
-    pub fn finish(&self) -> MotionMetrics {
-        MotionMetrics {
-            peak_displacement: self.peak_displacement,
-            peak_acceleration: self.peak_acceleration,
-            rms_displacement: if self.samples == 0 { 0.0 } else { (self.sum_sq / self.samples as f64).sqrt() },
-            settling_time: self.settling_time(),
-            dissipation_times: self.dissipated,
-        }
-    }
-    /// The last sampled time at which `|xs| >= 5 % |xs0|`, or `None` if the last sample still
-    /// is (not settled within the horizon). A series that never reaches the band settles at 0.
-    pub fn settling_time(&self) -> Option<f64> {
-        match self.last_outside {
-            None => Some(0.0),
-            Some(_) if self.last_is_outside => None,
-            t => t,
-        }
-    }
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    fn settling_time(xs: &[f64]) -> Option<f64> {
-        let mut tally = SampleTally { band: SETTLING_FRACTION, ..Default::default() };
-        for (k, &x) in xs.iter().enumerate() {
-            tally.add(k as f64, x, 0.0, 0.0);
-        }
-        tally.settling_time()
-    }
-
-    #[test]
-    fn settling_is_last_time_outside_the_band() {
-        assert_eq!(settling_time(&[1.0, -0.5, 0.01, 0.0]), Some(1.0));
-        assert_eq!(settling_time(&[1.0, 0.0, 0.0, 0.06]), None);
-        assert_eq!(settling_time(&[0.01, 0.0, 0.0, 0.0]), Some(0.0));
-    }
-
-    #[test]
-    fn dissipation_times_are_the_first_samples_below_each_level() {
-        let mut tally = SampleTally { initial_energy: 1.0, ..Default::default() };
-        for (k, e) in [1.0, 0.5, 0.1, 0.2, 0.05, 0.01, 0.001].into_iter().enumerate() {
-            tally.add(k as f64, 0.0, 0.0, e);
-        }
-        assert_eq!(tally.finish().dissipation_times, [Some(2.0), Some(5.0)]);
-    }
 
     #[test]
     fn spread_uses_nearest_rank() {

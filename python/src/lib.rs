@@ -18,10 +18,9 @@ use pyo3::prelude::*;
 use pyo3::sync::MutexExt;
 use pyo3::types::PyDict;
 
-use lpc_damper::model::ModelError as RustModelError;
+use lpc_damper::model::{ModelError as RustModelError, RunOptions};
 use lpc_damper::output::parquet::{table_parquet, Constant, TOOL_VERSION};
 use lpc_damper::output::{write_atomic, Headline, RunSummary};
-use lpc_damper::run::Record;
 use lpc_damper::scene::{self, Loaded, Overrides, SceneError as RustSceneError, SceneFile, Stepping};
 use lpc_damper::studies::{chain as chains, ensemble as ensembles, frf as frfs, sweep as sweeps};
 use lpc_damper::Model;
@@ -211,6 +210,7 @@ struct Settings {
     dt: Option<f64>,
     solver_iterations: Option<u32>,
     ccd: bool,
+    tolerance: Option<f64>,
 }
 
 impl Settings {
@@ -228,6 +228,7 @@ impl Settings {
             dt: self.dt,
             solver_iterations: self.solver_iterations,
             ccd: self.ccd,
+            tolerance: self.tolerance,
             ..Overrides::default()
         })
     }
@@ -392,11 +393,11 @@ impl Run {
     }
 }
 
-/// Runs one model on a damper scene. The compliant model takes budgets, as the CLI's
-/// `--max-steps` and `--max-wall-time`: a run that exceeds one raises `ModelError` whose
-/// `partial` attribute is the run so far.
+/// Runs one model on a damper scene. Every model takes budgets, as the CLI's `--max-steps`
+/// and `--max-wall-time`: a run that exceeds one raises `ModelError` whose `partial` attribute
+/// is the run so far.
 #[pyfunction]
-#[pyo3(signature = (scene, model = "reference", *, horizon = None, sample_dt = None, stepping = None, dt = None, solver_iterations = None, ccd = false, max_steps = None, max_wall_time = None))]
+#[pyo3(signature = (scene, model = "reference", *, horizon = None, sample_dt = None, stepping = None, dt = None, solver_iterations = None, ccd = false, tolerance = None, max_steps = None, max_wall_time = None))]
 #[allow(clippy::too_many_arguments)]
 fn run(
     py: Python<'_>,
@@ -408,37 +409,22 @@ fn run(
     dt: Option<f64>,
     solver_iterations: Option<u32>,
     ccd: bool,
+    tolerance: Option<f64>,
     max_steps: Option<u64>,
     max_wall_time: Option<f64>,
 ) -> PyResult<Run> {
-    use lpc_damper::compliant::{self, CompliantError, Options};
     let model = parse_model(model)?;
-    let s = scene.damper(&Settings { horizon, sample_dt, stepping, dt, solver_iterations, ccd })?;
-    let budgeted = max_steps.is_some() || max_wall_time.is_some();
-    if budgeted && model != Model::Compliant {
-        let name = if max_steps.is_some() { "max_steps" } else { "max_wall_time" };
-        return Err(SceneError::new_err(format!("{name}: applies to the compliant model, not to `{model}`")));
-    }
-    lpc_damper::run::check_budgets(max_steps, max_wall_time).map_err(|(budget, rule)| {
-        let name = if budget == lpc_damper::run::Budget::Steps { "max_steps" } else { "max_wall_time" };
-        SceneError::new_err(format!("{name}: {rule}"))
-    })?;
-    if !budgeted {
-        return Ok(Run::of(py.detach(|| model.simulate(&s)).map_err(model_error)?));
-    }
-    let options = Options { max_steps: max_steps.unwrap_or(compliant::MAX_STEPS), max_wall_s: max_wall_time, ..Options::default() };
-    let e = match py.detach(|| compliant::simulate_with(&s, options)) {
-        Ok(run) => return Ok(Run::of(run)),
-        Err(e) => e,
-    };
-    let message = e.to_string();
-    match e {
-        CompliantError::OverBudget { partial, .. } => {
-            let err = ModelError::new_err(message);
-            err.value(py).setattr("partial", Py::new(py, Run::of(*partial))?)?;
+    let s = scene.damper(&Settings { horizon, sample_dt, stepping, dt, solver_iterations, ccd, tolerance })?;
+    let options = RunOptions { max_steps, max_wall_s: max_wall_time, ..RunOptions::default() };
+    options.check_budgets().map_err(|(budget, rule)| SceneError::new_err(format!("{}: {rule}", budget.keyword())))?;
+    match py.detach(|| model.simulate(&s, &options)) {
+        Ok(run) => Ok(Run::of(run)),
+        Err(RustModelError::OverBudget(stop)) => {
+            let err = ModelError::new_err(stop.to_string());
+            err.value(py).setattr("partial", Py::new(py, Run::of(stop.partial))?)?;
             Err(err)
         }
-        other => Err(model_error(other.into())),
+        Err(e) => Err(model_error(e)),
     }
 }
 
@@ -482,7 +468,7 @@ fn write_part(dir: &PathBuf, name: &str, header: &[String], rows: &[Vec<Option<f
 /// Members `start..stop` (default all) of an ensemble of `members` drawn under the scene's
 /// `[tolerances]`: a dict of columns `member`, the drawn values, then every metric.
 #[pyfunction]
-#[pyo3(signature = (scene, members, *, seed = None, model = "reference", start = 0, stop = None, out = None, horizon = None, sample_dt = None, stepping = None, dt = None, solver_iterations = None, ccd = false))]
+#[pyo3(signature = (scene, members, *, seed = None, model = "reference", start = 0, stop = None, out = None, horizon = None, sample_dt = None, stepping = None, dt = None, solver_iterations = None, ccd = false, tolerance = None))]
 #[allow(clippy::too_many_arguments)]
 fn ensemble<'py>(
     py: Python<'py>,
@@ -499,9 +485,10 @@ fn ensemble<'py>(
     dt: Option<f64>,
     solver_iterations: Option<u32>,
     ccd: bool,
+    tolerance: Option<f64>,
 ) -> PyResult<Bound<'py, PyDict>> {
     let model = parse_model(model)?;
-    let nominal = scene.damper(&Settings { horizon, sample_dt, stepping, dt, solver_iterations, ccd })?;
+    let nominal = scene.damper(&Settings { horizon, sample_dt, stepping, dt, solver_iterations, ccd, tolerance })?;
     let l = &scene.loaded;
     let stop = stop.unwrap_or(members);
     let drawn = py
@@ -511,7 +498,7 @@ fn ensemble<'py>(
     let metrics = batched(py, all.len(), |range| {
         ensembles::map_members(
             &all[range],
-            |m| model.simulate_recording(&m.scene, Record::MetricsOnly).map(|r| Headline::of_run(&r).values()),
+            |m| model.simulate(&m.scene, &RunOptions::metrics_only()).map(|r| Headline::of_run(&r).values()),
             &|| {},
         )
         .map_err(model_error)
@@ -556,7 +543,7 @@ fn sweep_cells(scene: &Scene, axes: Option<Vec<String>>) -> PyResult<usize> {
 /// Cells `start..stop` (default all) of a sweep: a dict of columns `cell`, each axis' value
 /// as written, then every metric.
 #[pyfunction]
-#[pyo3(signature = (scene, axes = None, *, model = "reference", start = 0, stop = None, out = None, horizon = None, stepping = None, dt = None, solver_iterations = None, ccd = false))]
+#[pyo3(signature = (scene, axes = None, *, model = "reference", start = 0, stop = None, out = None, horizon = None, stepping = None, dt = None, solver_iterations = None, ccd = false, tolerance = None))]
 #[allow(clippy::too_many_arguments)]
 fn sweep<'py>(
     py: Python<'py>,
@@ -571,9 +558,10 @@ fn sweep<'py>(
     dt: Option<f64>,
     solver_iterations: Option<u32>,
     ccd: bool,
+    tolerance: Option<f64>,
 ) -> PyResult<Bound<'py, PyDict>> {
     let model = parse_model(model)?;
-    let (parameters, grid) = grid(scene, axes, &Settings { horizon, stepping, dt, solver_iterations, ccd, ..Settings::default() })?;
+    let (parameters, grid) = grid(scene, axes, &Settings { horizon, stepping, dt, solver_iterations, ccd, tolerance, ..Settings::default() })?;
     let stop = stop.unwrap_or(grid.len()).min(grid.len());
     if start >= stop {
         return Err(SceneError::new_err(format!("start: cells {start}..{stop} are not a part of 0..{}", grid.len())));

@@ -54,28 +54,21 @@
 //!   steps per elastic impact; an explicit step longer than [`STIFF_LIMIT`] over the fastest
 //!   contact damping rate is taken by RODAS4 instead, whose steps only the error control and
 //!   the closing bound limit. A step shrinking to round-off or a non-finite state end the run
-//!   with a [`CompliantError`] naming the scene; so do more than `max_steps` steps or more than
-//!   `max_wall_s` seconds of computing, which keep the run so far and say what its steps cost
-//!   (the impacts so far, the last step, the open contacts, the stiffest of them:
-//!   [`CompliantError::OverBudget`]).
-//!   [`Progress`] shows a run as it goes, and [`cost`] estimates from it what the whole run
-//!   will cost.
+//!   with a [`ModelError`] naming the scene; so does a budget, which keeps the run so far and
+//!   says what its steps cost (the impacts so far, the last step, the open contacts, the
+//!   stiffest of them).
 
 pub mod contact;
-pub mod cost;
 pub mod integrator;
 mod jacobian;
 pub mod rosenbrock;
 
-use std::time::Instant;
-
+use crate::model::{Checks, Meter, Model, ModelError, OverBudget, RunOptions, Setting, Simulator};
 use crate::run::{EnergyAccount, Impact, Record, Recorder, Run};
 use crate::scene::{Body, Scene};
 use integrator::{bracketed_root, next_step, Dopri5};
 use rosenbrock::Rodas4;
 
-/// Default error tolerance, relative to the contact scales (see the module docs).
-pub const DEFAULT_TOLERANCE: f64 = 1e-9;
 /// Default most steps (accepted and rejected) one run may take.
 pub const MAX_STEPS: u64 = 50_000_000;
 /// Floor of the speed that sets a contact's damping, relative to the scene's speed scale.
@@ -93,126 +86,74 @@ const SCAN_POINTS: usize = 8;
 /// inside the step and is located, rather than approached by ever shorter steps.
 const CLOSE_OVERSHOOT: f64 = 1.5;
 
-/// Settings of the compliant model.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct Options {
-    /// Error tolerance per step, relative to the contact scales.
-    pub tolerance: f64,
-    /// Most steps (accepted and rejected) before the run stops ([`CompliantError::OverBudget`]).
-    pub max_steps: u64,
-    /// Most seconds of computing before the run stops, if any ([`CompliantError::OverBudget`]).
-    pub max_wall_s: Option<f64>,
-    /// What the run keeps besides its metrics.
-    pub record: Record,
-}
-
-impl Default for Options {
-    fn default() -> Self {
-        Options { tolerance: DEFAULT_TOLERANCE, max_steps: MAX_STEPS, max_wall_s: None, record: Record::Series }
-    }
-}
-
-/// Steps between two updates of a run's [`Progress`] and two looks at its wall-time budget.
+/// Steps between two looks at the budgets and two reports of progress.
 pub const PROGRESS_STEPS: u64 = 1024;
 
-/// Where a run stands, for a progress bar on another thread: the simulated time reached and
-/// the steps taken, updated every [`PROGRESS_STEPS`] steps.
-#[derive(Debug, Default)]
-pub struct Progress {
-    t: std::sync::atomic::AtomicU64,
-    steps: std::sync::atomic::AtomicU64,
-}
+/// The compliant model.
+#[derive(Debug, Clone, Copy)]
+pub struct Compliant;
 
-impl Progress {
-    /// Simulated time reached, s.
-    pub fn time(&self) -> f64 {
-        f64::from_bits(self.t.load(std::sync::atomic::Ordering::Relaxed))
+impl Simulator for Compliant {
+    fn model(&self) -> Model {
+        Model::Compliant
     }
-    /// Steps taken (accepted and rejected).
-    pub fn steps(&self) -> u64 {
-        self.steps.load(std::sync::atomic::Ordering::Relaxed)
+
+    fn supports(&self, scene: &Scene) -> Result<(), String> {
+        let tolerance = scene.compliant.tolerance;
+        if !(tolerance > 0.0 && tolerance <= 1e-2) {
+            return Err(format!("its error tolerance must lie in (0, 1e-2] (got {})", crate::scene::human(tolerance)));
+        }
+        Ok(())
     }
-    fn set(&self, t: f64, steps: u64) {
-        self.t.store(t.to_bits(), std::sync::atomic::Ordering::Relaxed);
-        self.steps.store(steps, std::sync::atomic::Ordering::Relaxed);
+
+    fn simulate(&self, scene: &Scene, options: &RunOptions) -> Result<Run, ModelError> {
+        // Without a step budget the model still stops at MAX_STEPS rather than run for ever.
+        let meter = Meter::new(&RunOptions { max_steps: Some(options.max_steps.unwrap_or(MAX_STEPS)), ..*options }, PROGRESS_STEPS);
+        let system = System::new(scene);
+        let mut run = Driver::new(&system, options.record).run(&meter)?;
+        run.wall_time_s = meter.elapsed();
+        Ok(run)
+    }
+
+    fn checks(&self, scene: &Scene, run: &Run) -> Checks {
+        // Each step errs by at most the tolerance of the contact's scales; they add up at
+        // worst. Contact forces are equal and opposite and Runge-Kutta keeps linear invariants.
+        let balance = (run.events as f64 * scene.compliant.tolerance).max(1e-9);
+        Checks {
+            energy_gain: balance,
+            balance: Some(balance),
+            impact_gain: 1e-9,
+            exact_impacts: false,
+            momentum: 1e-9,
+            wall_overlap: overlap_bound(scene, run),
+            ball_overlap: None,
+            stall_by_rate: false,
+        }
+    }
+
+    fn settings(&self) -> &'static [Setting] {
+        &[Setting::Tolerance]
+    }
+
+    fn stepping(&self, _scene: &Scene) -> &'static str {
+        "adaptive"
     }
 }
 
-/// Why the compliant model could not finish a scene.
-#[derive(Debug, thiserror::Error)]
-pub enum CompliantError {
-    /// A budget ran out: more steps than `max_steps`, or more computing time than
-    /// `max_wall_s`. The run so far is kept, with what its steps cost.
-    #[error(
-        "scene `{scene}`: the compliant model stopped at t = {} s of {} s after {steps} steps and {wall_s:.1} s of computing: {budget}; {driver}",
-        crate::scene::human(*.t), crate::scene::human(*.horizon)
-    )]
-    OverBudget {
-        /// Scene name.
-        scene: String,
-        /// Simulated time reached, s.
-        t: f64,
-        /// The scene's horizon, s.
-        horizon: f64,
-        /// Steps taken.
-        steps: u64,
-        /// Computing time, s.
-        wall_s: f64,
-        /// Which budget ran out.
-        budget: String,
-        /// What the steps cost: the last step, the open contacts and the stiffest of them.
-        driver: String,
-        /// The run up to `t` (series, impacts, energy account so far).
-        partial: Box<Run>,
-    },
-    /// The step size fell to round-off.
-    #[error("scene `{scene}`: the compliant model's step fell to {h:e} s at t = {} s", crate::scene::human(*.t))]
-    StepUnderflow {
-        /// Scene name.
-        scene: String,
-        /// Simulated time reached, s.
-        t: f64,
-        /// Step tried, s.
-        h: f64,
-    },
-    /// The state became NaN or infinite.
-    #[error("scene `{scene}`: the compliant model's state became non-finite at t = {} s", crate::scene::human(*.t))]
-    NonFinite {
-        /// Scene name.
-        scene: String,
-        /// Simulated time reached, s.
-        t: f64,
-    },
-    /// The tolerance is not usable.
-    #[error("compliant model: tolerance must lie in (0, 1e-2] (got {})", crate::scene::human(*.0))]
-    Tolerance(f64),
-}
-
-/// Runs the compliant model on `scene` with the default options.
-pub fn simulate(scene: &Scene) -> Result<Run, CompliantError> {
-    simulate_with(scene, Options::default())
-}
-
-/// [`simulate`], keeping what `record` asks for.
-pub fn simulate_recording(scene: &Scene, record: Record) -> Result<Run, CompliantError> {
-    simulate_with(scene, Options { record, ..Options::default() })
-}
-
-/// Runs the compliant model on `scene` with `options`.
-pub fn simulate_with(scene: &Scene, options: Options) -> Result<Run, CompliantError> {
-    simulate_watched(scene, options, None)
-}
-
-/// [`simulate_with`], telling `progress` where the run stands as it goes.
-pub fn simulate_watched(scene: &Scene, options: Options, progress: Option<&Progress>) -> Result<Run, CompliantError> {
-    if !(options.tolerance > 0.0 && options.tolerance <= 1e-2) {
-        return Err(CompliantError::Tolerance(options.tolerance));
-    }
-    let start = Instant::now();
-    let system = System::new(scene);
-    let mut run = Driver::new(&system, options).run(start, progress)?;
-    run.wall_time_s = start.elapsed().as_secs_f64();
-    Ok(run)
+/// How far the compliant model's balls may legitimately overlap a wall: twice the elastic
+/// overlap of the fastest impact (the heaviest ball on the stiffest-to-reach, i.e. softest,
+/// wall contact) plus the static overlap of all the balls pressed by the frame's largest
+/// acceleration.
+fn overlap_bound(scene: &Scene, run: &Run) -> f64 {
+    let e_star = contact::effective_modulus(&scene.compliant);
+    let r_min = scene.balls.iter().map(|b| b.radius).fold(f64::INFINITY, f64::min);
+    let k = contact::stiffness(e_star, contact::effective_radius(r_min, None));
+    let m_max = scene.balls.iter().map(|b| b.mass).fold(0.0, f64::max);
+    let m_all: f64 = scene.balls.iter().map(|b| b.mass).sum();
+    let u_max = run.impacts.iter().map(|i| i.approach_speed).fold(0.0, f64::max);
+    let a_max = run.series.a.iter().fold(0.0f64, |m, a| m.max(a.abs()));
+    1e-9 * scene.container.map_or(1e-3, |c| c.length.max(1e-3))
+        + 2.0 * (contact::max_overlap(m_max, u_max, k) + (m_all * a_max / k).powf(2.0 / 3.0))
 }
 
 /// One side of a pair.
@@ -488,7 +429,6 @@ struct Contact {
 
 struct Driver<'s, 'a> {
     sys: &'s System<'a>,
-    options: Options,
     rk: Dopri5,
     /// The stiff integrator, its factored stage matrix, the forcing's time derivative and a
     /// scratch state for it.
@@ -521,7 +461,7 @@ struct Driver<'s, 'a> {
 }
 
 impl<'s, 'a> Driver<'s, 'a> {
-    fn new(sys: &'s System<'a>, options: Options) -> Self {
+    fn new(sys: &'s System<'a>, record: Record) -> Self {
         let scene = sys.scene;
         let mut y = vec![0.0; sys.len()];
         if sys.has_frame() {
@@ -534,7 +474,6 @@ impl<'s, 'a> Driver<'s, 'a> {
         let samples = scene.sample_count();
         Driver {
             sys,
-            options,
             rk: Dopri5::new(sys.len()),
             rodas: Rodas4::new(sys.len()),
             stage: jacobian::Stage::default(),
@@ -550,7 +489,7 @@ impl<'s, 'a> Driver<'s, 'a> {
             contacts: vec![None; sys.pairs.len()],
             v_max: vec![0.0; sys.pairs.len()],
             impacts: Vec::new(),
-            recorder: Recorder::new(sys.scene, options.record),
+            recorder: Recorder::new(sys.scene, record),
             next_sample: 0,
             sample_count: samples,
             steps: 0,
@@ -694,7 +633,7 @@ impl<'s, 'a> Driver<'s, 'a> {
                 speed = speed.min(v);
             }
         }
-        let tol = self.options.tolerance;
+        let tol = sys.scene.compliant.tolerance;
         // Positions are absolute coordinates: no scale below a few ulps of the largest.
         let ulps = 8.0 * f64::EPSILON * (0..sys.n).map(|i| self.y[sys.x(i)].abs()).fold(self.y[XS].abs(), f64::max);
         let (ex, ev) = ((tol * length).max(ulps), tol * speed);
@@ -943,7 +882,7 @@ impl<'s, 'a> Driver<'s, 'a> {
         let (series, motion) = self.recorder.finish();
         Run {
             scene: scene.name.clone(),
-            model: crate::run::Model::Compliant,
+            model: Model::Compliant,
             horizon: self.t,
             sample_dt: scene.sample_dt,
             initial_displacement: scene.initial_displacement,
@@ -959,7 +898,7 @@ impl<'s, 'a> Driver<'s, 'a> {
         }
     }
 
-    fn run(mut self, start: Instant, progress: Option<&Progress>) -> Result<Run, CompliantError> {
+    fn run(mut self, meter: &Meter) -> Result<Run, ModelError> {
         let sys = self.sys;
         let scene = sys.scene;
         let horizon = scene.horizon;
@@ -971,34 +910,24 @@ impl<'s, 'a> Driver<'s, 'a> {
         let mut h = sys.h_floor.min(sys.h_max);
         while self.t < horizon {
             self.steps += 1;
-            let over_steps = self.steps > self.options.max_steps;
-            if over_steps || self.steps % PROGRESS_STEPS == 0 {
-                if let Some(p) = progress {
-                    p.set(self.t, self.steps);
-                }
-                let wall_s = start.elapsed().as_secs_f64();
-                let over_time = self.options.max_wall_s.is_some_and(|w| wall_s > w);
-                if over_steps || over_time {
-                    let budget = if over_steps {
-                        format!("more than {} steps (--max-steps)", self.options.max_steps)
-                    } else {
-                        format!("more than {} s of computing (--max-wall-time)", crate::scene::human(self.options.max_wall_s.unwrap_or(0.0)))
-                    };
-                    let driver = self.cost_driver(h);
-                    let (t, steps) = (self.t, self.steps - 1);
-                    let mut partial = self.finish(initial);
-                    partial.wall_time_s = wall_s;
-                    return Err(CompliantError::OverBudget {
-                        scene: scene.name.clone(),
-                        t,
-                        horizon,
-                        steps,
-                        wall_s,
-                        budget,
-                        driver,
-                        partial: Box::new(partial),
-                    });
-                }
+            if let Some(budget) = meter.look(self.t, self.steps) {
+                let wall_s = meter.elapsed();
+                let cost = self.cost_driver(h);
+                let (t, steps) = (self.t, self.steps - 1);
+                let mut partial = self.finish(initial);
+                partial.wall_time_s = wall_s;
+                return Err(ModelError::OverBudget(Box::new(OverBudget {
+                    scene: scene.name.clone(),
+                    model: Model::Compliant,
+                    t,
+                    horizon,
+                    steps,
+                    wall_s,
+                    budget,
+                    limit: meter.limit(budget),
+                    cost,
+                    partial,
+                })));
             }
             let remaining = horizon - self.t;
             let (explicit_bound, implicit_bound) = self.step_bound();
@@ -1008,7 +937,8 @@ impl<'s, 'a> Driver<'s, 'a> {
             self.stiff = sys.damping_rate(&self.y, &self.dy, &self.v_max) * explicit_bound.min(remaining) > STIFF_LIMIT;
             let h_try = if self.stiff { h.min(implicit_bound).min(remaining) } else { h_explicit };
             if self.t + h_try == self.t {
-                return Err(CompliantError::StepUnderflow { scene: scene.name.clone(), t: self.t, h: h_try });
+                let why = format!("its step fell to {h_try:e} s");
+                return Err(ModelError::Stalled { scene: scene.name.clone(), model: Model::Compliant, t: self.t, steps: self.steps, why });
             }
             self.update_scales();
             self.attempt(h_try);
@@ -1057,7 +987,8 @@ impl<'s, 'a> Driver<'s, 'a> {
                     self.peak_true_acceleration = self.peak_true_acceleration.max(self.dy[VS].abs());
                 }
                 if !self.y.iter().all(|v| v.is_finite()) {
-                    return Err(CompliantError::NonFinite { scene: scene.name.clone(), t: self.t });
+                    let reason = format!("its state became non-finite at t = {} s", crate::scene::human(self.t));
+                    return Err(ModelError::Unstable { scene: scene.name.clone(), model: Model::Compliant, t: self.t, reason });
                 }
                 self.sample(t0, h_done, true);
             }
@@ -1066,9 +997,7 @@ impl<'s, 'a> Driver<'s, 'a> {
                 self.derivative();
             }
         }
-        if let Some(p) = progress {
-            p.set(self.t, self.steps);
-        }
+        meter.finish(self.t, self.steps);
         Ok(self.finish(initial))
     }
 }

@@ -18,11 +18,9 @@ pub mod record;
 pub mod resources;
 pub mod stepping;
 
-use std::time::Instant;
-
 use bevy::prelude::*;
 
-use crate::model::ModelError;
+use crate::model::{Checks, Meter, Model, ModelError, OverBudget, RunOptions, Setting, Simulator};
 use crate::run::{EnergyAccount, Record, Run};
 use crate::scene::Scene;
 pub use plugin::{DamperSet, DamperStep, LpcDamperPlugins};
@@ -120,71 +118,107 @@ pub fn headless_app_recording(scene: &Scene, settings: StepSettings, record: Rec
     app
 }
 
-/// Runs the contact model on `scene`.
-pub fn simulate(scene: &Scene) -> Result<Run, ModelError> {
-    simulate_with(scene, settings(scene))
+/// The contact model.
+#[derive(Debug, Clone, Copy)]
+pub struct Rapier;
+
+impl Simulator for Rapier {
+    fn model(&self) -> Model {
+        Model::Rapier
+    }
+
+    fn supports(&self, _scene: &Scene) -> Result<(), String> {
+        Ok(())
+    }
+
+    fn simulate(&self, scene: &Scene, options: &RunOptions) -> Result<Run, ModelError> {
+        simulate_with(scene, settings(scene), options)
+    }
+
+    fn checks(&self, _scene: &Scene, _run: &Run) -> Checks {
+        // f32 velocities, one rounding per impulse; Rapier's contacts sink by up to its allowed
+        // overlap before it corrects them, and balls deform nothing it could bound otherwise.
+        Checks {
+            energy_gain: ENERGY_GAIN_TOLERANCE,
+            balance: None,
+            impact_gain: ENERGY_GAIN_TOLERANCE,
+            exact_impacts: false,
+            momentum: 1e-5,
+            wall_overlap: ALLOWED_OVERLAP + 1e-6,
+            ball_overlap: None,
+            stall_by_rate: true,
+        }
+    }
+
+    fn settings(&self) -> &'static [Setting] {
+        &[Setting::Stepping, Setting::Dt, Setting::SolverIterations]
+    }
+
+    fn stepping(&self, scene: &Scene) -> &'static str {
+        settings(scene).stepping.name()
+    }
 }
 
-/// Runs the contact model on `scene` with `settings` as given (no step bound applied).
-pub fn simulate_with(scene: &Scene, settings: StepSettings) -> Result<Run, ModelError> {
-    run_app(scene, settings, Record::Series, None)
-}
-
-/// Runs the contact model on `scene`, keeping what `record` asks for.
-pub fn simulate_recording(scene: &Scene, record: Record) -> Result<Run, ModelError> {
-    run_app(scene, settings(scene), record, None)
-}
-
-/// [`simulate_recording`] within `max_wall_s` seconds of computing, if given
-/// ([`ModelError::OverBudget`]).
-pub fn simulate_within(scene: &Scene, record: Record, max_wall_s: Option<f64>) -> Result<Run, ModelError> {
-    run_app(scene, settings(scene), record, max_wall_s)
-}
-
-/// Steps between two looks at the computing-time budget.
+/// Steps between two looks at the budgets and two reports of progress.
 const BUDGET_STEPS: u64 = 256;
 
-fn run_app(scene: &Scene, settings: StepSettings, record: Record, max_wall_s: Option<f64>) -> Result<Run, ModelError> {
-    let start = Instant::now();
-    let mut app = headless_app_recording(scene, settings, record);
+/// Runs the contact model on `scene` with the plug-in's `settings` as given (no step bound
+/// applied): for studies of the contact model itself, which vary what the scene does not say.
+pub fn simulate_with(scene: &Scene, settings: StepSettings, options: &RunOptions) -> Result<Run, ModelError> {
+    let meter = Meter::new(options, BUDGET_STEPS);
+    let mut app = headless_app_recording(scene, settings, options.record);
     // The first update spawns the scene, lets bevy_rapier create its bodies and takes the
     // first step; the rest run the lean step schedule alone.
     app.update();
     let world = app.world_mut();
-    while world.resource::<StepClock>().t < scene.horizon * (1.0 - 1e-12) {
-        world.run_schedule(DamperStep);
-        if let Some(budget) = max_wall_s {
-            let clock = world.resource::<StepClock>();
-            let wall_s = start.elapsed().as_secs_f64();
-            if clock.steps % BUDGET_STEPS == 0 && wall_s > budget {
-                return Err(ModelError::OverBudget(format!(
-                    "scene `{}`: the contact model stopped at t = {} s after {} steps and {wall_s:.1} s of computing: more than {budget} s of computing",
-                    scene.name,
-                    crate::scene::human(clock.t),
-                    clock.steps
-                )));
-            }
+    loop {
+        let clock = *world.resource::<StepClock>();
+        if clock.t >= scene.horizon * (1.0 - 1e-12) {
+            break;
         }
+        if let Some(budget) = meter.look(clock.t, clock.steps) {
+            let wall_s = meter.elapsed();
+            let cost = format!("{} impacts so far; the last step was {} s", world.resource::<Recording>().impacts.len(), crate::scene::human(world.resource::<StepPlan>().h));
+            let mut partial = collect(world, scene, clock.t, clock.steps);
+            partial.wall_time_s = wall_s;
+            return Err(ModelError::OverBudget(Box::new(OverBudget {
+                scene: scene.name.clone(),
+                model: Model::Rapier,
+                t: clock.t,
+                horizon: scene.horizon,
+                steps: clock.steps,
+                wall_s,
+                budget,
+                limit: meter.limit(budget),
+                cost,
+                partial,
+            })));
+        }
+        world.run_schedule(DamperStep);
         if let Some(reason) = world.resource::<Recording>().failure.clone() {
-            return Err(ModelError::Unstable(format!(
-                "scene `{}`: the contact model stopped: {reason}; the reference and compliant models can run it",
-                scene.name
-            )));
+            let t = world.resource::<StepClock>().t;
+            return Err(ModelError::Unstable {
+                scene: scene.name.clone(),
+                model: Model::Rapier,
+                t,
+                reason: format!("{reason}; the reference and compliant models can run it"),
+            });
         }
     }
     let steps = app.world().resource::<StepClock>().steps;
-    let mut run = collect(app.world_mut(), scene, steps);
-    run.wall_time_s = start.elapsed().as_secs_f64();
+    meter.finish(scene.horizon, steps);
+    let mut run = collect(app.world_mut(), scene, scene.horizon, steps);
+    run.wall_time_s = meter.elapsed();
     Ok(run)
 }
 
-/// The [`Run`] recorded in `world`.
-pub fn collect(world: &mut World, scene: &Scene, steps: u64) -> Run {
+/// The [`Run`] recorded in `world`, up to time `t` (the horizon, or where a budget stopped it).
+pub fn collect(world: &mut World, scene: &Scene, t: f64, steps: u64) -> Run {
     let rec = world.remove_resource::<Recording>().expect("recording");
     let frame = world.get_resource::<FrameState>().copied();
     let (xs, vs) = frame.map_or((0.0, 0.0), |f| f.now);
     let f = scene.frame;
-    let final_ = scene.frame_energy(scene.horizon, xs, vs)
+    let final_ = scene.frame_energy(t, xs, vs)
         + scene.balls.iter().zip(&rec.v).map(|(b, v)| 0.5 * b.mass * v * v).sum::<f64>();
     let energy = EnergyAccount::forced(
         scene.initial_energy(),
@@ -196,8 +230,8 @@ pub fn collect(world: &mut World, scene: &Scene, steps: u64) -> Run {
     let (series, motion) = rec.recorder.finish();
     Run {
         scene: scene.name.clone(),
-        model: crate::run::Model::Rapier,
-        horizon: scene.horizon,
+        model: Model::Rapier,
+        horizon: t,
         sample_dt: scene.sample_dt,
         initial_displacement: scene.initial_displacement,
         damped_period: f.map_or(0.0, |f| f.damped_period()),

@@ -229,7 +229,7 @@ impl Solver<'_> {
     /// ones), so each pass re-reads only the pairs its last impulse changed: the pair's
     /// neighbours, and every ball-frame pair when the frame's velocity changed. With `checked`
     /// the first pass takes the pairs [`Solver::check_contacts`] has just read at this state.
-    pub(super) fn resolve(&mut self, checked: bool) -> Result<(), ReferenceError> {
+    pub(super) fn resolve(&mut self, checked: bool) -> Result<(), ModelError> {
         let range = self.pair_range();
         let mut contacts = std::mem::take(&mut self.contacts);
         contacts.clear();
@@ -318,11 +318,6 @@ impl Solver<'_> {
                 return Ok(());
             }
         }
-        Err(ReferenceError::Stalled {
-            scene: self.scene.name.clone(),
-            events: self.events,
-            t: self.t,
-            why: format!("{most_passes} impacts, merges and releases at one instant did not settle"),
-        })
+        Err(self.stalled(format!("{most_passes} impacts, merges and releases at one instant did not settle")))
     }
 }

@@ -12,7 +12,7 @@
 //! (the damper) and at its events (impacts), so each level is crossed once and bisected.
 
 use super::*;
-use crate::metrics::{MotionMetrics, DISSIPATION_LEVELS, SETTLING_FRACTION};
+use crate::run::{MotionMetrics, DISSIPATION_LEVELS, SETTLING_FRACTION};
 use crate::scene::Frame;
 
 /// Bisection steps that pin a crossing to an ulp of the time.
@@ -169,6 +169,11 @@ impl ExactTally {
         }
         self.peak_displacement = self.peak_displacement.max(max_x);
         self.peak_acceleration = self.peak_acceleration.max(pa);
+    }
+
+    /// Ends the tally at `t`, before the horizon (a run stopped by its budget).
+    pub(super) fn cut_at(&mut self, t: f64) {
+        self.horizon = t;
     }
 
     /// The metrics of the run, its last interval having ended at the horizon.

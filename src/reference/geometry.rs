@@ -165,7 +165,7 @@ impl Solver<'_> {
     ///
     /// Each pair read is kept in `self.pairs_now`: `resolve`, which comes next at the same
     /// instant and state, judges the contacts from them instead of reading every pair again.
-    pub(super) fn check_contacts(&mut self, trigger: Option<usize>) -> Result<(), ReferenceError> {
+    pub(super) fn check_contacts(&mut self, trigger: Option<usize>) -> Result<(), ModelError> {
         let mut pairs_now = std::mem::take(&mut self.pairs_now);
         pairs_now.clear();
         pairs_now.resize(self.n + 1, None);
@@ -179,14 +179,16 @@ impl Solver<'_> {
             let allowed = tol.max(self.accepted_overlap);
             if g < -allowed || apart {
                 let (a, b) = self.pair_bodies(p);
-                return Err(ReferenceError::ContactInvariant {
-                    scene: self.scene.name.clone(),
-                    t: self.t,
-                    pair: format!("{} / {}", Scene::body_name(a), Scene::body_name(b)),
-                    broken: if apart { "are apart at their contact" } else { "overlap" },
-                    by: g.abs(),
-                    tolerance: if apart { tol } else { allowed },
-                });
+                let what = format!(
+                    "its contact invariant at t = {} s: {} / {} {} by {:.3e} m (tolerance {:.3e} m)",
+                    crate::scene::human(self.t),
+                    Scene::body_name(a),
+                    Scene::body_name(b),
+                    if apart { "are apart at their contact" } else { "overlap" },
+                    g.abs(),
+                    if apart { tol } else { allowed },
+                );
+                return Err(ModelError::Broken { scene: self.scene.name.clone(), model: Model::Reference, t: self.t, what });
             }
         }
         self.pairs_now = pairs_now;

@@ -37,64 +37,12 @@ use output::*;
 use search::*;
 use segment::*;
 
-use std::time::Instant;
-
+use crate::model::{Budget, Checks, Meter, Model, ModelError, OverBudget, RunOptions, Setting, Simulator};
 use crate::run::{EnergyAccount, Impact, Record, Recorder, Run};
 use crate::scene::{Body, Scene};
 pub use crate::impact_law::impact_law;
 pub use crate::oscillator::Oscillator;
 use crate::oscillator::{gauss_legendre, Harmonic, ROUNDOFF_ULPS};
-
-/// Why the reference could not finish a scene.
-#[derive(Debug, thiserror::Error)]
-pub enum ReferenceError {
-    /// The solver gives up rather than run forever: more events than [`MAX_EVENTS`], more
-    /// than a thousand at one instant, or an instant whose impacts, merges
-    /// and releases do not settle.
-    #[error("scene `{scene}`: stalled after {events} events at t = {} s: {why}", crate::scene::human(*.t))]
-    Stalled {
-        /// Scene name.
-        scene: String,
-        /// Events processed.
-        events: u64,
-        /// Simulated time reached.
-        t: f64,
-        /// Which limit was reached.
-        why: String,
-    },
-    /// The computing-time budget ran out (a typed stop, not a failure of the scene).
-    #[error("scene `{scene}`: the reference stopped at t = {} s after {events} events and {wall_s:.1} s of computing: more than {budget_s} s of computing", crate::scene::human(*.t))]
-    OverBudget {
-        /// Scene name.
-        scene: String,
-        /// Events processed.
-        events: u64,
-        /// Simulated time reached.
-        t: f64,
-        /// Computing time, s.
-        wall_s: f64,
-        /// The budget, s.
-        budget_s: f64,
-    },
-    /// The postcondition of an event failed: a pair overlaps, or the pair whose contact was
-    /// taken does not touch, beyond the contact tolerance. The reference then missed or
-    /// mistimed a contact; it stops rather than go on with a wrong run.
-    #[error("scene `{scene}`: the reference broke its contact invariant at t = {} s: {pair} {broken} by {by:.3e} m (tolerance {tolerance:.3e} m); this is a bug of the reference, please report it with the scene file", crate::scene::human(*.t))]
-    ContactInvariant {
-        /// Scene name.
-        scene: String,
-        /// Simulated time of the event.
-        t: f64,
-        /// The two bodies, `left / right`.
-        pair: String,
-        /// What broke: `overlap` or `are apart at their contact`.
-        broken: &'static str,
-        /// By how much, m.
-        by: f64,
-        /// The contact tolerance there, m.
-        tolerance: f64,
-    },
-}
 
 /// Most events one run may process before it is declared stalled.
 pub const MAX_EVENTS: u64 = 20_000_000;
@@ -128,32 +76,77 @@ const STICK_SPEED: f64 = 1e-9;
 /// Bounce-return time below which a ball sticks to the frame, relative to the time scale.
 const STICK_TIME: f64 = 1e-7;
 
-/// Runs the reference model on `scene`.
-pub fn simulate(scene: &Scene) -> Result<Run, ReferenceError> {
-    simulate_recording(scene, Record::Series)
-}
-
-/// [`simulate`], keeping what `record` asks for.
-pub fn simulate_recording(scene: &Scene, record: Record) -> Result<Run, ReferenceError> {
-    simulate_within(scene, record, None)
-}
-
 /// Impacts a run makes room for at its start (80 bytes each).
 const IMPACTS_RESERVED: usize = 256;
 
-/// Events between two looks at the computing-time budget.
+/// Events between two looks at the budgets and two reports of progress.
 const BUDGET_EVENTS: u64 = 4096;
 
-/// [`simulate_recording`] within `max_wall_s` seconds of computing, if given
-/// ([`ReferenceError::OverBudget`]).
-pub fn simulate_within(scene: &Scene, record: Record, max_wall_s: Option<f64>) -> Result<Run, ReferenceError> {
-    let start = Instant::now();
-    let mut solver = Solver::new(scene, record);
-    solver.budget = max_wall_s.map(|w| (start, w));
-    solver.run()?;
-    let mut run = solver.finish();
-    run.wall_time_s = start.elapsed().as_secs_f64();
-    Ok(run)
+/// The reference model.
+#[derive(Debug, Clone, Copy)]
+pub struct Reference;
+
+impl Simulator for Reference {
+    fn model(&self) -> Model {
+        Model::Reference
+    }
+
+    fn supports(&self, _scene: &Scene) -> Result<(), String> {
+        Ok(())
+    }
+
+    fn simulate(&self, scene: &Scene, options: &RunOptions) -> Result<Run, ModelError> {
+        let meter = Meter::new(options, BUDGET_EVENTS);
+        let mut solver = Solver::new(scene, options.record);
+        let stop = solver.run(&meter)?;
+        let (t, events) = (solver.t, solver.events);
+        meter.finish(t, events);
+        let Some(budget) = stop else {
+            let mut run = solver.finish();
+            run.wall_time_s = meter.elapsed();
+            return Ok(run);
+        };
+        let cost = format!("{} impacts so far", solver.impacts.len());
+        let mut partial = solver.finish_at(t);
+        let wall_s = meter.elapsed();
+        partial.wall_time_s = wall_s;
+        Err(ModelError::OverBudget(Box::new(OverBudget {
+            scene: scene.name.clone(),
+            model: Model::Reference,
+            t,
+            horizon: scene.horizon,
+            steps: events,
+            wall_s,
+            budget,
+            limit: meter.limit(budget),
+            cost,
+            partial,
+        })))
+    }
+
+    fn checks(&self, scene: &Scene, _run: &Run) -> Checks {
+        // Exact to round-off: contacts within the contact tolerance (a bound of order 1e-13 to
+        // 1e-11 m, docs/MODEL.md §10), far inside a nanometre per millimetre of container.
+        let contact = 1e-9 * scene.container.map_or(1e-3, |c| c.length.max(1e-3));
+        Checks {
+            energy_gain: 1e-9,
+            balance: Some(1e-9),
+            impact_gain: 1e-9,
+            exact_impacts: true,
+            momentum: 1e-9,
+            wall_overlap: contact,
+            ball_overlap: Some(contact),
+            stall_by_rate: true,
+        }
+    }
+
+    fn settings(&self) -> &'static [Setting] {
+        &[]
+    }
+
+    fn stepping(&self, _scene: &Scene) -> &'static str {
+        "event-driven"
+    }
 }
 
 /// Which wall a stuck ball is held by.
@@ -226,8 +219,6 @@ struct Solver<'a> {
     last_impact: Vec<Option<usize>>,
     events: u64,
     recorder: Recorder,
-    /// When the run started and how many seconds of computing it may take.
-    budget: Option<(Instant, f64)>,
     /// Exact metrics of a free run (`None` when forced or frameless: read at the samples).
     exact: Option<ExactTally>,
     next_sample: usize,
@@ -314,7 +305,6 @@ impl<'a> Solver<'a> {
             last_impact: vec![None; n + 1],
             events: 0,
             recorder: if exact.is_some() { recorder.untallied() } else { recorder },
-            budget: None,
             exact,
             next_sample: 0,
             sample_count: samples,
@@ -343,7 +333,8 @@ impl<'a> Solver<'a> {
         }
     }
 
-    fn run(&mut self) -> Result<(), ReferenceError> {
+    /// Runs the events to the horizon: `Some(budget)` when a budget stopped it first.
+    fn run(&mut self, meter: &Meter) -> Result<Option<Budget>, ModelError> {
         let mut same_instant = 0u64;
         self.resolve(false)?;
         loop {
@@ -380,11 +371,8 @@ impl<'a> Solver<'a> {
             self.advance(t);
             self.check_contacts(pair)?;
             self.events += 1;
-            if let Some((start, budget_s)) = self.budget.filter(|_| self.events % BUDGET_EVENTS == 0) {
-                let wall_s = start.elapsed().as_secs_f64();
-                if wall_s > budget_s {
-                    return Err(ReferenceError::OverBudget { scene: self.scene.name.clone(), events: self.events, t, wall_s, budget_s });
-                }
+            if let Some(budget) = meter.look(t, self.events) {
+                return Ok(Some(budget));
             }
             if self.events > MAX_EVENTS || same_instant > MAX_EVENTS_PER_INSTANT {
                 let why = if same_instant > MAX_EVENTS_PER_INSTANT {
@@ -392,7 +380,7 @@ impl<'a> Solver<'a> {
                 } else {
                     format!("more than {MAX_EVENTS} events")
                 };
-                return Err(ReferenceError::Stalled { scene: self.scene.name.clone(), events: self.events, t, why });
+                return Err(self.stalled(why));
             }
             if release {
                 self.release_at = f64::INFINITY;
@@ -408,7 +396,12 @@ impl<'a> Solver<'a> {
         self.tally_until(self.horizon);
         self.sample_until(self.horizon, true);
         self.advance(self.horizon);
-        self.check_contacts(None)
+        self.check_contacts(None)?;
+        Ok(None)
     }
 
+    /// The stall of this run at the current time, for `why`.
+    fn stalled(&self, why: String) -> ModelError {
+        ModelError::Stalled { scene: self.scene.name.clone(), model: Model::Reference, t: self.t, steps: self.events, why }
+    }
 }

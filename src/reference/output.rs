@@ -98,6 +98,16 @@ impl Solver<'_> {
                 .sum::<f64>()
     }
 
+    /// The run so far, cut at the current time `t` (a budget stopped it there): its samples
+    /// before `t`, its impacts, its energy account to `t`.
+    pub(super) fn finish_at(mut self, t: f64) -> Run {
+        self.horizon = t;
+        if let Some(exact) = &mut self.exact {
+            exact.cut_at(t);
+        }
+        self.finish()
+    }
+
     pub(super) fn finish(mut self) -> Run {
         if self.has_frame() {
             self.book_segment_energy();
@@ -116,7 +126,7 @@ impl Solver<'_> {
         let motion = self.exact.map_or(sampled, |e| e.finish());
         Run {
             scene: self.scene.name.clone(),
-            model: crate::run::Model::Reference,
+            model: Model::Reference,
             horizon: self.horizon,
             sample_dt: self.scene.sample_dt,
             initial_displacement: self.scene.initial_displacement,

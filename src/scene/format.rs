@@ -194,6 +194,8 @@ pub struct CompliantFile {
     pub youngs_modulus: Option<f64>,
     /// Poisson's ratio `nu` (default 0.3).
     pub poisson_ratio: Option<f64>,
+    /// Error tolerance per step, relative to the contact scales (default 1e-9).
+    pub tolerance: Option<f64>,
 }
 
 /// What the harmonic forcing acts on.

@@ -140,18 +140,24 @@ pub struct RapierSettings {
     pub ccd: Option<bool>,
 }
 
-/// Material of balls and walls for the compliant contact model (docs/MODEL.md §9; steel by default).
+/// Material of balls and walls for the compliant contact model (docs/MODEL.md §9; steel by
+/// default), and the error tolerance of its integration.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct CompliantSettings {
     /// Young's modulus `E`, Pa.
     pub youngs_modulus: f64,
     /// Poisson's ratio `nu`.
     pub poisson_ratio: f64,
+    /// Error tolerance per step, relative to the contact scales.
+    pub tolerance: f64,
 }
+
+/// The compliant model's error tolerance when the scene sets none.
+pub const DEFAULT_COMPLIANT_TOLERANCE: f64 = 1e-9;
 
 impl Default for CompliantSettings {
     fn default() -> Self {
-        CompliantSettings { youngs_modulus: 200e9, poisson_ratio: 0.3 }
+        CompliantSettings { youngs_modulus: 200e9, poisson_ratio: 0.3, tolerance: DEFAULT_COMPLIANT_TOLERANCE }
     }
 }
 
@@ -672,6 +678,8 @@ pub struct Overrides {
     pub solver_iterations: Option<u32>,
     /// `--ccd`: Rapier's swept CCD on the balls.
     pub ccd: bool,
+    /// `--tolerance`: the compliant model's error tolerance.
+    pub tolerance: Option<f64>,
     /// `--kind`: force or base motion (a scene without `[forcing]` gets one).
     pub forcing_kind: Option<ForcingKind>,
     /// `--amplitude`: the forcing's amplitude, N or m.
@@ -689,6 +697,7 @@ impl Overrides {
             ("run.sample_dt", "--sample-dt", self.sample_dt.is_some()),
             ("rapier.dt", "--dt", self.dt.is_some()),
             ("rapier.solver_iterations", "--solver-iterations", self.solver_iterations.is_some()),
+            ("compliant.tolerance", "--tolerance", self.tolerance.is_some()),
             ("forcing.amplitude", "--amplitude", self.forcing_amplitude.is_some()),
             ("forcing.frequency", "--freq", self.forcing_frequency.is_some()),
         ];
@@ -703,6 +712,15 @@ impl Overrides {
                 dt: self.dt.or(r.dt),
                 solver_iterations: self.solver_iterations.or(r.solver_iterations),
                 ccd: if self.ccd { Some(true) } else { r.ccd },
+            },
+            &v,
+        )?;
+        let c = &scene.compliant;
+        let compliant = compliant_settings(
+            &format::CompliantFile {
+                youngs_modulus: Some(c.youngs_modulus),
+                poisson_ratio: Some(c.poisson_ratio),
+                tolerance: Some(self.tolerance.unwrap_or(c.tolerance)),
             },
             &v,
         )?;
@@ -723,19 +741,20 @@ impl Overrides {
                 Some(forcing(&g, &frame, &v)?)
             }
         };
-        Ok(Scene { horizon, sample_dt, rapier, forcing, ..scene })
+        Ok(Scene { horizon, sample_dt, rapier, compliant, forcing, ..scene })
     }
-    /// The Rapier flags alone against the file's rules (for commands that take lists of them
-    /// before any scene is loaded); an error names the flag.
-    pub fn validate_rapier(&self) -> Result<(), SceneError> {
-        let flags = [("rapier.dt", "--dt"), ("rapier.solver_iterations", "--solver-iterations")];
+    /// The models' settings alone against the file's rules (for commands that take lists of
+    /// them before any scene is loaded); an error names the flag.
+    pub fn validate_settings(&self) -> Result<(), SceneError> {
+        let flags = [("rapier.dt", "--dt"), ("rapier.solver_iterations", "--solver-iterations"), ("compliant.tolerance", "--tolerance")];
         let v = Validator { file: "(command line)", flags: &flags };
         let r = format::RapierFile { stepping: self.stepping, dt: self.dt, solver_iterations: self.solver_iterations, ccd: Some(self.ccd) };
-        rapier_settings(&r, &v).map(drop)
+        rapier_settings(&r, &v)?;
+        compliant_settings(&format::CompliantFile { tolerance: self.tolerance, ..Default::default() }, &v).map(drop)
     }
 }
 
-/// `file` with the run, Rapier and forcing settings of `scene` (built from it, perhaps with
+/// `file` with the run, Rapier, compliant and forcing settings of `scene` (built from it, perhaps with
 /// [`Overrides`]): what a study that varies the file's other parameters rebuilds from, so that
 /// the command line's settings hold for every variant.
 pub fn with_settings_of(file: &SceneFile, scene: &Scene) -> SceneFile {
@@ -743,6 +762,11 @@ pub fn with_settings_of(file: &SceneFile, scene: &Scene) -> SceneFile {
     SceneFile {
         run: format::RunFile { horizon: Some(scene.horizon), sample_dt: Some(scene.sample_dt) },
         rapier: format::RapierFile { stepping: r.stepping, dt: r.dt, solver_iterations: r.solver_iterations, ccd: r.ccd },
+        compliant: format::CompliantFile {
+            youngs_modulus: Some(scene.compliant.youngs_modulus),
+            poisson_ratio: Some(scene.compliant.poisson_ratio),
+            tolerance: Some(scene.compliant.tolerance),
+        },
         forcing: scene.forcing.map(|g| format::ForcingFile { kind: g.kind, amplitude: g.amplitude, frequency: g.frequency }),
         ..file.clone()
     }
@@ -895,7 +919,11 @@ fn compliant_settings(c: &format::CompliantFile, v: &Validator) -> Result<Compli
     if !(poisson_ratio > -1.0 && poisson_ratio < 0.5) {
         return Err(v.err("compliant.poisson_ratio", &format!("must lie in (-1, 0.5) for a stable solid (got {poisson_ratio})")));
     }
-    Ok(CompliantSettings { youngs_modulus, poisson_ratio })
+    let tolerance = v.positive("compliant.tolerance", c.tolerance.unwrap_or(d.tolerance))?;
+    if tolerance > 1e-2 {
+        return Err(v.err("compliant.tolerance", &format!("must lie in (0, 1e-2] (got {})", human(tolerance))));
+    }
+    Ok(CompliantSettings { youngs_modulus, poisson_ratio, tolerance })
 }
 
 fn forcing(g: &format::ForcingFile, frame: &Frame, v: &Validator) -> Result<Forcing, SceneError> {

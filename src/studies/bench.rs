@@ -4,10 +4,10 @@
 
 use serde::{Deserialize, Serialize};
 
+use super::StudyError;
+use crate::model::{Model, RunOptions, Setting};
+use crate::scene::{Overrides, Scene, Stepping};
 use crate::studies::compare::{errors, Errors};
-use crate::model::{Model, ModelError};
-use crate::rapier::Stepping;
-use crate::scene::Scene;
 
 /// A setting of a model (all `None` for the reference, which has none).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
@@ -47,16 +47,38 @@ pub struct BenchRow {
 pub struct Plan {
     /// Models.
     pub models: Vec<Model>,
-    /// Rapier steppings.
+    /// Steppings, for models that read one.
     pub steppings: Vec<Stepping>,
-    /// Rapier steps.
+    /// Steps, for models that read one.
     pub dts: Vec<f64>,
-    /// Rapier solver iterations.
+    /// Solver iterations, for models that read them.
     pub solver_iterations: Vec<u32>,
-    /// Compliant model tolerances.
-    pub compliant_tolerances: Vec<f64>,
+    /// Error tolerances, for models that read one.
+    pub tolerances: Vec<f64>,
     /// Runs per setting (the median is kept).
     pub repeat: usize,
+}
+
+impl Plan {
+    /// The settings `model` is measured at: every combination of the values given for the
+    /// settings it reads (one, with none, for a model that reads none).
+    pub fn variants(&self, model: Model) -> Vec<Overrides> {
+        let mut variants = vec![Overrides::default()];
+        for setting in model.settings() {
+            variants = variants
+                .into_iter()
+                .flat_map(|v| -> Vec<Overrides> {
+                    match setting {
+                        Setting::Stepping => self.steppings.iter().map(|&x| Overrides { stepping: Some(x), ..v }).collect(),
+                        Setting::Dt => self.dts.iter().map(|&x| Overrides { dt: Some(x), ..v }).collect(),
+                        Setting::SolverIterations => self.solver_iterations.iter().map(|&x| Overrides { solver_iterations: Some(x), ..v }).collect(),
+                        Setting::Tolerance => self.tolerances.iter().map(|&x| Overrides { tolerance: Some(x), ..v }).collect(),
+                    }
+                })
+                .collect();
+        }
+        variants
+    }
 }
 
 fn median(mut v: Vec<f64>) -> f64 {
@@ -69,88 +91,38 @@ fn median(mut v: Vec<f64>) -> f64 {
     }
 }
 
-/// The scene with one Rapier setting applied.
-fn with_setting(scene: &Scene, stepping: Stepping, dt: f64, iterations: u32) -> Scene {
-    let mut s = scene.clone();
-    s.rapier.stepping = Some(stepping);
-    s.rapier.dt = Some(dt);
-    s.rapier.solver_iterations = Some(iterations);
-    s
-}
-
 /// Measures every setting of `plan` on `scene` (sequentially, so timings do not compete);
 /// `progress` is called after each setting.
-pub fn bench_scene(scene: &Scene, plan: &Plan, progress: &dyn Fn()) -> Result<Vec<BenchRow>, ModelError> {
-    let reference = Model::Reference.simulate(scene)?;
+pub fn bench_scene(scene: &Scene, plan: &Plan, progress: &dyn Fn()) -> Result<Vec<BenchRow>, StudyError> {
+    let defaults = RunOptions::default();
+    let reference = Model::Reference.simulate(scene, &defaults)?;
     let mut rows = Vec::new();
-    let timed = |s: &Scene, model: Model| -> Result<(f64, crate::run::Run), ModelError> {
-        let mut times = Vec::with_capacity(plan.repeat);
-        let mut last = None;
-        for _ in 0..plan.repeat.max(1) {
-            let run = model.simulate(s)?;
-            times.push(run.wall_time_s);
-            last = Some(run);
-        }
-        Ok((median(times) / s.horizon, last.expect("at least one run")))
-    };
     for &model in &plan.models {
-        match model {
-            Model::Reference => {
-                let (cost, run) = timed(scene, model)?;
-                rows.push(BenchRow {
-                    scene: scene.name.clone(),
-                    model,
-                    settings: Settings { stepping: "event-driven", dt: None, solver_iterations: None, tolerance: None },
-                    wall_s_per_sim_s: cost,
-                    errors: errors(&run, &reference),
-                    steps_per_sim_s: run.events as f64 / scene.horizon,
-                    pareto: false,
-                });
-                progress();
+        for variant in plan.variants(model) {
+            let s = variant.apply(scene.clone(), "(command line)")?;
+            let mut times = Vec::with_capacity(plan.repeat);
+            let mut last = None;
+            for _ in 0..plan.repeat.max(1) {
+                let run = model.simulate(&s, &defaults)?;
+                times.push(run.wall_time_s);
+                last = Some(run);
             }
-            Model::Compliant => {
-                for &tolerance in &plan.compliant_tolerances {
-                    let opts = crate::compliant::Options { tolerance, ..Default::default() };
-                    let mut times = Vec::with_capacity(plan.repeat);
-                    let mut last = None;
-                    for _ in 0..plan.repeat.max(1) {
-                        let run = crate::compliant::simulate_with(scene, opts)?;
-                        times.push(run.wall_time_s);
-                        last = Some(run);
-                    }
-                    let run = last.expect("at least one run");
-                    rows.push(BenchRow {
-                        scene: scene.name.clone(),
-                        model,
-                        settings: Settings { stepping: "adaptive", dt: None, solver_iterations: None, tolerance: Some(tolerance) },
-                        wall_s_per_sim_s: median(times) / scene.horizon,
-                        errors: errors(&run, &reference),
-                        steps_per_sim_s: run.events as f64 / scene.horizon,
-                        pareto: false,
-                    });
-                    progress();
-                }
-            }
-            Model::Rapier => {
-                for &stepping in &plan.steppings {
-                    for &dt in &plan.dts {
-                        for &it in &plan.solver_iterations {
-                            let s = with_setting(scene, stepping, dt, it);
-                            let (cost, run) = timed(&s, model)?;
-                            rows.push(BenchRow {
-                                scene: scene.name.clone(),
-                                model,
-                                settings: Settings { stepping: stepping.name(), dt: Some(dt), solver_iterations: Some(it), tolerance: None },
-                                wall_s_per_sim_s: cost,
-                                errors: errors(&run, &reference),
-                                steps_per_sim_s: run.events as f64 / scene.horizon,
-                                pareto: false,
-                            });
-                            progress();
-                        }
-                    }
-                }
-            }
+            let run = last.expect("at least one run");
+            rows.push(BenchRow {
+                scene: scene.name.clone(),
+                model,
+                settings: Settings {
+                    stepping: model.stepping(&s),
+                    dt: variant.dt,
+                    solver_iterations: variant.solver_iterations,
+                    tolerance: variant.tolerance,
+                },
+                wall_s_per_sim_s: median(times) / s.horizon,
+                errors: errors(&run, &reference),
+                steps_per_sim_s: run.events as f64 / s.horizon,
+                pareto: false,
+            });
+            progress();
         }
     }
     mark_pareto(&mut rows);

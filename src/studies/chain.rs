@@ -4,7 +4,7 @@
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
-use crate::model::{Model, ModelError};
+use crate::model::{RunOptions, Model, ModelError};
 use crate::run::Run;
 use crate::scene::{ChainCase, Scene};
 
@@ -30,7 +30,7 @@ pub fn run_chain(cases: &[ChainCase], model: Model) -> Result<Vec<KerRow>, Model
     cases
         .par_iter()
         .map(|c| {
-            let run = model.simulate(&c.scene)?;
+            let run = model.simulate(&c.scene, &RunOptions::default())?;
             Ok(KerRow { large: c.large, small: if c.small { c.large - 1 } else { 0 }, ker: ker(&c.scene, &run) })
         })
         .collect()

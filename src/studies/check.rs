@@ -22,7 +22,7 @@ use serde::{Deserialize, Serialize};
 use super::StudyError;
 use crate::studies::chain::{run_chain, KerRow};
 use crate::metrics::{metrics, Metrics};
-use crate::model::Model;
+use crate::model::{Model, RunOptions};
 use crate::scene;
 use crate::studies::sweep::sweep_scenes;
 
@@ -80,7 +80,7 @@ pub fn current(dir: &Path, models: &[Model]) -> Result<Vec<Golden>, StudyError> 
         }
         for &model in models {
             for s in &cases {
-                let run = model.simulate(s)?;
+                let run = model.simulate(s, &RunOptions::default())?;
                 out.push(Golden {
                     case: s.name.clone(),
                     model,

@@ -11,9 +11,9 @@ use rand_pcg::Pcg64;
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
-use crate::model::{Model, ModelError};
+use crate::model::{RunOptions, Model, ModelError};
 use crate::output::{Headline, SUMMARY_METRICS};
-use crate::run::{bytes_for_people, fits_in_memory, Record, MEMORY_SHARE};
+use crate::run::{refuse_beyond_memory, Record};
 use crate::scene::{self, Distribution, Length, Scene, SceneError, SceneFile, Tolerances};
 
 /// Draws one member may take before its tolerances are declared too wide for it.
@@ -209,17 +209,8 @@ pub fn members_bytes(scene: &Scene, count: usize) -> f64 {
 
 /// Refuses, with the numbers, an ensemble whose members would not fit in the memory left.
 fn check_members_memory(scene: &Scene, count: usize) -> Result<(), String> {
-    let need = members_bytes(scene, count);
-    fits_in_memory(need).map_err(|available| {
-        format!(
-            "is {count}: its members would take {} of memory ({} balls each), more than {:.0} % of the {} this \
-             process can still use; use fewer members",
-            bytes_for_people(need),
-            scene.balls.len(),
-            100.0 * MEMORY_SHARE,
-            bytes_for_people(available)
-        )
-    })
+    let what = format!("is {count}: its members ({} balls each)", scene.balls.len());
+    refuse_beyond_memory(members_bytes(scene, count), &what, "use fewer members")
 }
 
 struct Drawer<'a> {
@@ -382,7 +373,7 @@ pub fn run_members(
     let runs = map_members(
         &ensemble.members,
         |m| {
-            let run = model.simulate_recording(&m.scene, record)?;
+            let run = model.simulate(&m.scene, &RunOptions { record, ..RunOptions::default() })?;
             let metrics = Headline::of_run(&run).values();
             let series = keep_xs.then_some(run.series);
             Ok::<_, ModelError>((metrics, series))
@@ -416,15 +407,9 @@ pub fn run_members(
 /// Refuses, with the numbers, a band whose members' displacements would not fit in memory.
 fn check_band_memory(scene: &Scene, members: usize) -> Result<(), ModelError> {
     let need = scene.sample_count() as f64 * members as f64 * 8.0;
-    fits_in_memory(need).map_err(|available| {
-        ModelError::Refused(format!(
-            "the band of {members} members x {} samples would take {} of the {} this process can still use; \
-             raise run.sample_dt, use fewer members, or leave out --out (the metrics need no series)",
-            scene.sample_count(),
-            bytes_for_people(need),
-            bytes_for_people(available)
-        ))
-    })
+    let what = format!("the band of {members} members x {} samples", scene.sample_count());
+    refuse_beyond_memory(need, &what, "raise run.sample_dt, use fewer members, or leave out --out (the metrics need no series)")
+        .map_err(ModelError::Refused)
 }
 
 /// A distribution's summary: median, 5-95 % band, mean, standard deviation and range of the

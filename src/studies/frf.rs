@@ -18,7 +18,7 @@
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
-use crate::model::{Model, ModelError};
+use crate::model::{RunOptions, Model, ModelError};
 use crate::studies::ensemble::{Member, Stats};
 use crate::run::Run;
 use crate::scene::Scene;
@@ -128,7 +128,7 @@ pub fn steady_peaks(scene: &Scene, model: Model) -> Result<(SteadyState, f64, Ve
                 crate::scene::human(s.sample_dt)
             ))
         })?;
-        let run = model.simulate(&s)?;
+        let run = model.simulate(&s, &RunOptions::default())?;
         let peaks = period_peaks(&run, period);
         let reading = steady_reading(&run, &peaks, period);
         if reading.steady || doubling == MAX_DOUBLINGS {
@@ -185,16 +185,8 @@ pub fn check_ensemble_memory(members: usize, frequencies: usize) -> Result<(), S
     let per_run = (std::mem::size_of::<(usize, usize, bool)>()
         + std::mem::size_of::<Result<(Vec<f64>, SteadyState), ModelError>>()
         + 2 * BLOCK_PERIODS * std::mem::size_of::<f64>()) as f64;
-    crate::run::fits_in_memory(runs * per_run).map_err(|available| {
-        format!(
-            "is {members} over {frequencies} frequencies: {} runs whose results would take {} of memory, more than {:.0} % of \
-             the {} left; use fewer members or frequencies",
-            crate::scene::human(runs),
-            crate::run::bytes_for_people(runs * per_run),
-            100.0 * crate::run::MEMORY_SHARE,
-            crate::run::bytes_for_people(available)
-        )
-    })
+    let what = format!("is {members} over {frequencies} frequencies: {} runs whose results", crate::scene::human(runs));
+    crate::run::refuse_beyond_memory(runs * per_run, &what, "use fewer members or frequencies")
 }
 
 /// The frequency response over `members`: each run per frequency with and without the damper,

@@ -12,8 +12,7 @@ use serde::{Deserialize, Serialize};
 
 use super::StudyError;
 use crate::studies::frf;
-use crate::model::Model;
-use crate::run::Record;
+use crate::model::{Model, RunOptions};
 use crate::scene::{self, Arrangement, Length, Loaded, Scene, SceneError};
 use crate::studies::ensemble;
 use crate::studies::sweep::Axis;
@@ -228,7 +227,7 @@ fn evaluate(
             let objective_of = |scene: &Scene| -> Result<Option<f64>, StudyError> {
                 Ok(match objective {
                     Objective::SettlingTime => {
-                        crate::metrics::metrics(&model.simulate_recording(scene, Record::MetricsOnly)?).settling_time
+                        crate::metrics::metrics(&model.simulate(scene, &RunOptions::metrics_only())?).settling_time
                     }
                     Objective::ResonantAmplitude { from, to, steps } => {
                         let mut worst: f64 = 0.0;

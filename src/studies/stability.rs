@@ -9,7 +9,7 @@
 
 use serde::Serialize;
 
-use crate::model::{Model, ModelError};
+use crate::model::{Model, ModelError, RunOptions};
 use crate::rapier::{simulate_with, StepSettings, Stepping};
 use crate::scene::{self, Scene};
 
@@ -113,7 +113,7 @@ pub fn case_scene(case: Case, speed: f64) -> Scene {
 /// Runs one cell.
 pub fn cell(case: Case, config: Config, dt: f64, speed: f64) -> Cell {
     let scene = case_scene(case, speed);
-    let reference = crate::reference::simulate(&scene).expect("two balls never stall");
+    let reference = Model::Reference.simulate(&scene, &RunOptions::default()).expect("two balls never stall");
     let settings = StepSettings {
         stepping: config.stepping,
         dt,
@@ -124,7 +124,7 @@ pub fn cell(case: Case, config: Config, dt: f64, speed: f64) -> Cell {
         self_check: false,
     };
     let e0 = scene.initial_energy();
-    let (outcome, energy_error) = match simulate_with(&scene, settings) {
+    let (outcome, energy_error) = match simulate_with(&scene, settings, &RunOptions::default()) {
         Err(ModelError::Refused(_)) => ("refused".to_string(), 0.0),
         Err(e) => (format!("error: {e}"), f64::NAN),
         Ok(run) => {

@@ -9,7 +9,7 @@ use rand::{Rng, SeedableRng};
 use rand_pcg::Pcg64;
 use serde::Serialize;
 
-use crate::model::Model;
+use crate::model::{Model, ModelError, RunOptions};
 use crate::run::Run;
 use crate::scene::format::{BallsFile, ForcingFile, FrameFile, RunFile};
 use crate::scene::{self, Arrangement, ForcingKind, Length, Scene, SceneFile};
@@ -194,7 +194,8 @@ pub enum Passed {
 /// Runs `model` on `scene` within `max_wall_s` seconds of computing (if given) and checks the
 /// run.
 pub fn judge_run(model: Model, scene: &Scene, max_wall_s: Option<f64>) -> Result<Passed, Failure> {
-    let outcome = catch_unwind(AssertUnwindSafe(|| model.simulate_within(scene, crate::run::Record::Series, max_wall_s)));
+    let options = RunOptions { max_wall_s, ..RunOptions::default() };
+    let outcome = catch_unwind(AssertUnwindSafe(|| model.simulate(scene, &options)));
     let run = match outcome {
         Err(panic) => {
             let msg = panic
@@ -204,23 +205,19 @@ pub fn judge_run(model: Model, scene: &Scene, max_wall_s: Option<f64>) -> Result
                 .unwrap_or_default();
             return Err(Failure { check: "panic", detail: msg });
         }
-        // Refusing with a reason, before or during the run, is a correct answer.
-        Ok(Err(crate::model::ModelError::Refused(reason))) => return Ok(Passed::Refused { reason, during_run: false }),
-        Ok(Err(crate::model::ModelError::Unstable(reason))) => return Ok(Passed::Refused { reason, during_run: true }),
-        Ok(Err(
-            e @ (crate::model::ModelError::OverBudget(_)
-            | crate::model::ModelError::Reference(crate::reference::ReferenceError::OverBudget { .. })
-            | crate::model::ModelError::Compliant(crate::compliant::CompliantError::OverBudget { .. })),
-        )) => return Ok(Passed::Stopped(e.to_string())),
-        Ok(Err(e)) => {
-            let check = match &e {
-                crate::model::ModelError::Reference(crate::reference::ReferenceError::ContactInvariant { .. }) => "invariant",
-                _ if e.to_string().contains("stalled") => "stall",
-                _ => "error",
-            };
-            return Err(Failure { check, detail: e.to_string() });
-        }
         Ok(Ok(run)) => run,
+        // Refusing with a reason, before or during the run, is a correct answer; so is a stop
+        // at the budget.
+        Ok(Err(e)) => {
+            let detail = e.to_string();
+            return match e {
+                ModelError::Refused(_) => Ok(Passed::Refused { reason: detail, during_run: false }),
+                ModelError::Unstable { .. } => Ok(Passed::Refused { reason: detail, during_run: true }),
+                ModelError::OverBudget(_) => Ok(Passed::Stopped(detail)),
+                ModelError::Broken { .. } => Err(Failure { check: "invariant", detail }),
+                ModelError::Stalled { .. } => Err(Failure { check: "stall", detail }),
+            };
+        }
     };
     judge(model, scene, &run)?;
     Ok(Passed::Run(Box::new(run)))
@@ -240,13 +237,8 @@ pub fn judge(model: Model, scene: &Scene, run: &Run) -> Result<(), Failure> {
     // Energy scale: the initial energy, or for a scene at rest the work its impacts could do
     // (none), so that round-off on zero is not "energy gained".
     let e0 = run.energy.initial.max(1e-12);
-    // Reference: exact to round-off. Rapier: f32 velocities, one rounding per impulse.
-    let (balance_tol, impact_tol) = match model {
-        Model::Reference => (1e-9, 1e-9),
-        Model::Rapier => (crate::rapier::ENERGY_GAIN_TOLERANCE, crate::rapier::ENERGY_GAIN_TOLERANCE),
-        // Each step errs by at most the tolerance of the contact's scales; they add up at worst.
-        Model::Compliant => ((run.events as f64 * crate::compliant::DEFAULT_TOLERANCE).max(1e-9), 1e-9),
-    };
+    let checks = model.checks(scene, run);
+    let (balance_tol, impact_tol) = (checks.energy_gain, checks.impact_gain);
     // Losses are never negative, so the energy at the end is at most what there was plus what
     // the excitation put in.
     let work = run.energy.forcing_work;
@@ -258,7 +250,7 @@ pub fn judge(model: Model, scene: &Scene, run: &Run) -> Result<(), Failure> {
     // against the energies that flow, not a relative error: a scene at rest whose balls touch
     // a wall starts with the elastic energy of a round-off overlap (1e-36 J), and a forced
     // frame can take in and give back far more than it keeps.
-    if model != Model::Rapier {
+    if let Some(balance_tol) = checks.balance {
         let a = &run.energy;
         let residual = a.initial + a.forcing_work - a.final_ - a.damping_loss - a.impact_loss;
         let flow = e0 + work.abs() + forced_energy_scale(scene);
@@ -277,7 +269,7 @@ pub fn judge(model: Model, scene: &Scene, run: &Run) -> Result<(), Failure> {
         let most = 0.5 * ball_mass(imp.a).max(ball_mass(imp.b)) * imp.approach_speed.powi(2);
         // (Only a single impulse is so bounded: a cascade at one instant or a merged run can
         // pass on energy from the neighbours.)
-        let single = model == Model::Reference && imp.impulses == 1;
+        let single = checks.exact_impacts && imp.impulses == 1;
         if imp.energy_lost < -impact_tol * e0 || (single && imp.energy_lost > most * (1.0 + 1e-9) + 1e-12 * e0) {
             return fail("impact-loss", format!("impact at t = {} loses {} J (at most {most} J)", imp.t, imp.energy_lost));
         }
@@ -288,12 +280,7 @@ pub fn judge(model: Model, scene: &Scene, run: &Run) -> Result<(), Failure> {
             let p = |k: usize| f.mass * s.vs[k] + (0..scene.balls.len()).map(|i| scene.balls[i].mass * s.v[i][k]).sum::<f64>();
             let scale = f.mass * s.vs.iter().fold(0.0f64, |m, v| m.max(v.abs()))
                 + scene.balls.iter().enumerate().map(|(i, b)| b.mass * s.v[i].iter().fold(0.0f64, |m, v| m.max(v.abs()))).sum::<f64>();
-            let tol = match model {
-                Model::Reference => 1e-9,
-                Model::Rapier => 1e-5,
-                // Contact forces are equal and opposite and Runge-Kutta keeps linear invariants.
-                Model::Compliant => 1e-9,
-            } * scale.max(1e-300);
+            let tol = checks.momentum * scale.max(1e-300);
             for k in 0..s.len() {
                 if (p(k) - p(0)).abs() > tol {
                     return fail("momentum", format!("total momentum {} at t = {} (was {})", p(k), s.t[k], p(0)));
@@ -302,21 +289,15 @@ pub fn judge(model: Model, scene: &Scene, run: &Run) -> Result<(), Failure> {
         }
     }
     if let Some(c) = scene.container {
-        // Reference: contact tolerance; Rapier: its allowed overlap (5e-5 m) before correction.
-        let tol = match model {
-            Model::Reference => 1e-9 * c.length.max(1e-3),
-            Model::Rapier => crate::rapier::ALLOWED_OVERLAP + 1e-6,
-            Model::Compliant => compliant_overlap_bound(scene, run),
-        };
+        let tol = checks.wall_overlap;
         for k in 0..s.len() {
             for (i, b) in scene.balls.iter().enumerate() {
                 let (lo, hi) = (s.x[i][k] - b.radius - s.xs[k], s.xs[k] + c.length - s.x[i][k] - b.radius);
                 if lo < -tol || hi < -tol {
                     return fail("outside", format!("ball{} outside the container by {:e} m at t = {}", i + 1, -lo.min(hi), s.t[k]));
                 }
-                if model == Model::Reference && i > 0 {
-                    // Balls never pass each other (docs/MODEL.md §1); the contact models' balls may
-                    // overlap by their contact's deformation, which `outside` bounds already.
+                if let (Some(tol), true) = (checks.ball_overlap, i > 0) {
+                    // Balls never pass each other (docs/MODEL.md §1).
                     let g = (s.x[i][k] - b.radius) - (s.x[i - 1][k] + scene.balls[i - 1].radius);
                     if g < -tol {
                         return fail("overlap", format!("ball{} and ball{} overlap by {:e} m at t = {}", i, i + 1, -g, s.t[k]));
@@ -326,9 +307,7 @@ pub fn judge(model: Model, scene: &Scene, run: &Run) -> Result<(), Failure> {
         }
     }
     let rate = run.events as f64 / run.horizon.max(1e-300);
-    // The compliant model takes ~10^2 steps per impact, however many impacts a stiff frame
-    // drives; its guard against stalling is its step limit (an error, caught above).
-    if rate > STALL_EVENTS_PER_SIM_S && model != Model::Compliant {
+    if rate > STALL_EVENTS_PER_SIM_S && checks.stall_by_rate {
         return fail("stall", format!("{rate:.3e} events per simulated second"));
     }
     Ok(())
@@ -341,23 +320,6 @@ fn forced_energy_scale(scene: &Scene) -> f64 {
     let osc = crate::oscillator::Oscillator::new(f.mass, f.damping, f.stiffness);
     let speed = osc.harmonic_response(p, q, w).amplitude() * w;
     0.5 * f.mass * speed * speed
-}
-
-/// How far the compliant model's balls may legitimately overlap a wall: twice the elastic
-/// overlap of the fastest impact (the heaviest ball on the stiffest-to-reach, i.e. softest,
-/// wall contact) plus the static overlap of all the balls pressed by the frame's largest
-/// acceleration.
-fn compliant_overlap_bound(scene: &Scene, run: &Run) -> f64 {
-    use crate::compliant::contact;
-    let e_star = contact::effective_modulus(&scene.compliant);
-    let r_min = scene.balls.iter().map(|b| b.radius).fold(f64::INFINITY, f64::min);
-    let k = contact::stiffness(e_star, contact::effective_radius(r_min, None));
-    let m_max = scene.balls.iter().map(|b| b.mass).fold(0.0, f64::max);
-    let m_all: f64 = scene.balls.iter().map(|b| b.mass).sum();
-    let u_max = run.impacts.iter().map(|i| i.approach_speed).fold(0.0, f64::max);
-    let a_max = run.series.a.iter().fold(0.0f64, |m, a| m.max(a.abs()));
-    1e-9 * scene.container.map_or(1e-3, |c| c.length.max(1e-3))
-        + 2.0 * (contact::max_overlap(m_max, u_max, k) + (m_all * a_max / k).powf(2.0 / 3.0))
 }
 
 /// The damper scene of `file`, or why the scene's rules reject it.

@@ -5,7 +5,7 @@
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
-use crate::model::{Model, ModelError};
+use crate::model::{RunOptions, Model, ModelError};
 use crate::output::RunSummary;
 use crate::scene::{self, Length, Loaded, Scene, SceneError};
 
@@ -227,7 +227,7 @@ pub fn run_grid(
 ) -> Result<Vec<SweepPoint>, ModelError> {
     grid.par_iter()
         .map(|g| {
-            let run = model.simulate(&g.scene)?;
+            let run = model.simulate(&g.scene, &RunOptions::default())?;
             progress();
             Ok(SweepPoint { at: Coordinates::of(parameters, &g.values), summary: RunSummary::of(&run) })
         })

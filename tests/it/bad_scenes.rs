@@ -151,17 +151,21 @@ fn impossible_forcing_and_material() {
 #[test]
 fn model_errors_print_times_for_people() {
     // Issue 19: a stall at t = 1.916e-6 s printed `0.000001916413341752815 s`.
-    let e = lpc_damper::reference::ReferenceError::Stalled { scene: "s".into(), events: 7, t: 1.916413341752815e-6, why: "w".into() };
+    use lpc_damper::model::{Budget, ModelError, OverBudget};
+    use lpc_damper::Model;
+    let e = ModelError::Stalled { scene: "s".into(), model: Model::Reference, steps: 7, t: 1.916413341752815e-6, why: "w".into() };
     assert!(e.to_string().contains("at t = 1.916e-6 s"), "{e}");
-    let e = lpc_damper::compliant::CompliantError::OverBudget {
+    let e = OverBudget {
         scene: "s".into(),
+        model: Model::Compliant,
         t: 0.30000000000000004,
         horizon: 5.0,
         steps: 7,
         wall_s: 600.0000001,
-        budget: "b".into(),
-        driver: "d".into(),
-        partial: Box::new(lpc_damper::run::Run::empty("s", lpc_damper::Model::Compliant)),
+        budget: Budget::WallTime,
+        limit: 600.0,
+        cost: "d".into(),
+        partial: lpc_damper::run::Run::empty("s", Model::Compliant),
     };
     assert!(e.to_string().contains("at t = 0.3 s of 5 s after 7 steps and 600.0 s of computing"), "{e}");
 }

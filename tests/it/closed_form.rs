@@ -5,7 +5,7 @@ use crate::common;
 
 use approx::assert_relative_eq;
 use common::*;
-use lpc_damper::reference::simulate;
+use crate::common::reference;
 use lpc_damper::scene::{Body, Frame};
 
 /// Round-off bound for quantities built from a few dozen floating operations on O(1) data.
@@ -14,7 +14,7 @@ const ROUND_OFF: f64 = 1e-12;
 #[test]
 fn no_damper_follows_the_damped_oscillator() {
     let scene = lpc_damper::scene::load_scene(lpc_damper::scene::scenes_dir().join("no-damper.toml")).unwrap();
-    let run = simulate(&scene).unwrap();
+    let run = reference(&scene).unwrap();
     let f = scene.frame.unwrap();
     let sigma = f.damping / (2.0 * f.mass);
     let wd = (f.stiffness / f.mass - sigma * sigma).sqrt();
@@ -45,7 +45,7 @@ fn one_ball_on_a_free_frame_bounces_as_worked_out_by_hand() {
     let mut scene = damper(frame, 0.0, &[m], e, gap, clearance, 1.0);
     let v0 = 0.5;
     scene.initial_velocities[0] = v0;
-    let run = simulate(&scene).unwrap();
+    let run = reference(&scene).unwrap();
     let r = scene.balls[0].radius;
     let free_path = scene.container.unwrap().length - 2.0 * r;
 
@@ -81,7 +81,7 @@ fn first_wall_impact_on_an_undamped_spring_frame() {
     let frame = Frame { mass: 1.35, stiffness: 865.0, damping: 0.0 };
     let xs0 = 0.0185;
     let scene = damper(frame, xs0, &[0.11], 0.9, 0.004, 0.02, 0.2);
-    let run = simulate(&scene).unwrap();
+    let run = reference(&scene).unwrap();
     let w = (frame.stiffness / frame.mass).sqrt();
     let (x_ball, r, le) = (scene.initial_positions[0], scene.balls[0].radius, scene.container.unwrap().length);
     let t1 = ((x_ball + r - le) / xs0).acos() / w;

@@ -13,10 +13,13 @@
 //! Issue 18: packed and pressed contacts cost what their motion needs (the packed column and a
 //! plastic light ball between heavy ones, each once stopped by millions of explicit steps).
 
+use lpc_damper::model::{ModelError, OverBudget, RunOptions};
 use crate::common;
 use lpc_damper::studies::compare::errors;
-use lpc_damper::compliant::{self, contact, Options, DEFAULT_TOLERANCE};
-use lpc_damper::reference::impact_law;
+use crate::common::compliant;
+use lpc_damper::compliant::contact;
+use lpc_damper::scene::DEFAULT_COMPLIANT_TOLERANCE as DEFAULT_TOLERANCE;
+use lpc_damper::impact_law::impact_law;
 use lpc_damper::run::Run;
 use lpc_damper::scene::{
     ball_radius, load_scene, parse, scenes_dir, Ball, BallKind, CompliantSettings, Container, Forcing, ForcingKind, Frame,
@@ -71,7 +74,7 @@ fn ball_in_frame(frame: Frame, xs0: f64, m: f64, v: f64, clearance: f64, e: f64,
 }
 
 fn run(scene: &Scene) -> Run {
-    compliant::simulate(scene).unwrap()
+    compliant(scene).unwrap()
 }
 
 /// Elastic Hertz impact of reduced mass `m` at speed `v`: (duration, peak force).
@@ -190,7 +193,7 @@ fn paper_scene_balances_energy_to_the_integration_error() {
     let scene = load_scene(scenes_dir().join("lpc-lsl.toml")).unwrap();
     let mut last = f64::INFINITY;
     for tol in [1e-9, 1e-10] {
-        let r = compliant::simulate_with(&scene, Options { tolerance: tol, ..Default::default() }).unwrap();
+        let r = compliant(&with_tolerance(&scene, tol)).unwrap();
         let err = r.energy.balance_error.abs();
         // Each step errs by at most tol of the contact's scales; the errors add up at worst.
         assert!(err <= r.events as f64 * tol, "tol {tol:e}: balance {err:e} after {} steps", r.events);
@@ -228,7 +231,7 @@ fn paper_scene_follows_the_reference_within_what_contact_durations_explain() {
     let scene = load_scene(scenes_dir().join("lpc-lsl.toml")).unwrap();
     let mut early = scene.clone();
     early.horizon = 0.5;
-    let reference = Model::Reference.simulate(&early).unwrap();
+    let reference = Model::Reference.simulate(&early, &RunOptions::default()).unwrap();
     let soft = errors(&run(&early), &reference).max_xs_early;
     assert!(soft <= 0.25e-3, "max |xs - xs_ref| over 0.5 s: {soft:e} m");
     // And the difference is that duration: t_c ~ E^(-2/5), so 100 times stiffer balls shrink
@@ -239,7 +242,7 @@ fn paper_scene_follows_the_reference_within_what_contact_durations_explain() {
     let ratio = soft / stiff_err;
     assert!((4.5..9.0).contains(&ratio), "error {soft:e} -> {stiff_err:e} (ratio {ratio})");
     let full = run(&scene);
-    let count = Model::Reference.simulate(&scene).unwrap().impacts.len() as f64;
+    let count = Model::Reference.simulate(&scene, &RunOptions::default()).unwrap().impacts.len() as f64;
     assert!((full.impacts.len() as f64 - count).abs() <= 0.1 * count, "{} impacts vs {count}", full.impacts.len());
 }
 
@@ -287,10 +290,11 @@ fn runs_are_bitwise_repeatable() {
 #[test]
 fn a_step_limit_stops_the_run_and_keeps_it_so_far() {
     let scene = load_scene(scenes_dir().join("lpc-lsl.toml")).unwrap();
-    let err = compliant::simulate_with(&scene, Options { max_steps: 3000, ..Default::default() }).unwrap_err();
+    let err = Model::Compliant.simulate(&scene, &RunOptions { max_steps: Some(3000), ..RunOptions::default() }).unwrap_err();
     let msg = err.to_string();
     assert!(msg.contains("lpc-lsl") && msg.contains("--max-steps"), "{msg}");
-    let compliant::CompliantError::OverBudget { t, steps, partial, .. } = err else { panic!("{msg}") };
+    let ModelError::OverBudget(stop) = err else { panic!("{msg}") };
+    let OverBudget { t, steps, partial, .. } = *stop;
     assert_eq!(steps, 3000);
     assert!(t > 0.0 && t < scene.horizon);
     // The run so far is a run: its samples end by `t`, and its energy balance closes to the
@@ -298,8 +302,10 @@ fn a_step_limit_stops_the_run_and_keeps_it_so_far() {
     assert_eq!(partial.horizon, t);
     assert!(!partial.series.t.is_empty() && *partial.series.t.last().unwrap() <= t);
     assert!(partial.energy.balance_error.abs() < 1e-6, "{:?}", partial.energy);
-    let via_model = lpc_damper::model::ModelError::from(compliant::CompliantError::Tolerance(0.0));
-    assert!(via_model.to_string().contains("tolerance"));
+    let mut bad = scene.clone();
+    bad.compliant.tolerance = 0.0;
+    let refused = Model::Compliant.simulate(&bad, &RunOptions::default());
+    assert!(refused.is_err_and(|e| e.to_string().contains("tolerance")));
 }
 
 /// Issue 18's packed column (45 balls, no gaps, e = 0.07): the budget stops it and says what
@@ -309,14 +315,14 @@ const PACKED_COLUMN: &str = include_str!("../../examples/scenes/packed-column.to
 #[test]
 fn a_budget_says_what_the_steps_cost() {
     let scene = lpc_damper::scene::parse(PACKED_COLUMN, "packed.toml", "packed").unwrap().scene.unwrap();
-    let err = compliant::simulate_with(&scene, Options { max_steps: 20_000, ..Default::default() }).unwrap_err();
+    let err = Model::Compliant.simulate(&scene, &RunOptions { max_steps: Some(20_000), ..RunOptions::default() }).unwrap_err();
     let msg = err.to_string();
     assert!(msg.contains("packed-column") && msg.contains("contacts open, the stiffest ball") && msg.contains("Hertz period"), "{msg}");
-    // A wall-time budget of nothing stops at its first look, after PROGRESS_STEPS steps.
-    let err = compliant::simulate_with(&scene, Options { max_wall_s: Some(0.0), ..Default::default() }).unwrap_err();
-    let compliant::CompliantError::OverBudget { steps, budget, .. } = err else { panic!("not a budget stop") };
-    assert_eq!(steps, compliant::PROGRESS_STEPS - 1);
-    assert!(budget.contains("--max-wall-time"), "{budget}");
+    // A wall-time budget of a nanosecond stops at its first look, after PROGRESS_STEPS steps.
+    let err = Model::Compliant.simulate(&scene, &RunOptions { max_wall_s: Some(1e-9), ..RunOptions::default() }).unwrap_err();
+    let ModelError::OverBudget(stop) = err else { panic!("not a budget stop") };
+    assert_eq!(stop.steps, lpc_damper::compliant::PROGRESS_STEPS - 1);
+    assert!(stop.budget_text().contains("--max-wall-time"), "{}", stop.budget_text());
 }
 
 #[test]
@@ -330,9 +336,18 @@ fn lpc_run_writes_the_run_a_budget_stopped() {
     assert!(err.contains("wrote the run up to t = ") && err.contains("--max-steps"), "{err}");
     let series = std::fs::read_to_string(out.join("series.csv")).unwrap();
     assert!(series.lines().count() > 10);
-    let o = crate::common::lpc(["run".as_ref(), scene.as_os_str(), "--max-steps".as_ref(), "5000".as_ref()]);
-    assert_eq!(o.status.code(), Some(2));
-    assert!(String::from_utf8_lossy(&o.stderr).contains("applies to the compliant model"));
+    // Every model takes the budgets: the reference stops at its event budget likewise.
+    let o = crate::common::lpc(["run".as_ref(), scene.as_os_str(), "--max-steps".as_ref(), "50".as_ref()]);
+    assert_eq!(o.status.code(), Some(1));
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(err.contains("the reference stopped") && err.contains("50 events (--max-steps)"), "{err}");
+}
+
+/// `scene` with the compliant model's error tolerance `tolerance`.
+fn with_tolerance(scene: &Scene, tolerance: f64) -> Scene {
+    let mut scene = scene.clone();
+    scene.compliant.tolerance = tolerance;
+    scene
 }
 
 /// `scene` with its horizon cut to `horizon`.
@@ -345,8 +360,9 @@ fn cut(mut scene: Scene, horizon: f64) -> Scene {
 /// final state are integration error away from the finer one's. Chaos amplifies a step's error
 /// over a long run, so these runs are short.
 fn converges(scene: &Scene, tol: f64, max_steps: u64) -> (Run, Run) {
-    let coarse = compliant::simulate_with(scene, Options { tolerance: tol, max_steps, ..Default::default() }).unwrap();
-    let fine = compliant::simulate_with(scene, Options { tolerance: tol / 10.0, max_steps, ..Default::default() }).unwrap();
+    let options = RunOptions { max_steps: Some(max_steps), ..RunOptions::default() };
+    let coarse = Model::Compliant.simulate(&with_tolerance(scene, tol), &options).unwrap();
+    let fine = Model::Compliant.simulate(&with_tolerance(scene, tol / 10.0), &options).unwrap();
     for r in [&coarse, &fine] {
         assert!(r.energy.balance_error.abs() <= r.events as f64 * tol, "{}: balance {:e} after {} steps", scene.name, r.energy.balance_error, r.events);
     }

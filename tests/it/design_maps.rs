@@ -1,7 +1,7 @@
 //! Design maps and design search: grids of two parameters (`lpc sweep --x --y`), the heat map,
 //! `lpc optimize` against an exhaustive evaluation, `lpc frf` files, and the noise proxy.
 
-use crate::common;
+use crate::common::{self, reference};
 
 use lpc_damper::metrics::{metrics, noise};
 use lpc_damper::studies::optimize::{optimize, Judging, Objective};
@@ -108,7 +108,7 @@ fn optimize_finds_the_best_of_an_exhaustive_evaluation() {
             .replace("gap = \"0.25 Rr\"", &format!("gap = \"{gap} Rr\""))
             .replace("clearance = \"2 Rr\"", &format!("container_length = {length:?}"));
         let s = scene::parse(&text, "t", "t").unwrap().scene.unwrap();
-        let settle = metrics(&lpc_damper::reference::simulate(&s).unwrap()).settling_time.unwrap_or(f64::INFINITY);
+        let settle = metrics(&reference(&s).unwrap()).settling_time.unwrap_or(f64::INFINITY);
         if settle < best.0 {
             best = (settle, gap);
         }
@@ -122,7 +122,7 @@ fn optimize_finds_the_best_of_an_exhaustive_evaluation() {
 #[test]
 fn the_noise_proxy_summarises_the_impact_list() {
     let s = paper("lpc-lsl.toml").scene.unwrap();
-    let run = lpc_damper::reference::simulate(&s).unwrap();
+    let run = reference(&s).unwrap();
     let n = noise(&run);
     assert_eq!(n.impact_rate, run.impacts.len() as f64 / s.horizon);
     let e = n.energy_lost.unwrap();

@@ -3,14 +3,14 @@
 
 use crate::common;
 
-use lpc_damper::reference::simulate;
+use crate::common::reference;
 
 #[test]
 fn every_paper_scene_balances_energy_and_keeps_balls_inside() {
     let scenes = common::all_paper_scenes();
     assert!(scenes.len() >= 5 + 14 + 10, "expected every paper scene, got {}", scenes.len());
     for scene in scenes {
-        let run = simulate(&scene).unwrap();
+        let run = reference(&scene).unwrap();
         assert!(run.energy.balance_error.abs() <= 1e-12, "{}: balance error {:e}", scene.name, run.energy.balance_error);
         assert!(run.impacts.iter().all(|i| i.energy_lost >= 0.0), "{}", scene.name);
         // Contact tolerance is 1e-12 of the container length (< 1e-13 m).
@@ -22,8 +22,8 @@ fn every_paper_scene_balances_energy_and_keeps_balls_inside() {
 #[test]
 fn runs_are_bitwise_repeatable() {
     let scene = lpc_damper::scene::load_scene(lpc_damper::scene::scenes_dir().join("lpc-lslsl.toml")).unwrap();
-    let a = simulate(&scene).unwrap();
-    let b = simulate(&scene).unwrap();
+    let a = reference(&scene).unwrap();
+    let b = reference(&scene).unwrap();
     assert_eq!(a.series, b.series);
     assert_eq!(a.impacts, b.impacts);
 }
@@ -33,7 +33,7 @@ fn damper_beats_no_damper_on_the_paper_scene() {
     // Qualitative result of the paper (Figs. 8-9): with the LPC damper the frame settles much
     // sooner than with the conventional damper, and both beat the bare frame.
     let load = |n: &str| lpc_damper::scene::load_scene(lpc_damper::scene::scenes_dir().join(n)).unwrap();
-    let metrics = |n: &str| lpc_damper::metrics::metrics(&simulate(&load(n)).unwrap());
+    let metrics = |n: &str| lpc_damper::metrics::metrics(&reference(&load(n)).unwrap());
     let bare = metrics("no-damper.toml");
     let conventional = metrics("conventional.toml");
     let lsl = metrics("lpc-lsl.toml");

@@ -3,10 +3,10 @@
 //! the frame's period; the draws depend only on (seed, k), never on threads; a metrics-only
 //! member has exactly the metrics of a full run; bad tolerances are refused with the field.
 
+use lpc_damper::model::RunOptions;
 use std::f64::consts::PI;
 
 use lpc_damper::output::Headline;
-use lpc_damper::run::Record;
 use lpc_damper::scene::{self, Loaded};
 use lpc_damper::studies::ensemble::{self, quantile};
 use lpc_damper::Model;
@@ -31,7 +31,7 @@ fn zero_tolerances_reproduce_the_single_run_exactly() {
     let members = draw(&l, 4, None);
     assert_eq!(members.redraws, 0);
     for model in Model::ALL {
-        let single = model.simulate(l.scene.as_ref().unwrap()).unwrap();
+        let single = model.simulate(l.scene.as_ref().unwrap(), &RunOptions::default()).unwrap();
         let expected = Headline::of_run(&single).values();
         let runs = ensemble::run_members(&members, *model, true, &|| {}).unwrap();
         for (k, m) in runs.metrics.iter().enumerate() {
@@ -48,8 +48,8 @@ fn metrics_only_runs_have_exactly_the_metrics_of_full_runs() {
     for text in [LSL.to_string(), forced] {
         let s = loaded(&text).scene.unwrap();
         for model in Model::ALL {
-            let full = model.simulate(&s).unwrap();
-            let lean = model.simulate_recording(&s, Record::MetricsOnly).unwrap();
+            let full = model.simulate(&s, &RunOptions::default()).unwrap();
+            let lean = model.simulate(&s, &RunOptions::metrics_only()).unwrap();
             assert!(lean.series.is_empty(), "{model}: a metrics-only run kept its series");
             assert!(!full.series.is_empty());
             assert_eq!(Headline::of_run(&lean), Headline::of_run(&full), "{model} on {}", s.name);
@@ -65,7 +65,7 @@ fn dissipation_times_are_where_the_energy_falls_to_each_level() {
                 [balls]\narrangement = \"L\"\nlarge_mass = 0.11\ndensity = 8000.0\nrestitution = 0.9\ngap = 0.2\nclearance = 0.2\n\
                 [run]\nhorizon = 8.0\n";
     let s = loaded(text).scene.unwrap();
-    let run = Model::Reference.simulate(&s).unwrap();
+    let run = Model::Reference.simulate(&s, &RunOptions::default()).unwrap();
     assert!(run.impacts.is_empty(), "the ball was meant to stay clear of the walls");
     let (m, k, c, x0): (f64, f64, f64, f64) = (1.35, 865.0, 1.092, 0.0185);
     let sigma = c / (2.0 * m);
@@ -89,7 +89,7 @@ fn dissipation_times_are_where_the_energy_falls_to_each_level() {
     }
     // Forced runs have none: energy need not fall.
     let forced = loaded(&format!("{text}[forcing]\nkind = \"force\"\namplitude = 1.0\nfrequency = 3.0\n")).scene.unwrap();
-    let m = lpc_damper::metrics::metrics(&Model::Reference.simulate(&forced).unwrap());
+    let m = lpc_damper::metrics::metrics(&Model::Reference.simulate(&forced, &RunOptions::default()).unwrap());
     assert_eq!((m.dissipation_time_90, m.dissipation_time_99), (None, None));
 }
 
@@ -109,7 +109,7 @@ fn a_uniform_stiffness_tolerance_gives_the_analytic_distribution_of_the_period()
     let periods: Vec<f64> = ensemble::map_members(
         &members.members,
         |member| {
-            let run = Model::Reference.simulate(&member.scene)?;
+            let run = Model::Reference.simulate(&member.scene, &RunOptions::default())?;
             assert!(run.impacts.is_empty());
             // Two upward zero crossings of xs (linearly interpolated) one period apart.
             let (t, x) = (&run.series.t, &run.series.xs);
@@ -312,10 +312,10 @@ fn exact_reference_metrics_bound_the_sampled_ones_within_one_sample() {
     // samples they can only miss a peak, a crossing or an energy level by one sample's motion.
     for name in ["lpc-lsl", "lpc-lslsl", "conventional", "no-damper"] {
         let s = scene::load_scene(scene::scenes_dir().join(format!("{name}.toml"))).unwrap();
-        let run = Model::Reference.simulate(&s).unwrap();
+        let run = Model::Reference.simulate(&s, &RunOptions::default()).unwrap();
         let exact = run.motion;
         let series = &run.series;
-        let mut tally = lpc_damper::metrics::SampleTally::new(&s);
+        let mut tally = lpc_damper::run::SampleTally::new(&s);
         for k in 0..series.len() {
             let kinetic: f64 = s.balls.iter().enumerate().map(|(i, b)| 0.5 * b.mass * series.v[i][k].powi(2)).sum();
             let energy = s.frame_energy(series.t[k], series.xs[k], series.vs[k]) + kinetic;

@@ -2,11 +2,13 @@
 //! `m x'' + c x' + k x = P sin wt + Q cos wt`, for a force and for base motion, in both models;
 //! the energy balance with the excitation's work; the frequency response against `|H(w)|`.
 
+use lpc_damper::model::RunOptions;
 use crate::common;
 
 use lpc_damper::studies::frf;
 use lpc_damper::scene::{Forcing, ForcingKind, Scene};
-use lpc_damper::{reference, Model};
+use crate::common::reference;
+use lpc_damper::Model;
 
 const FRAME: lpc_damper::scene::Frame = common::PAPER_FRAME;
 
@@ -48,7 +50,7 @@ fn bare_forced_frame_follows_the_textbook_solution_in_both_models() {
             let scene = bare(kind, amp, f, 0.01);
             let scale = 0.01 + textbook(kind, amp, f, 0.0, 100.0).abs().max(amp / FRAME.stiffness);
             for model in [Model::Reference, Model::Rapier] {
-                let run = model.simulate(&scene).unwrap();
+                let run = model.simulate(&scene, &RunOptions::default()).unwrap();
                 let worst = run
                     .series
                     .t
@@ -78,7 +80,7 @@ fn forced_damper_balances_energy_with_the_forcing_work() {
         if kind == ForcingKind::Base {
             g.amplitude = 2.0 / FRAME.stiffness; // the same load amplitude as the force
         }
-        let run = reference::simulate(&s).unwrap();
+        let run = reference(&s).unwrap();
         assert!(run.impacts.len() > 50, "{kind:?}: the balls must be set moving");
         // Closed form between impacts, Gauss-Legendre for the work: round-off only.
         assert!(run.energy.balance_error.abs() <= 1e-12, "{kind:?}: {:e}", run.energy.balance_error);

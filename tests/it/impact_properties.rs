@@ -3,7 +3,8 @@
 
 use crate::common;
 
-use lpc_damper::reference::{impact_law, simulate};
+use crate::common::reference;
+use lpc_damper::impact_law::impact_law;
 use lpc_damper::scene::{ball_radius, Ball, BallKind, Scene};
 use proptest::prelude::*;
 
@@ -44,7 +45,7 @@ proptest! {
         let gaps: Vec<f64> = balls.iter().map(|b| b.1).collect();
         let speeds: Vec<f64> = balls.iter().map(|b| b.2).collect();
         let scene = free_chain(&masses, &gaps, &speeds, e);
-        let run = simulate(&scene).unwrap();
+        let run = reference(&scene).unwrap();
         let p0: f64 = masses.iter().zip(&speeds).map(|(m, v)| m * v).sum();
         let p1: f64 = masses.iter().zip(&run.final_velocities).map(|(m, v)| m * v).sum();
         let scale: f64 = masses.iter().zip(&speeds).map(|(m, v)| m * v.abs()).sum::<f64>() + 1e-300;

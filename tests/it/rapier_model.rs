@@ -1,5 +1,6 @@
 //! The Rapier/Bevy contact model against closed forms, Eq. 9-10 and the reference.
 
+use lpc_damper::model::RunOptions;
 use crate::common;
 
 use approx::assert_relative_eq;
@@ -7,7 +8,7 @@ use common::*;
 use lpc_damper::studies::compare::errors;
 use lpc_damper::output::files::{impacts_csv, series_csv};
 use lpc_damper::output::RunSummary;
-use lpc_damper::reference::impact_law;
+use lpc_damper::impact_law::impact_law;
 use lpc_damper::scene::{ball_radius, load_scene, scenes_dir, Ball, BallKind, Frame, Scene};
 use lpc_damper::Model;
 
@@ -22,8 +23,8 @@ fn paper(name: &str) -> Scene {
 #[test]
 fn free_frame_follows_the_closed_form_to_round_off() {
     let scene = paper("no-damper");
-    let rapier = Model::Rapier.simulate(&scene).unwrap();
-    let reference = Model::Reference.simulate(&scene).unwrap();
+    let rapier = Model::Rapier.simulate(&scene, &RunOptions::default()).unwrap();
+    let reference = Model::Reference.simulate(&scene, &RunOptions::default()).unwrap();
     // The kinematic frame is advanced by the exact flow, one step at a time: 2500 steps of a
     // few ulps each.
     let max = rapier.series.xs.iter().zip(&reference.series.xs).map(|(a, b)| (a - b).abs()).fold(0.0, f64::max);
@@ -42,7 +43,7 @@ fn two_balls(v0: f64, gap: f64) -> Scene {
 #[test]
 fn one_ball_ball_impact_follows_eq_9_10() {
     let scene = two_balls(0.5, 0.001);
-    let run = Model::Rapier.simulate(&scene).unwrap();
+    let run = Model::Rapier.simulate(&scene, &RunOptions::default()).unwrap();
     let (v1, v2, lost) = impact_law(0.11, 0.5, 0.011, 0.0, 0.9);
     assert_eq!(run.impacts.len(), 1);
     assert_relative_eq!(run.final_velocities[0], v1, max_relative = F32_SOLVE);
@@ -59,7 +60,7 @@ fn one_ball_wall_impact_follows_eq_9_10_with_the_finite_frame_mass() {
     let frame = Frame { mass: 1.35, stiffness: 0.0, damping: 0.0 };
     let mut scene = damper(frame, 0.0, &[0.11], 0.9, 0.004, 0.01, 0.03);
     scene.initial_velocities[0] = 0.5;
-    let run = Model::Rapier.simulate(&scene).unwrap();
+    let run = Model::Rapier.simulate(&scene, &RunOptions::default()).unwrap();
     let (vb, vf, lost) = impact_law(0.11, 0.5, 1.35, 0.0, 0.9);
     assert_eq!(run.impacts.len(), 1, "{:?}", run.impacts);
     assert_relative_eq!(*run.series.v[0].last().unwrap(), vb, max_relative = F32_SOLVE);
@@ -73,7 +74,7 @@ fn momentum_is_conserved_across_every_impact() {
     let frame = Frame { mass: 1.35, stiffness: 0.0, damping: 0.0 };
     let mut scene = damper(frame, 0.0, &[0.11, 0.011, 0.11], 0.9, 0.0037, 0.03, 1.0);
     scene.initial_velocities = vec![0.6, -0.3, 0.2];
-    let run = Model::Rapier.simulate(&scene).unwrap();
+    let run = Model::Rapier.simulate(&scene, &RunOptions::default()).unwrap();
     assert!(run.impacts.len() > 20, "{} impacts", run.impacts.len());
     let s = &run.series;
     let momentum = |k: usize| 1.35 * s.vs[k] + (0..3).map(|i| scene.balls[i].mass * s.v[i][k]).sum::<f64>();
@@ -87,7 +88,7 @@ fn momentum_is_conserved_across_every_impact() {
 fn no_ball_leaves_the_container_on_the_paper_scenes() {
     for name in ["conventional", "lpc-lsl", "lpc-lslsl", "chain-lll"] {
         let scene = paper(name);
-        let run = Model::Rapier.simulate(&scene).unwrap();
+        let run = Model::Rapier.simulate(&scene, &RunOptions::default()).unwrap();
         // Rapier lets contacts overlap by its allowed linear error (0.005 length units =
         // 50 um here) before correcting.
         let gap = min_gap(&scene, &run);
@@ -98,8 +99,8 @@ fn no_ball_leaves_the_container_on_the_paper_scenes() {
 #[test]
 fn two_runs_give_identical_bytes() {
     let scene = paper("lpc-lsl");
-    let a = Model::Rapier.simulate(&scene).unwrap();
-    let b = Model::Rapier.simulate(&scene).unwrap();
+    let a = Model::Rapier.simulate(&scene, &RunOptions::default()).unwrap();
+    let b = Model::Rapier.simulate(&scene, &RunOptions::default()).unwrap();
     assert_eq!(series_csv(&a), series_csv(&b));
     assert_eq!(impacts_csv(&a), impacts_csv(&b));
     let strip = |r| RunSummary { wall_time_s: 0.0, ..RunSummary::of(r) };
@@ -115,8 +116,8 @@ fn two_runs_give_identical_bytes() {
 fn compare_on_the_paper_scenes_is_within_the_measured_bounds() {
     for name in ["conventional", "lpc-lsl", "lpc-lslsl", "chain-lll"] {
         let scene = paper(name);
-        let reference = Model::Reference.simulate(&scene).unwrap();
-        let run = Model::Rapier.simulate(&scene).unwrap();
+        let reference = Model::Reference.simulate(&scene, &RunOptions::default()).unwrap();
+        let run = Model::Rapier.simulate(&scene, &RunOptions::default()).unwrap();
         let e = errors(&run, &reference);
         assert!(e.max_xs_early <= 0.2e-3, "{name}: early error {:e} m", e.max_xs_early);
         assert!(e.impact_loss_diff.abs() <= 0.02, "{name}: impact loss differs by {:.3} E0", e.impact_loss_diff);
@@ -127,7 +128,7 @@ fn compare_on_the_paper_scenes_is_within_the_measured_bounds() {
 #[test]
 fn lsl_meets_the_rms_target() {
     let scene = paper("lpc-lsl");
-    let e = errors(&Model::Rapier.simulate(&scene).unwrap(), &Model::Reference.simulate(&scene).unwrap());
+    let e = errors(&Model::Rapier.simulate(&scene, &RunOptions::default()).unwrap(), &Model::Reference.simulate(&scene, &RunOptions::default()).unwrap());
     assert!(e.rms_xs <= 0.5e-3, "rms {:e} m", e.rms_xs);
 }
 
@@ -138,8 +139,8 @@ fn lsl_meets_the_rms_target() {
 fn heavy_ball_gets_the_two_body_law() {
     let frame = Frame { mass: 0.1, stiffness: 865.0, damping: 1.0 };
     let scene = damper(frame, 0.01, &[0.11], 0.9, 0.004, 0.005, 1.0);
-    let run = Model::Rapier.simulate(&scene).unwrap();
-    let reference = Model::Reference.simulate(&scene).unwrap();
+    let run = Model::Rapier.simulate(&scene, &RunOptions::default()).unwrap();
+    let reference = Model::Reference.simulate(&scene, &RunOptions::default()).unwrap();
     assert!(!run.impacts.is_empty());
     for (a, b) in run.impacts.iter().zip(&reference.impacts).take(3) {
         assert_eq!((a.a, a.b), (b.a, b.b));

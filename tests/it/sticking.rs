@@ -5,14 +5,14 @@
 use crate::common;
 
 use common::*;
-use lpc_damper::reference::simulate;
+use crate::common::reference;
 use lpc_damper::run::Run;
 use lpc_damper::scene::Scene;
 
 /// Checks common to every sticking scene; `max_events` is a generous bound on the events a
 /// collapse-free solver needs (each impact plus a few holds and releases).
 fn check(scene: &Scene, max_events: u64) -> Run {
-    let run = simulate(scene).unwrap();
+    let run = reference(scene).unwrap();
     assert!(run.events <= max_events, "{} events (bound {max_events})", run.events);
     assert!(run.energy.balance_error.abs() <= 1e-12, "balance error {:e}", run.energy.balance_error);
     assert!(min_gap(scene, &run) >= -1e-12, "overlap {:e}", min_gap(scene, &run));

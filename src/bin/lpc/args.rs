@@ -26,9 +26,10 @@ pub enum TableFormat {
     Csv,
 }
 
-/// Settings of the Rapier model that every command accepts.
+/// Settings of the models that every command accepts; each model reads its own and ignores
+/// the others.
 #[derive(clap::Args, Clone, Copy)]
-pub struct RapierArgs {
+pub struct ModelArgs {
     /// Rapier model: `aligned` (steps end at contacts) or `fixed` steps.
     #[arg(long)]
     stepping: Option<Stepping>,
@@ -41,9 +42,12 @@ pub struct RapierArgs {
     /// Rapier model: turn on Rapier's swept CCD for the balls.
     #[arg(long)]
     ccd: bool,
+    /// Compliant model: error tolerance per step, relative to the contact scales (default 1e-9).
+    #[arg(long)]
+    tolerance: Option<f64>,
 }
 
-impl RapierArgs {
+impl ModelArgs {
     /// These flags, with `--horizon` and `--sample-dt` where a command has them, as overrides
     /// that the scene module validates by the file's own rules.
     pub fn overrides(self, horizon: Option<f64>, sample_dt: Option<f64>) -> Overrides {
@@ -54,6 +58,7 @@ impl RapierArgs {
             dt: self.dt,
             solver_iterations: self.solver_iterations,
             ccd: self.ccd,
+            tolerance: self.tolerance,
             ..Overrides::default()
         }
     }

@@ -86,7 +86,7 @@ macro_rules! failures {
     )*};
 }
 
-failures!(anyhow::Error, ModelError, lpc_damper::reference::ReferenceError, FigureError, std::io::Error, serde_json::Error, csv::Error, std::string::FromUtf8Error);
+failures!(anyhow::Error, ModelError, FigureError, std::io::Error, serde_json::Error, csv::Error, std::string::FromUtf8Error);
 
 #[cfg(feature = "render")]
 failures!(lpc_damper::render::RenderError);

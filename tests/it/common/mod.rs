@@ -7,6 +7,19 @@ pub mod masri_caughey;
 use std::ffi::OsStr;
 use std::process::{Command, Output};
 
+use lpc_damper::model::{Model, ModelError, RunOptions};
+use lpc_damper::run::Run;
+
+/// The reference on `scene` with the default options.
+pub fn reference(scene: &Scene) -> Result<Run, ModelError> {
+    Model::Reference.simulate(scene, &RunOptions::default())
+}
+
+/// The compliant model on `scene` with the default options.
+pub fn compliant(scene: &Scene) -> Result<Run, ModelError> {
+    Model::Compliant.simulate(scene, &RunOptions::default())
+}
+
 /// The `lpc` binary as a user runs it, from the repository's root (so `scenes/...` resolves).
 pub fn lpc_command() -> Command {
     let mut command = Command::new(env!("CARGO_BIN_EXE_lpc"));

@@ -1,6 +1,7 @@
 //! An ensemble of a scene without `[tolerances]` panicked (the draw blamed its failures on
 //! the first toleranced parameter, of which there was none). Every member is the nominal scene.
 
+use lpc_damper::model::RunOptions;
 use lpc_damper::output::Headline;
 use lpc_damper::studies::ensemble;
 use lpc_damper::Model;
@@ -11,7 +12,7 @@ fn an_ensemble_without_tolerances_is_the_nominal_scene_repeated() {
     assert!(l.tolerances.is_none());
     let nominal = l.scene.as_ref().unwrap();
     let members = ensemble::draw(&l.file, &l.path, nominal, None, 3, None).unwrap();
-    let single = Headline::of_run(&Model::Reference.simulate(nominal).unwrap()).values();
+    let single = Headline::of_run(&Model::Reference.simulate(nominal, &RunOptions::default()).unwrap()).values();
     let runs = ensemble::run_members(&members, Model::Reference, false, &|| {}).unwrap();
     assert!(members.columns.is_empty());
     assert_eq!(runs.metrics, vec![single; 3]);

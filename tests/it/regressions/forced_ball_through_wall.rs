@@ -2,9 +2,11 @@
 //! scenes written to find such misses found three more ways for it to go wrong. One test per
 //! bug, each on the scene that showed it.
 
+use lpc_damper::model::RunOptions;
 use crate::common::{lpc_command, min_gap, scene_from_toml as scene};
 
-use lpc_damper::{reference, Model};
+use crate::common::reference;
+use lpc_damper::Model;
 
 /// The sign-change scan of the forced frame's acceleration cleared a sub-interval whose end
 /// values differed in sign (a bound compared with a value smaller than its own round-off), so
@@ -18,7 +20,7 @@ fn a_forced_ball_never_enters_a_wall() {
          gap = 0.025\nclearance = 0.025\n[forcing]\nkind = \"force\"\namplitude = 2.0\nfrequency = 3.3\n\
          [run]\nhorizon = 10.0\nsample_dt = 0.0005\n",
     );
-    let run = reference::simulate(&s).unwrap();
+    let run = reference(&s).unwrap();
     // The contact tolerance: 1e-12 of the container (round-off is far below it here).
     let gap = min_gap(&s, &run);
     assert!(gap >= -1e-12 * s.container.unwrap().length, "a ball is {:e} m inside a wall", -gap);
@@ -37,7 +39,7 @@ fn released_balls_do_not_fall_back_onto_their_wall() {
          [run]\nhorizon = 0.002\nsample_dt = 0.0001\n\
          [forcing]\nkind = \"base\"\namplitude = 0.005611764237531015\nfrequency = 215.40240833243777\n",
     );
-    let run = reference::simulate(&s).unwrap();
+    let run = reference(&s).unwrap();
     assert!(run.energy.balance_error.abs() < 1e-9, "{:e}", run.energy.balance_error);
 }
 
@@ -55,7 +57,7 @@ fn a_contact_closer_than_a_tick_of_time_is_taken() {
          [run]\nhorizon = 0.51\nsample_dt = 0.001\n\
          [forcing]\nkind = \"force\"\namplitude = 162195261.029805\nfrequency = 1179.1740839169877\n",
     );
-    let run = reference::simulate(&s).unwrap();
+    let run = reference(&s).unwrap();
     assert!(run.energy.balance_error.abs() < 1e-9, "{:e}", run.energy.balance_error);
 }
 
@@ -72,7 +74,7 @@ fn an_accepted_overlap_stays_accepted() {
          [run]\nhorizon = 0.59\nsample_dt = 0.0005\n\
          [forcing]\nkind = \"force\"\namplitude = 86213055.98482168\nfrequency = 50.55983129038648\n",
     );
-    let run = Model::Reference.simulate(&s);
+    let run = Model::Reference.simulate(&s, &RunOptions::default());
     assert!(run.is_ok(), "{}", run.unwrap_err());
 }
 

@@ -6,6 +6,7 @@
 //! balls of forced-lsl became one lump after 6 s. The plug-in now resolves the impacts of
 //! touching pairs itself, one pair at a time as Eq. 9-10 and the reference say.
 
+use lpc_damper::model::RunOptions;
 use approx::assert_relative_eq;
 use lpc_damper::scene::{ball_radius, Ball, BallKind, Frame};
 use lpc_damper::Model;
@@ -21,8 +22,8 @@ const F32_SOLVE: f64 = 2e-6;
 fn a_touching_chain_passes_the_momentum_along() {
     let ball = Ball { mass: 0.11, radius: ball_radius(0.11, 8000.0), kind: BallKind::Large };
     let scene = common::free_chain(vec![ball; 3], &[0.001, 0.0], &[0.5, 0.0, 0.0], 1.0, 0.01, 1e-3);
-    let run = Model::Rapier.simulate(&scene).unwrap();
-    let reference = Model::Reference.simulate(&scene).unwrap();
+    let run = Model::Rapier.simulate(&scene, &RunOptions::default()).unwrap();
+    let reference = Model::Reference.simulate(&scene, &RunOptions::default()).unwrap();
     for (got, want) in run.final_velocities.iter().zip(&reference.final_velocities) {
         assert!((got - want).abs() <= F32_SOLVE * 0.5, "{:?} against {:?}", run.final_velocities, reference.final_velocities);
     }
@@ -38,9 +39,9 @@ fn forced_balls_do_not_glue() {
     );
     scene.forcing.as_mut().unwrap().frequency = 3.0;
     scene.horizon = 8.0;
-    let run = Model::Rapier.simulate(&scene).unwrap();
+    let run = Model::Rapier.simulate(&scene, &RunOptions::default()).unwrap();
     let late = run.impacts.iter().filter(|i| i.t >= 6.0).count();
-    let reference = Model::Reference.simulate(&scene).unwrap();
+    let reference = Model::Reference.simulate(&scene, &RunOptions::default()).unwrap();
     let reference_late = reference.impacts.iter().filter(|i| i.t >= 6.0).count();
     // The reference strikes 91 times in the last 2 s; glued, the contact model struck 16 times.
     assert!(late as f64 >= 0.5 * reference_late as f64, "{late} impacts after 6 s against the reference's {reference_late}");
@@ -52,8 +53,8 @@ fn forced_balls_do_not_glue() {
 fn a_plastic_damper_loses_what_the_reference_loses() {
     let mut scene = damper(PAPER_FRAME, 0.0185, &[0.11], 0.0, 0.25 * ball_radius(0.11, 8000.0), 0.03, 2.0);
     scene.sample_dt = 1e-3;
-    let run = Model::Rapier.simulate(&scene).unwrap();
-    let reference = Model::Reference.simulate(&scene).unwrap();
+    let run = Model::Rapier.simulate(&scene, &RunOptions::default()).unwrap();
+    let reference = Model::Reference.simulate(&scene, &RunOptions::default()).unwrap();
     let e0 = reference.energy.initial;
     // Measured: 1e-4 of E0 apart (1e-3 before held balls joined the frame's mass).
     assert!(
@@ -71,7 +72,7 @@ fn heavy_balls_conserve_momentum_across_every_impact() {
     let frame = Frame { mass: 0.05, stiffness: 0.0, damping: 0.0 };
     let mut scene = damper(frame, 0.0, &[0.11, 0.11], 0.7, 0.002, 0.004, 0.05);
     scene.initial_velocities = vec![0.3, -0.2];
-    let run = Model::Rapier.simulate(&scene).unwrap();
+    let run = Model::Rapier.simulate(&scene, &RunOptions::default()).unwrap();
     assert!(run.impacts.len() >= 3, "{:?}", run.impacts);
     let p0 = 0.11 * (0.3 - 0.2);
     let vs = *run.series.vs.last().unwrap();
@@ -107,8 +108,8 @@ fn forced_single_ball_damper_matches_the_reference_in_steady_state() {
 fn a_released_ball_struck_again_bounces_as_eq_9_10() {
     let mut scene = damper(PAPER_FRAME, -0.0185, &[0.11], 0.9, 0.0, 0.2, 1.5);
     scene.sample_dt = 1e-3;
-    let run = Model::Rapier.simulate(&scene).unwrap();
-    let reference = Model::Reference.simulate(&scene).unwrap();
+    let run = Model::Rapier.simulate(&scene, &RunOptions::default()).unwrap();
+    let reference = Model::Reference.simulate(&scene, &RunOptions::default()).unwrap();
     let struck = |r: &lpc_damper::run::Run| -> Vec<lpc_damper::run::Impact> {
         r.impacts.iter().filter(|i| i.approach_speed > 0.1).cloned().collect()
     };

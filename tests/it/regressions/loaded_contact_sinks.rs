@@ -3,6 +3,7 @@
 //! the stress run reported as a ball outside the container. The plug-in now projects sunk balls
 //! back (positions only) and bounds the step by the walls' chord error.
 
+use lpc_damper::model::RunOptions;
 use crate::common;
 use lpc_damper::Model;
 
@@ -29,7 +30,7 @@ sample_dt = 0.00001
 #[test]
 fn a_ball_carried_by_a_fast_wall_stays_inside() {
     let s = common::scene_from_toml(SCENE);
-    let run = Model::Rapier.simulate(&s).unwrap();
+    let run = Model::Rapier.simulate(&s, &RunOptions::default()).unwrap();
     let c = s.container.unwrap();
     let r = s.balls[0].radius;
     let worst = (0..run.series.len())

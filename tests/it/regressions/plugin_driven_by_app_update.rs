@@ -5,7 +5,8 @@
 //! so every correction was undone one step later and the run drifted millimetres from the
 //! headless model within 0.2 s. The feedback now keeps the component equal to the body.
 
-use lpc_damper::rapier::{collect, settings, simulate, LpcDamperPlugins, StepClock};
+use lpc_damper::model::{Model, RunOptions};
+use lpc_damper::rapier::{collect, settings, LpcDamperPlugins, StepClock};
 use lpc_damper::scene::{load_scene, scenes_dir, Overrides};
 
 use bevy::prelude::*;
@@ -14,7 +15,7 @@ use bevy::prelude::*;
 fn the_plugin_in_a_users_app_runs_the_headless_model() {
     let scene = load_scene(scenes_dir().join("lpc-lsl.toml")).unwrap();
     let scene = Overrides { horizon: Some(0.5), ..Overrides::default() }.apply(scene, "lpc-lsl").unwrap();
-    let headless = simulate(&scene).unwrap();
+    let headless = Model::Rapier.simulate(&scene, &RunOptions::default()).unwrap();
     let mut app = App::new();
     app.init_resource::<Time>().add_plugins(LpcDamperPlugins { scene: scene.clone(), settings: settings(&scene), record: lpc_damper::run::Record::Series });
     app.finish();
@@ -23,7 +24,7 @@ fn the_plugin_in_a_users_app_runs_the_headless_model() {
         app.update();
     }
     let steps = app.world().resource::<StepClock>().steps;
-    let driven = collect(app.world_mut(), &scene, steps);
+    let driven = collect(app.world_mut(), &scene, scene.horizon, steps);
     assert_eq!(driven.impacts.len(), headless.impacts.len());
     assert_eq!(driven.series.len(), headless.series.len());
     // The same steps on the same f32 bodies: the same numbers.

@@ -5,6 +5,7 @@
 //! frame at 38 m/s striking a light ball still beats Rapier's solver (`FAST_FRAME`, stress
 //! seed 91211), and the check still stops that run.
 
+use lpc_damper::model::RunOptions;
 use lpc_damper::model::ModelError;
 use crate::common;
 use lpc_damper::Model;
@@ -57,7 +58,7 @@ sample_dt = 0.0001
 fn the_contact_model_runs_the_squeeze_and_passes_every_check() {
     for ratio in ["661.7318540906778", "1e9"] {
         let s = common::scene_from_toml(&SCENE.replace("661.7318540906778", ratio));
-        let run = Model::Rapier.simulate(&s).unwrap();
+        let run = Model::Rapier.simulate(&s, &RunOptions::default()).unwrap();
         lpc_damper::studies::stress::judge(Model::Rapier, &s, &run).unwrap();
     }
 }
@@ -65,14 +66,15 @@ fn the_contact_model_runs_the_squeeze_and_passes_every_check() {
 #[test]
 fn the_contact_model_stops_with_the_reason_instead_of_a_wrong_run() {
     let s = common::scene_from_toml(FAST_FRAME);
-    match Model::Rapier.simulate(&s) {
-        Err(ModelError::Unstable(reason)) => {
+    match Model::Rapier.simulate(&s, &RunOptions::default()) {
+        Err(e @ ModelError::Unstable { .. }) => {
+            let reason = e.to_string();
             assert!(reason.contains("stress-91211") && reason.contains("left wall"), "{reason}");
             assert!(reason.contains("mass ratio 348"), "{reason}");
         }
         other => panic!("expected the run to stop as unstable, got {:?}", other.map(|r| r.impacts.len())),
     }
-    let reference = Model::Reference.simulate(&s).unwrap();
+    let reference = Model::Reference.simulate(&s, &RunOptions::default()).unwrap();
     lpc_damper::studies::stress::judge(Model::Reference, &s, &reference).unwrap();
 }
 
@@ -82,7 +84,7 @@ fn the_stability_map_still_sees_the_raw_behaviour() {
     let s = common::scene_from_toml(FAST_FRAME);
     let mut settings = lpc_damper::rapier::settings(&s);
     settings.self_check = false;
-    let run = lpc_damper::rapier::simulate_with(&s, settings).unwrap();
+    let run = lpc_damper::rapier::simulate_with(&s, settings, &RunOptions::default()).unwrap();
     let failure = lpc_damper::studies::stress::judge(Model::Rapier, &s, &run).unwrap_err();
     assert_eq!(failure.check, "outside");
 }

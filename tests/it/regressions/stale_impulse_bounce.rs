@@ -3,6 +3,7 @@
 //! solved plastically: a small ball between two large ones stuck to one of them. The plug-in
 //! now applies the bounce Rapier skipped; the chain experiment must match the reference.
 
+use lpc_damper::model::RunOptions;
 use lpc_damper::studies::chain::{ker, run_chain};
 use lpc_damper::scene::{load, scenes_dir};
 use lpc_damper::Model;
@@ -25,8 +26,8 @@ fn small_ball_between_large_balls_keeps_bouncing() {
     // LSL on the paper's frame: the small ball rattles between the large ones at sub-millimetre
     // gaps; with the stale impulse it stuck after a few impacts (about a third of the impacts).
     let scene = lpc_damper::scene::load_scene(scenes_dir().join("lpc-lsl.toml")).unwrap();
-    let reference = Model::Reference.simulate(&scene).unwrap();
-    let rapier = Model::Rapier.simulate(&scene).unwrap();
+    let reference = Model::Reference.simulate(&scene, &RunOptions::default()).unwrap();
+    let rapier = Model::Rapier.simulate(&scene, &RunOptions::default()).unwrap();
     let (r, a) = (reference.impacts.len() as f64, rapier.impacts.len() as f64);
     assert!((a - r).abs() <= 0.1 * r, "reference {r} impacts, rapier {a}");
 }

@@ -22,7 +22,7 @@ pub struct Args {
     models: Vec<Model>,
     /// Rapier steppings, comma-separated.
     #[arg(long, value_delimiter = ',', default_value = "fixed,aligned")]
-    stepping: Vec<lpc_damper::rapier::Stepping>,
+    stepping: Vec<lpc_damper::scene::Stepping>,
     /// Rapier steps (longest steps when aligned), s, comma-separated.
     #[arg(long, value_delimiter = ',', default_value = "0.0001,0.0002,0.0005,0.001,0.002")]
     dt: Vec<f64>,
@@ -53,10 +53,13 @@ pub fn run(a: Args) -> Result<ExitStatus> {
         a.scenes.clone()
     };
     for &dt in &a.dt {
-        Overrides { dt: Some(dt), ..Overrides::default() }.validate_rapier()?;
+        Overrides { dt: Some(dt), ..Overrides::default() }.validate_settings()?;
     }
     for &it in &a.solver_iterations {
-        Overrides { solver_iterations: Some(it), ..Overrides::default() }.validate_rapier()?;
+        Overrides { solver_iterations: Some(it), ..Overrides::default() }.validate_settings()?;
+    }
+    for &tolerance in &a.tolerance {
+        Overrides { tolerance: Some(tolerance), ..Overrides::default() }.validate_settings()?;
     }
     if !(1..=MAX_REPEAT).contains(&a.repeat) {
         let rule = format!("must lie in 1..={MAX_REPEAT} (got {})", a.repeat);
@@ -67,14 +70,10 @@ pub fn run(a: Args) -> Result<ExitStatus> {
         steppings: a.stepping.clone(),
         dts: a.dt.clone(),
         solver_iterations: a.solver_iterations.clone(),
-        compliant_tolerances: a.tolerance.clone(),
+        tolerances: a.tolerance.clone(),
         repeat: a.repeat,
     };
-    let per_scene = a.models.iter().map(|m| match m {
-        Model::Reference => 1,
-        Model::Rapier => plan.steppings.len() * plan.dts.len() * plan.solver_iterations.len(),
-        Model::Compliant => plan.compliant_tolerances.len(),
-    }).sum::<usize>();
+    let per_scene = a.models.iter().map(|&m| plan.variants(m).len()).sum::<usize>();
     let bar = progress_bar(per_scene * paths.len(), "bench");
     let mut rows = Vec::new();
     for p in &paths {

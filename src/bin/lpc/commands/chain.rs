@@ -6,7 +6,7 @@ use lpc_damper::studies::chain::{run_chain, KerRow};
 use lpc_damper::scene;
 use lpc_damper::Model;
 
-use crate::args::{invalid, override_scene, print_json, Format, RapierArgs};
+use crate::args::{invalid, override_scene, print_json, Format, ModelArgs};
 use crate::table::{right, Table};
 use crate::exit::{ExitStatus, Result};
 
@@ -21,7 +21,7 @@ pub struct Args {
     #[arg(long, value_enum, default_value_t = Format::Text)]
     format: Format,
     #[command(flatten)]
-    rapier: RapierArgs,
+    settings: ModelArgs,
 }
 
 pub fn run(a: Args) -> Result<ExitStatus> {
@@ -30,7 +30,7 @@ pub fn run(a: Args) -> Result<ExitStatus> {
     let mut cases =
         loaded.chain.ok_or_else(|| invalid(&path, "chain", "is missing: `lpc chain` needs a scene file with a [chain] table"))?;
     for c in &mut cases {
-        override_scene(&mut c.scene, a.rapier.overrides(None, None), &path)?;
+        override_scene(&mut c.scene, a.settings.overrides(None, None), &path)?;
     }
     let rows: Vec<KerRow> = run_chain(&cases, a.model)?;
     match a.format {

@@ -5,6 +5,7 @@ use std::path::PathBuf;
 
 use anyhow::Context;
 
+use lpc_damper::model::RunOptions;
 use lpc_damper::studies::compare::{errors, Errors};
 use lpc_damper::output::{write_run_dir, RunSummary};
 use lpc_damper::Model;
@@ -12,7 +13,7 @@ use lpc_damper::Model;
 use lpc_damper::output::SUMMARY_METRICS;
 use lpc_damper::studies::ensemble::{self, Agreement, Ensemble, Stats};
 
-use crate::args::{load_nominal, print_json, progress_bar, EnsembleArgs, Format, RapierArgs};
+use crate::args::{load_nominal, print_json, progress_bar, EnsembleArgs, Format, ModelArgs};
 use crate::table::{left, right, statistic, Table};
 use crate::exit::{ExitStatus, Result};
 
@@ -27,7 +28,7 @@ pub struct Args {
     #[arg(long)]
     horizon: Option<f64>,
     #[command(flatten)]
-    rapier: RapierArgs,
+    settings: ModelArgs,
     /// Output format on standard output.
     #[arg(long, value_enum, default_value_t = Format::Text)]
     format: Format,
@@ -54,16 +55,16 @@ struct Comparison {
 }
 
 pub fn run(a: Args) -> Result<ExitStatus> {
-    let nominal = load_nominal(&a.scene, a.rapier.overrides(a.horizon, None))?;
+    let nominal = load_nominal(&a.scene, a.settings.overrides(a.horizon, None))?;
     if let Some(members) = nominal.ensemble(a.ensemble)? {
         return compare_ensembles(&a, &nominal.scene.name, &members);
     }
     let scene = nominal.scene;
-    let reference = Model::Reference.simulate(&scene)?;
+    let reference = Model::Reference.simulate(&scene, &RunOptions::default())?;
     let mut models = std::collections::BTreeMap::new();
     let mut runs = vec![];
     for &m in a.models.iter().filter(|m| **m != Model::Reference) {
-        let run = m.simulate(&scene)?;
+        let run = m.simulate(&scene, &RunOptions::default())?;
         models.insert(m.name().to_string(), ModelComparison { summary: RunSummary::of(&run), errors: errors(&run, &reference) });
         runs.push(run);
     }

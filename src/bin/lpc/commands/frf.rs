@@ -9,7 +9,7 @@ use lpc_damper::output::write_atomic;
 use lpc_damper::scene::{self, Overrides};
 use lpc_damper::Model;
 
-use crate::args::{invalid, load_nominal, parse_range, print_json, progress_bar, EnsembleArgs, Format, RapierArgs};
+use crate::args::{invalid, load_nominal, parse_range, print_json, progress_bar, EnsembleArgs, Format, ModelArgs};
 use crate::table::{right, Table};
 use crate::exit::{CommandError, ExitStatus, Result};
 
@@ -40,7 +40,7 @@ pub struct Args {
     #[arg(long)]
     out: Option<PathBuf>,
     #[command(flatten)]
-    rapier: RapierArgs,
+    settings: ModelArgs,
     #[command(flatten)]
     ensemble: EnsembleArgs,
 }
@@ -52,7 +52,7 @@ enum ForcingKindArg {
 }
 
 pub fn run(a: Args) -> Result<ExitStatus> {
-    let nominal = load_nominal(&a.scene, a.rapier.overrides(None, None))?;
+    let nominal = load_nominal(&a.scene, a.settings.overrides(None, None))?;
     let scene = nominal.scene.clone();
     let (from, to) = parse_range(&a.freq, &a.scene, "--freq")?;
     let invalid = |field: &str, rule: String| invalid(&a.scene, field, rule);

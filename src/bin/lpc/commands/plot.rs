@@ -2,11 +2,12 @@
 
 use std::path::{Path, PathBuf};
 
+use lpc_damper::model::RunOptions;
 use lpc_damper::studies::chain::run_chain;
 use lpc_damper::scene;
 use lpc_damper::Model;
 
-use crate::args::{invalid, override_scene, parse_size, RapierArgs};
+use crate::args::{invalid, override_scene, parse_size, ModelArgs};
 use crate::exit::{ExitStatus, Result};
 
 #[derive(clap::Args)]
@@ -25,7 +26,7 @@ pub struct Args {
     #[arg(long, default_value = "1000x640", value_parser = parse_size)]
     size: (u32, u32),
     #[command(flatten)]
-    rapier: RapierArgs,
+    settings: ModelArgs,
 }
 
 pub fn run(a: Args) -> Result<ExitStatus> {
@@ -76,28 +77,28 @@ pub fn run(a: Args) -> Result<ExitStatus> {
         let loaded = scene::load(&a.input)?;
         if let Some(mut cases) = loaded.chain.clone() {
             for c in &mut cases {
-                override_scene(&mut c.scene, a.rapier.overrides(None, None), &a.input)?;
+                override_scene(&mut c.scene, a.settings.overrides(None, None), &a.input)?;
             }
             figs.push(figures::ker_chart(&run_chain(&cases, a.model)?, a.model.name()));
         } else if loaded.file.sweep.is_some() {
             use rayon::prelude::*;
             let mut scenes = lpc_damper::studies::sweep::sweep_scenes(&loaded)?;
             for (_, s) in &mut scenes {
-                override_scene(s, a.rapier.overrides(None, None), &a.input)?;
+                override_scene(s, a.settings.overrides(None, None), &a.input)?;
             }
             let parameter = loaded.file.sweep.as_ref().map_or(String::new(), |s| s.parameter.clone());
             let values: Vec<String> = loaded.file.sweep.as_ref().map_or(vec![], |s| s.values.iter().map(|v| v.to_string()).collect());
             let runs = scenes
                 .par_iter()
                 .zip(values)
-                .map(|((_, s), label)| Ok((label, a.model.simulate(s)?)))
+                .map(|((_, s), label)| Ok((label, a.model.simulate(s, &RunOptions::default())?)))
                 .collect::<std::result::Result<Vec<_>, lpc_damper::model::ModelError>>()?;
             figs.push(figures::sweep_curves(&parameter, &runs));
         } else {
             let mut s = loaded.scene.clone().expect("a scene file without [chain] has [frame]");
-            override_scene(&mut s, a.rapier.overrides(None, None), &a.input)?;
-            let run = a.model.simulate(&s)?;
-            let bare = lpc_damper::reference::simulate(&s.without_damper())?;
+            override_scene(&mut s, a.settings.overrides(None, None), &a.input)?;
+            let run = a.model.simulate(&s, &RunOptions::default())?;
+            let bare = lpc_damper::Model::Reference.simulate(&s.without_damper(), &RunOptions::default())?;
             figs.extend(figures::time_histories(&run, (!s.balls.is_empty()).then_some(&bare)));
             if !s.balls.is_empty() {
                 figs.push(figures::ball_positions(&run, s.container.map(|c| c.length)));

@@ -4,11 +4,12 @@ use std::path::PathBuf;
 
 use anyhow::Context;
 
+use lpc_damper::model::RunOptions;
 use lpc_damper::output::write_run_dir;
 use lpc_damper::scene::{Overrides, Scene};
 use lpc_damper::Model;
 
-use crate::args::{invalid, load_scene, parse_size, RapierArgs};
+use crate::args::{invalid, load_scene, parse_size, ModelArgs};
 use crate::exit::{CommandError, ExitStatus, Result};
 
 #[derive(clap::Args)]
@@ -31,7 +32,7 @@ pub struct Args {
     #[arg(long, default_value = "reference")]
     model: Model,
     #[command(flatten)]
-    rapier: RapierArgs,
+    settings: ModelArgs,
 }
 
 pub fn run(a: Args) -> Result<ExitStatus> {
@@ -43,12 +44,12 @@ pub fn run(a: Args) -> Result<ExitStatus> {
     if !(a.fps.is_finite() && a.fps > 0.0 && a.fps <= 10_000.0) {
         return Err(invalid(&a.scene, "--fps", format!("must lie in (0, 10000] (got {})", a.fps)).into());
     }
-    let s = load_scene(&a.scene, a.rapier.overrides(None, None))?;
+    let s = load_scene(&a.scene, a.settings.overrides(None, None))?;
     // Frames fall on samples: the run is sampled at a step dividing the frame interval.
     let (sample_dt, per_frame) = lpc_damper::run::frame_sampling(a.fps, s.sample_dt);
     let timing = Overrides { horizon: a.horizon, sample_dt: Some(sample_dt), ..Overrides::default() };
     let s = timing.apply(s, &a.scene.display().to_string())?;
-    let run = a.model.simulate(&s)?;
+    let run = a.model.simulate(&s, &RunOptions::default())?;
     write_run_dir(&run, &a.out).with_context(|| format!("writing outputs to {}", a.out.display()))?;
     render_run(&s, &run, &a, per_frame)?;
     Ok(ExitStatus::Success)

@@ -11,7 +11,7 @@ use lpc_damper::output::parquet::{table_parquet, Constant, TOOL_VERSION};
 use lpc_damper::studies::ensemble::{self, Ensemble, EnsembleSummary, ShardInfo};
 use lpc_damper::Model;
 
-use crate::args::{load_nominal, parse_shard, print_json, progress_bar, EnsembleArgs, Format, RapierArgs};
+use crate::args::{load_nominal, parse_shard, print_json, progress_bar, EnsembleArgs, Format, ModelArgs};
 use crate::exit::{ExitStatus, Result};
 use crate::table::{left, right, statistic, Table};
 
@@ -29,7 +29,7 @@ pub struct Args {
     #[arg(long)]
     sample_dt: Option<f64>,
     #[command(flatten)]
-    rapier: RapierArgs,
+    settings: ModelArgs,
     /// Write series.csv, impacts.csv and summary.json into this directory.
     #[arg(long)]
     out: Option<PathBuf>,
@@ -43,11 +43,11 @@ pub struct Args {
     /// members.csv, members.parquet and shard.json, which `lpc merge` joins.
     #[arg(long, value_name = "I/K", requires = "ensemble", value_parser = parse_shard)]
     shard: Option<(usize, usize)>,
-    /// Compliant model: stop after this many integration steps (default 5e7), keeping the run
-    /// so far (written with --out) and saying what its steps cost.
+    /// Stop after this many steps (the reference: events; the compliant model stops at 5e7
+    /// without one), keeping the run so far (written with --out) and saying what its steps cost.
     #[arg(long, value_name = "N")]
     max_steps: Option<u64>,
-    /// Compliant model: stop after this many seconds of computing, likewise.
+    /// Stop after this many seconds of computing, likewise.
     #[arg(long, value_name = "S")]
     max_wall_time: Option<f64>,
 }
@@ -55,36 +55,30 @@ pub struct Args {
 /// How long a run goes before its progress is shown.
 const QUIET_FOR_S: f64 = 1.0;
 
-/// The compliant model on `scene` within the budgets of `a`. A long run says so early, with
-/// its estimated cost ([`lpc_damper::compliant::cost`], revised when it moves by more than
-/// twofold), and shows a progress bar (on a terminal) once it has run for [`QUIET_FOR_S`]; a run
-/// stopped by a budget is written to `--out` as far as it got before the error is reported.
-fn run_compliant(a: &Args, scene: &lpc_damper::scene::Scene) -> Result<lpc_damper::run::Run> {
-    use lpc_damper::compliant::{self, cost, CompliantError, Options, Progress};
+/// `model` on `scene` within the budgets of `a`. A long run says so early, with its estimated
+/// cost ([`lpc_damper::model::cost`], revised when it moves by more than twofold), and shows a
+/// progress bar (on a terminal) once it has run for [`QUIET_FOR_S`]; a run stopped by a budget
+/// is written to `--out` as far as it got before the error is reported.
+fn run_watched(a: &Args, scene: &lpc_damper::scene::Scene) -> Result<lpc_damper::run::Run> {
+    use lpc_damper::model::{cost, Progress, RunOptions};
     use lpc_damper::scene::human;
-    lpc_damper::run::check_budgets(a.max_steps, a.max_wall_time).map_err(|(budget, rule)| {
-        let flag = if budget == lpc_damper::run::Budget::Steps { "--max-steps" } else { "--max-wall-time" };
-        crate::args::invalid(&a.scene, flag, rule)
-    })?;
-    lpc_damper::run::check_memory(scene).map_err(lpc_damper::model::ModelError::Refused)?;
-    let options = Options {
-        max_steps: a.max_steps.unwrap_or(compliant::MAX_STEPS),
-        max_wall_s: a.max_wall_time,
-        ..Options::default()
-    };
     let progress = Progress::default();
+    let options = RunOptions { max_steps: a.max_steps, max_wall_s: a.max_wall_time, progress: Some(&progress), ..RunOptions::default() };
+    options.check_budgets().map_err(|(budget, rule)| crate::args::invalid(&a.scene, budget.flag(), rule))?;
+    let model = a.model;
+    let unit = model.step_unit();
     let done = std::sync::atomic::AtomicBool::new(false);
     let result = std::thread::scope(|s| {
-        s.spawn(|| {
+        let watcher = s.spawn(|| {
             let bar = indicatif::ProgressBar::new(1000);
             let shown = std::cell::Cell::new(false);
             let say = |said: cost::Said| {
                 // Said on a terminal or in a log: what the whole run will cost.
                 let e = said.estimate;
                 let line = format!(
-                    "compliant: `{}` {}: about {} steps and {:.1} s of computing in all, at its recent rate (t = {:.3e} of {} s \
-                     after {:.2} s and {} steps; lately {} steps per simulated second, {:.2e} s each; a pack's cost can change \
-                     tenfold as it runs, so this is revised when it moves twofold; --max-steps and --max-wall-time bound it)",
+                    "{model}: `{}` {}: about {} {unit} and {:.1} s of computing in all, at its recent rate (t = {:.3e} of {} s \
+                     after {:.2} s and {} {unit}; lately {} {unit} per simulated second, {:.2e} s each; a run's cost can change \
+                     tenfold as it goes, so this is revised when it moves twofold; --max-steps and --max-wall-time bound it)",
                     scene.name,
                     if said.revision { "revised" } else { "is a long run" },
                     human(e.steps.round()),
@@ -107,33 +101,33 @@ fn run_compliant(a: &Args, scene: &lpc_damper::scene::Scene) -> Result<lpc_dampe
                     return;
                 }
                 if !shown.replace(true) {
-                    bar.set_style(
-                        indicatif::ProgressStyle::with_template("compliant [{bar:30}] {msg} ({elapsed}, about {eta} to go)").expect("valid template"),
-                    );
+                    let template = format!("{model} [{{bar:30}}] {{msg}} ({{elapsed}}, about {{eta}} to go)");
+                    bar.set_style(indicatif::ProgressStyle::with_template(&template).expect("valid template"));
                 }
                 bar.set_position((1000.0 * t / scene.horizon).clamp(0.0, 1000.0) as u64);
-                bar.set_message(format!("t = {t:.3e} of {:.3e} s, {steps} steps", scene.horizon));
+                bar.set_message(format!("t = {t:.3e} of {:.3e} s, {steps} {unit}", scene.horizon));
             };
             cost::watch(&progress, scene.horizon, &done, say, tick);
             bar.finish_and_clear();
         });
-        let result = compliant::simulate_watched(scene, options, Some(&progress));
+        let result = model.simulate(scene, &options);
         done.store(true, std::sync::atomic::Ordering::Relaxed);
+        watcher.thread().unpark();
         result
     });
     let e = match result {
         Ok(run) => return Ok(run),
         Err(e) => e,
     };
-    if let (CompliantError::OverBudget { partial, .. }, Some(dir)) = (&e, &a.out) {
+    if let (Some(partial), Some(dir)) = (e.partial(), &a.out) {
         write_run_dir(partial, dir).with_context(|| format!("writing outputs to {}", dir.display()))?;
-        eprintln!("wrote the run up to t = {} s to {}", lpc_damper::scene::human(partial.horizon), dir.display());
+        eprintln!("wrote the run up to t = {} s to {}", human(partial.horizon), dir.display());
     }
-    Err(lpc_damper::model::ModelError::from(e).into())
+    Err(e.into())
 }
 
 pub fn run(a: Args) -> Result<ExitStatus> {
-    let nominal = load_nominal(&a.scene, a.rapier.overrides(a.horizon, a.sample_dt))?;
+    let nominal = load_nominal(&a.scene, a.settings.overrides(a.horizon, a.sample_dt))?;
     if let Some(shard) = a.shard {
         let members = nominal.ensemble_shard(a.ensemble, shard)?.expect("--shard requires --ensemble");
         return run_shard(&a, &nominal.scene, &members, shard);
@@ -142,10 +136,6 @@ pub fn run(a: Args) -> Result<ExitStatus> {
         return run_ensemble(&a, &nominal.scene, &members);
     }
     let scene = nominal.scene;
-    if (a.max_steps.is_some() || a.max_wall_time.is_some()) && a.model != Model::Compliant {
-        let flag = if a.max_steps.is_some() { "--max-steps" } else { "--max-wall-time" };
-        return Err(crate::args::invalid(&a.scene, flag, format!("applies to the compliant model, not to `{}`", a.model)).into());
-    }
     // Said before the run, which may be long: the series it will keep.
     if let Ok(every @ 2..) = lpc_damper::run::series_every(&scene) {
         eprintln!(
@@ -155,7 +145,7 @@ pub fn run(a: Args) -> Result<ExitStatus> {
             lpc_damper::scene::human(scene.sample_dt * every as f64)
         );
     }
-    let run = if a.model == Model::Compliant { run_compliant(&a, &scene)? } else { a.model.simulate(&scene)? };
+    let run = run_watched(&a, &scene)?;
     let summary = RunSummary::of(&run);
     if let Some(dir) = &a.out {
         write_run_dir(&run, dir).with_context(|| format!("writing outputs to {}", dir.display()))?;
@@ -293,7 +283,7 @@ fn write_ensemble_dir(
     runs: &ensemble::EnsembleRuns,
     summary: &EnsembleSummary,
 ) -> anyhow::Result<()> {
-    let run = model.simulate(nominal)?;
+    let run = model.simulate(nominal, &lpc_damper::model::RunOptions::default())?;
     write_run_dir(&run, dir)?;
     write_members(dir, model, members.seed, &members.columns, members, &runs.metrics)?;
     write_atomic(&dir.join("ensemble.json"), &serde_json::to_vec_pretty(summary)?)?;

@@ -44,7 +44,8 @@ pub struct Args {
 }
 
 pub fn run(a: Args) -> Result<ExitStatus> {
-    lpc_damper::run::check_budgets(None, a.max_wall_time).map_err(|(_, rule)| lpc_damper::scene::SceneError::Invalid {
+    let budget = lpc_damper::model::RunOptions { max_wall_s: a.max_wall_time, ..Default::default() };
+    budget.check_budgets().map_err(|(_, rule)| lpc_damper::scene::SceneError::Invalid {
         file: "(command line)".into(),
         field: "--max-wall-time".into(),
         rule,

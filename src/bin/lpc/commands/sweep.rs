@@ -12,7 +12,7 @@ use lpc_damper::Model;
 use lpc_damper::studies::ensemble;
 use lpc_damper::studies::sweep::{Axis, Coordinates, EnsemblePoint, GridScene, SweepPoint};
 
-use crate::args::{invalid, override_scene, print_json, progress_bar, quantile_arg, EnsembleArgs, Format, Nominal, RapierArgs};
+use crate::args::{invalid, override_scene, print_json, progress_bar, quantile_arg, EnsembleArgs, Format, Nominal, ModelArgs};
 use crate::table::{right, statistic, Table};
 use crate::exit::{ExitStatus, Result};
 
@@ -45,7 +45,7 @@ pub struct Args {
     #[arg(long, default_value = "settling_time")]
     metric: String,
     #[command(flatten)]
-    rapier: RapierArgs,
+    settings: ModelArgs,
     #[command(flatten)]
     ensemble: EnsembleArgs,
     /// With --ensemble: the quantile of each cell's distribution that the map shows (default
@@ -74,12 +74,12 @@ pub fn run(a: Args) -> Result<ExitStatus> {
     }
     let mut grid = lpc_damper::studies::sweep::grid_scenes(&loaded, &axes)?;
     for g in &mut grid {
-        override_scene(&mut g.scene, a.rapier.overrides(a.horizon, None), &a.scene)?;
+        override_scene(&mut g.scene, a.settings.overrides(a.horizon, None), &a.scene)?;
     }
     let parameters: Vec<String> = axes.iter().map(|x| x.parameter.clone()).collect();
     if a.ensemble.ensemble.is_some() {
         let q = quantile_arg(a.quantile, &a.scene)?;
-        let nominal = Nominal::of(&loaded, a.rapier.overrides(a.horizon, None))?;
+        let nominal = Nominal::of(&loaded, a.settings.overrides(a.horizon, None))?;
         return sweep_ensembles(&a, &nominal, &axes, &parameters, &grid, q);
     }
     let parameter = parameters.join(" x ");

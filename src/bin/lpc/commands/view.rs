@@ -2,9 +2,10 @@
 
 use std::path::PathBuf;
 
+use lpc_damper::model::RunOptions;
 use lpc_damper::Model;
 
-use crate::args::{load_scene, RapierArgs};
+use crate::args::{load_scene, ModelArgs};
 use crate::exit::{CommandError, ExitStatus, Result};
 
 #[derive(clap::Args)]
@@ -18,7 +19,7 @@ pub struct Args {
     #[arg(long)]
     horizon: Option<f64>,
     #[command(flatten)]
-    rapier: RapierArgs,
+    settings: ModelArgs,
 }
 
 pub fn run(a: Args) -> Result<ExitStatus> {
@@ -29,8 +30,8 @@ pub fn run(a: Args) -> Result<ExitStatus> {
     if std::env::var_os("DISPLAY").is_none_or(|d| d.is_empty()) {
         return Err(CommandError::failure(anyhow::anyhow!("no display: `lpc view` needs an X11 display (DISPLAY is not set); `lpc render` draws frames off-screen")));
     }
-    let s = load_scene(&a.scene, a.rapier.overrides(a.horizon, None))?;
-    let run = a.model.simulate(&s)?;
+    let s = load_scene(&a.scene, a.settings.overrides(a.horizon, None))?;
+    let run = a.model.simulate(&s, &RunOptions::default())?;
     #[cfg(feature = "render")]
     lpc_damper::render::window::view(&s, run);
     #[cfg(not(feature = "render"))]

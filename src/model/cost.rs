@@ -1,15 +1,15 @@
-//! What a compliant run will cost, judged from the run itself while it goes: the steps still
+//! What a run will cost, judged from the run itself while it goes: the steps (or events) still
 //! to take at the rate of its recent steps per simulated second, and the seconds at its
-//! measured cost per step.
+//! measured cost per step. Every model reports where it stands through [`super::Progress`].
 //!
-//! Why measured, not predicted from the scene alone: the cost of the compliant model is set by
-//! what its contacts do, which only it resolves. A pack of balls pressed together trembles at
-//! its Hertz frequencies and rattles through thousands of contacts where the impulse models
-//! count one merge (docs/BENCHMARKS.md, "Compliant model on packs and resting contacts": the
-//! packed column's 835 contacts against the reference's single impact), and a run's first
-//! milliseconds (the balls' first impacts, a pack settling) often cost more per simulated second
-//! than the rest. So the estimate reads the *recent* half of the run's computing time, which
-//! has left the start behind, and is revised as the run goes ([`CostWatch::revised`]).
+//! Why measured, not predicted from the scene alone: a model's cost is set by what its contacts
+//! do, which only it resolves. A pack of balls pressed together trembles at its Hertz
+//! frequencies in the compliant model and rattles through thousands of contacts where the
+//! reference counts one merge (docs/BENCHMARKS.md, "Compliant model on packs and resting
+//! contacts"), and a run's first milliseconds (the first impacts, a pack settling) often cost
+//! more per simulated second than the rest. So the estimate reads the *recent* half of the
+//! run's computing time, which has left the start behind, and is revised as the run goes
+//! ([`CostWatch::revised`]).
 
 /// An estimate of a whole run's cost.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -110,7 +110,8 @@ pub struct Said {
     pub steps: u64,
 }
 
-/// Watches a run through its [`super::Progress`] until `done`: reads it every [`READ_EVERY`],
+/// Watches a run through its [`super::Progress`] until `done` (the run's thread sets it and
+/// unparks this one, which then returns at once): reads it every [`READ_EVERY`],
 /// passes each reading to `tick(elapsed_s, t, steps)`, and from [`ESTIMATE_AFTER_S`] on passes
 /// to `say` the estimates of a long run to say ([`CostWatch::revised`]; once a run has been
 /// said to be long, its revisions whatever their size). Run on its own thread beside the run.
@@ -125,7 +126,10 @@ pub fn watch(
     let mut watch = CostWatch::default();
     let mut long = false;
     while !done.load(std::sync::atomic::Ordering::Relaxed) {
-        std::thread::sleep(READ_EVERY);
+        std::thread::park_timeout(READ_EVERY);
+        if done.load(std::sync::atomic::Ordering::Relaxed) {
+            break;
+        }
         let (elapsed_s, t, steps) = (start.elapsed().as_secs_f64(), progress.time(), progress.steps());
         watch.record(elapsed_s, t, steps);
         if elapsed_s >= ESTIMATE_AFTER_S {

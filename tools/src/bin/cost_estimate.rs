@@ -1,10 +1,10 @@
 //! How good the compliant model's cost estimates are (issue 18): runs the compliant model on
 //! each scene given (a scene file, or a seed of `lpc stress --max-horizon 2`), watched as
-//! `lpc run` watches it ([`lpc_damper::compliant::cost::watch`]), and prints what it said and
+//! `lpc run` watches it ([`lpc_damper::model::cost::watch`]), and prints what it said and
 //! when, against what the run took.
 //!
-//! `cargo run --release --example cost_estimate -- examples/scenes/packed-column.toml 31338 80056 ...`
-use lpc_damper::compliant::{self, cost, Options, Progress};
+//! `cargo run --release -p lpc-tools --bin cost_estimate -- examples/scenes/packed-column.toml 31338 80056 ...`
+use lpc_damper::model::{cost, Model, Progress, RunOptions};
 use lpc_damper::run::Record;
 
 fn main() {
@@ -22,15 +22,16 @@ fn main() {
         let done = std::sync::atomic::AtomicBool::new(false);
         let mut said = Vec::new();
         let start = std::time::Instant::now();
-        let options = Options { record: Record::MetricsOnly, max_wall_s: Some(60.0), ..Options::default() };
+        let options = RunOptions { record: Record::MetricsOnly, max_wall_s: Some(60.0), progress: Some(&progress), ..RunOptions::default() };
         let run = std::thread::scope(|s| {
             let watcher = s.spawn(|| {
                 let mut said = Vec::new();
                 cost::watch(&progress, scene.horizon, &done, |e| said.push(e), |_, _, _| {});
                 said
             });
-            let run = compliant::simulate_watched(&scene, options, Some(&progress));
+            let run = Model::Compliant.simulate(&scene, &options);
             done.store(true, std::sync::atomic::Ordering::Relaxed);
+            watcher.thread().unpark();
             said = watcher.join().expect("the watcher ends");
             run
         });

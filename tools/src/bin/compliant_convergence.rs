@@ -2,10 +2,10 @@
 //! Young's modulus: contact durations scale as E^(-2/5)), and its energy balance against the
 //! error tolerance. Figures of docs/BENCHMARKS.md, "Compliant model".
 //!
-//! `cargo run --release --example compliant_convergence`
+//! `cargo run --release -p lpc-tools --bin compliant_convergence`
 
 use lpc_damper::studies::compare::errors;
-use lpc_damper::compliant::{simulate, simulate_with, Options};
+use lpc_damper::model::{Model, RunOptions};
 use lpc_damper::scene::{load_scene, scenes_dir};
 
 fn main() {
@@ -17,8 +17,8 @@ fn main() {
             let mut scene = load_scene(scenes_dir().join(format!("{name}.toml"))).unwrap();
             scene.horizon = 0.5;
             scene.compliant.youngs_modulus *= factor;
-            let reference = lpc_damper::reference::simulate(&scene).unwrap();
-            let e = errors(&simulate(&scene).unwrap(), &reference);
+            let reference = Model::Reference.simulate(&scene, &RunOptions::default()).unwrap();
+            let e = errors(&Model::Compliant.simulate(&scene, &RunOptions::default()).unwrap(), &reference);
             row += &format!(" {:>10.4}", e.max_xs_early * 1e3);
         }
         println!("{row}");
@@ -26,7 +26,9 @@ fn main() {
     println!("\nlpc-lsl, 5 s: energy balance error against the tolerance");
     let scene = load_scene(scenes_dir().join("lpc-lsl.toml")).unwrap();
     for tolerance in [1e-6, 1e-7, 1e-8, 1e-9, 1e-10, 1e-11] {
-        let run = simulate_with(&scene, Options { tolerance, ..Default::default() }).unwrap();
+        let mut scene = scene.clone();
+        scene.compliant.tolerance = tolerance;
+        let run = Model::Compliant.simulate(&scene, &RunOptions::default()).unwrap();
         println!(
             "tolerance {tolerance:.0e}: balance error {:+.2e}, {} steps, {} impacts, {:.1} ms",
             run.energy.balance_error,

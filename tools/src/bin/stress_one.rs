@@ -1,11 +1,13 @@
 //! Runs one stress scene (by seed, or a TOML file through the reference) and prints its time:
-//! `cargo run --release --example stress_one -- SEED [MAX_HORIZON] [MODEL]` (`--toml` prints
+//! `cargo run --release -p lpc-tools --bin stress_one -- SEED [MAX_HORIZON] [MODEL]` (`--toml` prints
 //! the scene file instead) or `... -- scene.toml`.
+use lpc_damper::model::{Model, RunOptions};
+
 fn main() {
     let args: Vec<String> = std::env::args().collect();
     if args[1].ends_with(".toml") {
         let scene = lpc_damper::scene::load_scene(&args[1]).unwrap();
-        let run = lpc_damper::reference::simulate(&scene).unwrap();
+        let run = Model::Reference.simulate(&scene, &RunOptions::default()).unwrap();
         println!("events {} impacts {} events per simulated second {:.0}", run.events, run.impacts.len(), run.events as f64 / scene.horizon);
         return;
     }

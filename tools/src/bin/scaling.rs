@@ -1,11 +1,11 @@
 //! How cost grows with the number of balls, the horizon and the sweep size, for both models.
-//! `cargo run --release --example scaling` prints the tables quoted in docs/BENCHMARKS.md.
+//! `cargo run --release -p lpc-tools --bin scaling` prints the tables quoted in docs/BENCHMARKS.md.
 
 use std::time::Instant;
 
 use lpc_damper::scene::{load, load_scene, scenes_dir, Arrangement, Length};
 use lpc_damper::studies::sweep::{run_sweep, sweep_scenes};
-use lpc_damper::Model;
+use lpc_damper::model::{Model, RunOptions};
 
 fn main() {
     let lsl = scenes_dir().join("lpc-lsl.toml");
@@ -18,7 +18,7 @@ fn main() {
         loaded.file.balls.as_mut().unwrap().arrangement = Arrangement::Letters(letters);
         let scene = lpc_damper::scene::from_file(loaded.file, "scaling", "scaling").unwrap().scene.unwrap();
         for model in [Model::Reference, Model::Rapier] {
-            let run = model.simulate(&scene).unwrap();
+            let run = model.simulate(&scene, &RunOptions::default()).unwrap();
             println!(
                 "| {n} | {} | {:.2e} | {:.0} | {} |",
                 model.name(),
@@ -35,7 +35,7 @@ fn main() {
         let mut scene = load_scene(&lsl).unwrap();
         scene.horizon = horizon;
         for model in [Model::Reference, Model::Rapier] {
-            let run = model.simulate(&scene).unwrap();
+            let run = model.simulate(&scene, &RunOptions::default()).unwrap();
             println!(
                 "| {horizon} | {} | {:.3e} | {:.2e} | {} |",
                 model.name(),

@@ -1,0 +1,143 @@
+//! What a caller asks of one run besides the scene: what to keep, how much it may cost, and
+//! where to report its progress. Every model takes the same options.
+
+use std::sync::atomic::{AtomicU64, Ordering};
+use std::time::Instant;
+
+use crate::run::Record;
+
+/// How one run is to be made.
+#[derive(Debug, Clone, Copy, Default)]
+pub struct RunOptions<'a> {
+    /// What the run keeps besides its metrics.
+    pub record: Record,
+    /// Most steps (the reference: events) before the run stops with the run so far
+    /// ([`super::ModelError::OverBudget`]).
+    pub max_steps: Option<u64>,
+    /// Most seconds of computing before the run stops, likewise.
+    pub max_wall_s: Option<f64>,
+    /// Where the run reports the simulated time reached and the steps taken as it goes.
+    pub progress: Option<&'a Progress>,
+}
+
+impl RunOptions<'_> {
+    /// A run that keeps only its metrics (an ensemble member's).
+    pub fn metrics_only() -> Self {
+        RunOptions { record: Record::MetricsOnly, ..RunOptions::default() }
+    }
+
+    /// The rules the budgets keep (`--max-steps`, `--max-wall-time` and their Python keywords):
+    /// at least one step, a positive and finite number of seconds. The rule broken, for the
+    /// caller to name its field.
+    pub fn check_budgets(&self) -> Result<(), (Budget, String)> {
+        if self.max_steps == Some(0) {
+            return Err((Budget::Steps, "must be at least 1".into()));
+        }
+        match self.max_wall_s {
+            Some(w) if !(w > 0.0 && w.is_finite()) => Err((Budget::WallTime, format!("must be a positive number of seconds (got {w})"))),
+            _ => Ok(()),
+        }
+    }
+}
+
+/// A run's budget: steps (events, for the reference) or seconds of computing.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Budget {
+    /// Steps or events.
+    Steps,
+    /// Seconds of computing.
+    WallTime,
+}
+
+impl Budget {
+    /// The command-line flag that sets it.
+    pub fn flag(self) -> &'static str {
+        match self {
+            Budget::Steps => "--max-steps",
+            Budget::WallTime => "--max-wall-time",
+        }
+    }
+    /// The Python keyword that sets it.
+    pub fn keyword(self) -> &'static str {
+        match self {
+            Budget::Steps => "max_steps",
+            Budget::WallTime => "max_wall_time",
+        }
+    }
+}
+
+/// Where a run stands, for a progress bar or a cost estimate on another thread: the simulated
+/// time reached and the steps (or events) taken, updated as the run goes ([`Meter`]).
+#[derive(Debug, Default)]
+pub struct Progress {
+    t: AtomicU64,
+    steps: AtomicU64,
+}
+
+impl Progress {
+    /// Simulated time reached, s.
+    pub fn time(&self) -> f64 {
+        f64::from_bits(self.t.load(Ordering::Relaxed))
+    }
+    /// Steps (or events) taken.
+    pub fn steps(&self) -> u64 {
+        self.steps.load(Ordering::Relaxed)
+    }
+    /// Records where the run stands.
+    pub fn set(&self, t: f64, steps: u64) {
+        self.t.store(t.to_bits(), Ordering::Relaxed);
+        self.steps.store(steps, Ordering::Relaxed);
+    }
+}
+
+/// A run's budgets and progress as its model looks at them: every `every` steps it reports
+/// where it stands and says which budget, if any, has run out. Every model keeps one, so the
+/// budgets mean the same in all of them.
+#[derive(Debug, Clone, Copy)]
+pub struct Meter<'a> {
+    start: Instant,
+    every: u64,
+    max_steps: Option<u64>,
+    max_wall_s: Option<f64>,
+    progress: Option<&'a Progress>,
+}
+
+impl<'a> Meter<'a> {
+    /// A meter started now for a run under `options`, looking every `every` steps.
+    pub fn new(options: &RunOptions<'a>, every: u64) -> Self {
+        Meter { start: Instant::now(), every: every.max(1), max_steps: options.max_steps, max_wall_s: options.max_wall_s, progress: options.progress }
+    }
+    /// Seconds of computing since the run started.
+    pub fn elapsed(&self) -> f64 {
+        self.start.elapsed().as_secs_f64()
+    }
+    /// The run has taken `steps` steps and reached `t`: on every `every`-th step (and past the
+    /// step budget) reports it and returns the budget that has run out, if any.
+    #[inline]
+    pub fn look(&self, t: f64, steps: u64) -> Option<Budget> {
+        let over_steps = self.max_steps.is_some_and(|m| steps > m);
+        if !over_steps && steps % self.every != 0 {
+            return None;
+        }
+        if let Some(p) = self.progress {
+            p.set(t, steps);
+        }
+        if over_steps {
+            return Some(Budget::Steps);
+        }
+        self.max_wall_s.filter(|&w| self.elapsed() > w).map(|_| Budget::WallTime)
+    }
+    /// Reports the end of the run.
+    pub fn finish(&self, t: f64, steps: u64) {
+        if let Some(p) = self.progress {
+            p.set(t, steps);
+        }
+    }
+    /// The limit of `budget`, in its unit (steps, or seconds).
+    pub fn limit(&self, budget: Budget) -> f64 {
+        match budget {
+            Budget::Steps => self.max_steps.unwrap_or(u64::MAX) as f64,
+            Budget::WallTime => self.max_wall_s.unwrap_or(f64::INFINITY),
+        }
+    }
+}

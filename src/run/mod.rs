@@ -1,0 +1,209 @@
+//! The common output of every model: sampled series, impact list, energy account and wall
+//! time. Metrics, comparison and output read only this type, so models stay interchangeable.
+
+mod memory;
+mod series;
+mod tally;
+
+pub use memory::{
+    available_memory, bytes_for_people, check_memory, fits_in_memory, refuse_beyond_memory, series_bytes, series_every, MAX_SERIES_EVERY,
+    MEMORY_SHARE,
+};
+pub use series::{Record, Recorder, Series};
+pub use tally::{MotionMetrics, SampleTally, DISSIPATION_LEVELS, SETTLING_FRACTION};
+
+use crate::scene::Body;
+
+/// Declares the models the tool has, one line each: the label in outputs and on the command
+/// line, how messages name it, and what its budget counts. The registry
+/// (`crate::registry`) maps each to its implementation.
+macro_rules! models {
+    ($($(#[$doc:meta])* $variant:ident = $name:literal, $title:literal, $unit:literal;)*) => {
+        /// A model of the damper.
+        #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord, serde::Serialize, serde::Deserialize)]
+        #[serde(rename_all = "lowercase")]
+        pub enum Model {
+            $($(#[$doc])* $variant,)*
+        }
+
+        impl Model {
+            /// Every model, in report order.
+            pub const ALL: &'static [Model] = &[$(Model::$variant),*];
+
+            /// Name used on the command line and in outputs.
+            pub fn name(self) -> &'static str {
+                match self {
+                    $(Model::$variant => $name,)*
+                }
+            }
+
+            /// How messages name the model (`the reference`).
+            pub fn title(self) -> &'static str {
+                match self {
+                    $(Model::$variant => $title,)*
+                }
+            }
+
+            /// What its step budget counts (`events`, `steps`).
+            pub fn step_unit(self) -> &'static str {
+                match self {
+                    $(Model::$variant => $unit,)*
+                }
+            }
+        }
+    };
+}
+
+models! {
+    /// The exact event-driven impulse solver.
+    Reference = "reference", "the reference", "events";
+    /// Rapier colliders in a headless Bevy app.
+    Rapier = "rapier", "the contact model", "steps";
+    /// Hertz contacts with Hunt-Crossley damping, integrated through every contact.
+    Compliant = "compliant", "the compliant model", "steps";
+}
+
+impl std::fmt::Display for Model {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
+impl std::str::FromStr for Model {
+    type Err = String;
+    fn from_str(s: &str) -> Result<Self, String> {
+        Model::ALL
+            .iter()
+            .copied()
+            .find(|m| m.name() == s)
+            .ok_or_else(|| format!("unknown model `{s}`; choose one of {}", Model::ALL.iter().map(|m| m.name()).collect::<Vec<_>>().join(", ")))
+    }
+}
+
+/// One impact between two neighbouring bodies.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Impact {
+    /// s.
+    pub t: f64,
+    /// The left body of the pair.
+    pub a: Body,
+    /// The right body of the pair.
+    pub b: Body,
+    /// Relative speed of approach just before, m/s.
+    pub approach_speed: f64,
+    /// Kinetic energy lost, J.
+    pub energy_lost: f64,
+    /// Momentum exchanges this impact stands for (sequential impulses at one instant, or the
+    /// bodies of a merged run): each rounds momentum once, which bounds round-off.
+    pub impulses: u32,
+    /// Largest contact force during the impact, N (compliant contact only; impulse models
+    /// have none).
+    pub peak_force: Option<f64>,
+    /// Time the bodies stay in contact, s (compliant contact only).
+    pub contact_duration: Option<f64>,
+}
+
+/// Where the energy went.
+/// `balance_error = (initial + forcing_work - final - damping_loss - impact_loss) / (|initial| + |forcing_work|)`.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct EnergyAccount {
+    /// Mechanical energy at t = 0, J.
+    pub initial: f64,
+    /// Mechanical energy at the horizon, J.
+    pub final_: f64,
+    /// Dissipated by the frame damper `cs`, J.
+    pub damping_loss: f64,
+    /// Lost in impacts, J.
+    pub impact_loss: f64,
+    /// Work done by the excitation, J (0 in free vibration).
+    pub forcing_work: f64,
+    /// Relative balance error.
+    pub balance_error: f64,
+}
+
+impl EnergyAccount {
+    /// An account with its balance error computed.
+    pub fn new(initial: f64, final_: f64, damping_loss: f64, impact_loss: f64) -> Self {
+        Self::forced(initial, final_, damping_loss, impact_loss, 0.0)
+    }
+    /// An account of a forced run, the excitation having done `forcing_work`.
+    pub fn forced(initial: f64, final_: f64, damping_loss: f64, impact_loss: f64, forcing_work: f64) -> Self {
+        let scale = initial.abs() + forcing_work.abs();
+        let scale = if scale != 0.0 { scale } else { 1.0 };
+        EnergyAccount {
+            initial,
+            final_,
+            damping_loss,
+            impact_loss,
+            forcing_work,
+            balance_error: (initial + forcing_work - final_ - damping_loss - impact_loss) / scale,
+        }
+    }
+}
+
+/// A model's result for one scene.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Run {
+    /// Scene name.
+    pub scene: String,
+    /// Model name (`reference`, `rapier`, ...).
+    pub model: Model,
+    /// Simulated time actually covered, s.
+    pub horizon: f64,
+    /// Output step, s.
+    pub sample_dt: f64,
+    /// Initial frame displacement (for the settling threshold).
+    pub initial_displacement: f64,
+    /// Bare frame's damped period, s (0 when it does not oscillate).
+    pub damped_period: f64,
+    /// Sampled motion (empty when the run kept only its metrics, [`Record::MetricsOnly`]).
+    pub series: Series,
+    /// The metrics of the motion (tallied at the samples, or exact where a model knows its
+    /// motion in closed form).
+    pub motion: MotionMetrics,
+    /// Every impact, in time order.
+    pub impacts: Vec<Impact>,
+    /// Energy account.
+    pub energy: EnergyAccount,
+    /// Events processed (impacts, sticks, releases); for stall detection.
+    pub events: u64,
+    /// Final ball velocities (exact, not sampled), m/s.
+    pub final_velocities: Vec<f64>,
+    /// Largest |acceleration| of the frame for t >= T with contact forces included, m/s^2
+    /// (compliant contact only: impulse models have infinite acceleration at impacts).
+    pub peak_true_acceleration: Option<f64>,
+    /// Computing time, s.
+    pub wall_time_s: f64,
+}
+
+/// A sampling step for a run to be shown at `fps` frames per second, and the samples per
+/// frame: the largest step no longer than `sample_dt` that divides `1 / fps`, so that every
+/// frame falls on a sample.
+pub fn frame_sampling(fps: f64, sample_dt: f64) -> (f64, usize) {
+    let per_frame = (1.0 / (fps * sample_dt)).ceil().max(1.0) as usize;
+    (1.0 / (fps * per_frame as f64), per_frame)
+}
+
+impl Run {
+    /// A run of nothing: no samples, no impacts, no energy (a stand-in for a refused scene,
+    /// or a shell to hold a series read back from a file).
+    pub fn empty(scene: &str, model: Model) -> Self {
+        Run {
+            scene: scene.into(),
+            model,
+            horizon: 0.0,
+            sample_dt: 0.0,
+            initial_displacement: 0.0,
+            damped_period: 0.0,
+            series: Series::default(),
+            motion: MotionMetrics::default(),
+            impacts: vec![],
+            energy: EnergyAccount::default(),
+            events: 0,
+            final_velocities: vec![],
+            peak_true_acceleration: None,
+            wall_time_s: 0.0,
+        }
+    }
+}
+
