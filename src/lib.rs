@@ -20,6 +20,7 @@
 #![warn(missing_docs)]
 
 pub mod compliant;
+pub mod files;
 pub mod impact_law;
 pub mod metrics;
 pub mod model;

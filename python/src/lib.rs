@@ -19,8 +19,9 @@ use pyo3::sync::MutexExt;
 use pyo3::types::PyDict;
 
 use lpc_damper::model::{ModelError as RustModelError, RunOptions};
-use lpc_damper::output::parquet::{table_parquet, Constant, TOOL_VERSION};
-use lpc_damper::output::{write_atomic, Headline, RunSummary};
+use lpc_damper::files::write_atomic;
+use lpc_damper::metrics::{Headline, Metric, RunSummary};
+use lpc_damper::output::parquet::{provenance, table_parquet, Constant, TOOL_VERSION};
 use lpc_damper::scene::{self, Loaded, Overrides, SceneError as RustSceneError, SceneFile, Stepping};
 use lpc_damper::studies::{chain as chains, ensemble as ensembles, frf as frfs, sweep as sweeps};
 use lpc_damper::Model;
@@ -331,7 +332,7 @@ impl Run {
             let column = |f: &dyn Fn(&lpc_damper::run::Impact) -> f64| floats(py, run.impacts.iter().map(f).collect());
             impacts.set_item("t", column(&|i| i.t))?;
             let names = |left: bool| -> Vec<String> {
-                run.impacts.iter().map(|i| scene::Scene::body_name(if left { i.a } else { i.b })).collect()
+                run.impacts.iter().map(|i| if left { i.a } else { i.b }.name()).collect()
             };
             let numpy = py.import("numpy")?;
             impacts.set_item("body_a", numpy.call_method1("asarray", (names(true),))?)?;
@@ -505,11 +506,7 @@ fn ensemble<'py>(
     })?;
     let (header, rows) = ensembles::members_table(&drawn.columns, all, &metrics);
     if let Some(dir) = &out {
-        let constants = [
-            ("seed", Constant::Unsigned(drawn.seed)),
-            ("model", Constant::Text(model.name().into())),
-            ("version", Constant::Text(TOOL_VERSION.into())),
-        ];
+        let constants = provenance(model, Some(drawn.seed));
         write_part(dir, &format!("part-{start:09}-{stop:09}.parquet"), &header, &rows, ensembles::INTEGER_COLUMNS, &constants)?;
     }
     columns(py, &header, &rows, ensembles::INTEGER_COLUMNS)
@@ -530,7 +527,7 @@ fn grid(scene: &Scene, axes: Option<Vec<String>>, settings: &Settings) -> PyResu
     for g in &mut grid {
         g.scene = overrides.apply(g.scene.clone(), &l.path).map_err(scene_error)?;
     }
-    Ok((axes.iter().map(|a| a.parameter.clone()).collect(), grid))
+    Ok((axes.iter().map(|a| a.parameter.to_string()).collect(), grid))
 }
 
 /// The number of cells of a sweep (see `sweep`).
@@ -575,7 +572,7 @@ fn sweep<'py>(
     })?;
     let (header, rows) = sweeps::cells_table(&parameters, &points);
     if let Some(dir) = &out {
-        let constants = [("model", Constant::Text(model.name().into())), ("version", Constant::Text(TOOL_VERSION.into()))];
+        let constants = provenance(model, None);
         write_part(dir, &format!("part-{start:09}-{stop:09}.parquet"), &header, &rows, sweeps::INTEGER_COLUMNS, &constants)?;
     }
     columns(py, &header, &rows, sweeps::INTEGER_COLUMNS)
@@ -645,7 +642,7 @@ fn _lpc_damper(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add("ModelError", py.get_type::<ModelError>())?;
     m.add("__version__", TOOL_VERSION)?;
     m.add("MODELS", Model::ALL.iter().map(|m| m.name()).collect::<Vec<_>>())?;
-    m.add("METRICS", lpc_damper::output::SUMMARY_METRICS.to_vec())?;
+    m.add("METRICS", Metric::ALL.iter().map(|m| m.name()).collect::<Vec<_>>())?;
     m.add_class::<Scene>()?;
     m.add_class::<Run>()?;
     m.add_function(wrap_pyfunction!(load_scene, m)?)?;

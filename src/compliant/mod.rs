@@ -218,33 +218,8 @@ impl<'a> System<'a> {
         let radius: Vec<f64> = scene.balls.iter().map(|b| b.radius).collect();
         let frame_mass = scene.frame.map_or(f64::INFINITY, |f| f.mass);
         let e_star = contact::effective_modulus(&scene.compliant);
-        // The speed scale: the frame's initial swing, the balls' initial speeds, the forcing.
-        let (w0, forcing_speed) = match scene.frame {
-            Some(f) => {
-                let w0 = (f.stiffness / f.mass).sqrt();
-                let fs = scene.forcing.map_or(0.0, |g| {
-                    let (p, q) = g.harmonic_load(f.damping, f.stiffness);
-                    p.hypot(q) / (f.mass * g.omega()) + match g.kind {
-                        crate::scene::ForcingKind::Base => g.amplitude * g.omega(),
-                        crate::scene::ForcingKind::Force => 0.0,
-                    }
-                });
-                (w0, fs)
-            }
-            None => (0.0, 0.0),
-        };
-        let extent = scene.container.map_or_else(
-            || match (scene.initial_positions.first(), scene.initial_positions.last()) {
-                (Some(a), Some(b)) => b - a,
-                _ => 0.0,
-            },
-            |c| c.length,
-        );
-        let v_scale = (w0 * scene.initial_displacement.abs())
-            .max(scene.initial_velocities.iter().fold(0.0, |m: f64, v| m.max(v.abs())))
-            .max(forcing_speed)
-            .max(extent.max(radius.iter().fold(0.0, |m: f64, r| m.max(*r))) / scene.horizon)
-            .max(1e-12);
+        let w0 = scene.frame.map_or(0.0, |f| (f.stiffness / f.mass).sqrt());
+        let v_scale = scene.speed_scale();
         let mut pairs = Vec::new();
         let walls = scene.container.map(|c| c.length);
         let range = if walls.is_some() { 0..n + 1 } else { 1..n.max(1) };
@@ -276,7 +251,7 @@ impl<'a> System<'a> {
             .iter()
             .map(|p| p.length)
             .reduce(f64::min)
-            .unwrap_or_else(|| scene.initial_displacement.abs().max(extent).max(1e-9) * 1e-3);
+            .unwrap_or_else(|| scene.length_scale() * 1e-3);
         let h_floor = pairs.iter().map(|p| 0.1 * p.length / v_scale).reduce(f64::min).unwrap_or(scene.horizon);
         let mut h_max = scene.horizon;
         if w0 > 0.0 {
@@ -402,15 +377,7 @@ impl<'a> System<'a> {
     }
 
     fn bodies(&self, pair: &Pair) -> (Body, Body) {
-        let a = match pair.left {
-            Side::Ball(i) => Body::Ball(i),
-            Side::Wall(_) => Body::LeftWall,
-        };
-        let b = match pair.right {
-            Side::Ball(j) => Body::Ball(j),
-            Side::Wall(_) => Body::RightWall,
-        };
-        (a, b)
+        crate::scene::pair_bodies(pair.p, self.n)
     }
 }
 

@@ -428,7 +428,7 @@ pub fn overlay(runs: &[(String, Series)], scene: &str) -> Figure {
     }
 }
 
-/// Reads a `series.csv` written by [`super::files::series_csv`].
+/// Reads a `series.csv` written by [`super::series_csv`].
 pub fn read_series_csv(path: &Path) -> Result<Series, FigureError> {
     let fail = |reason: String| FigureError { path: path.display().to_string(), reason };
     let mut r = csv::Reader::from_path(path).map_err(|e| fail(e.to_string()))?;

@@ -24,6 +24,15 @@ pub enum Constant {
 /// The tool's version, as every table records it.
 pub const TOOL_VERSION: &str = env!("CARGO_PKG_VERSION");
 
+/// The constants every table records where it came from: the seed of its draws (for an
+/// ensemble's), the model and the tool's version.
+pub fn provenance(model: crate::run::Model, seed: Option<u64>) -> Vec<(&'static str, Constant)> {
+    let mut constants: Vec<(&'static str, Constant)> = seed.map(|s| ("seed", Constant::Unsigned(s))).into_iter().collect();
+    constants.push(("model", Constant::Text(model.name().into())));
+    constants.push(("version", Constant::Text(TOOL_VERSION.into())));
+    constants
+}
+
 /// A Parquet file (zstd) of `rows` under `header`, then one column per constant.
 pub fn table_parquet(
     header: &[String],

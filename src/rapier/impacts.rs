@@ -27,7 +27,7 @@ use bevy_rapier3d::rapier::dynamics::RigidBodyHandle;
 use super::resources::{held_balls, Bodies, DamperScene, FrameState, Recording, StepClock, StepPlan};
 use crate::impact_law::impact_law;
 use crate::run::Impact;
-use crate::scene::{Body, Scene};
+use crate::scene::{pair_bodies, pair_gap, Scene};
 
 /// Pairs closer than this are touching, m (the same tolerance the step planner aims at).
 pub const TOUCHING: f64 = super::stepping::TOUCHING as f64;
@@ -67,7 +67,7 @@ impl Instant<'_> {
 
     /// Gap across `pair`, m (`None` for a wall pair without walls).
     fn gap(&self, scene: &Scene, pair: usize) -> Option<f64> {
-        pair_gap(scene, self.x, self.frame.as_ref().map(|(xs, _, _, length)| (*xs, *length)), pair)
+        pair_gap(&scene.balls, self.x, self.frame.as_ref().map(|(xs, _, _, length)| (*xs, *length)), pair)
     }
 
     /// Mass and velocity of body `body` (-1 and n are the frame).
@@ -170,33 +170,6 @@ pub fn book(ledger: Ledger<'_>, n: usize, hit: &PairImpact, t: f64, step: u64) {
         peak_force: None,
         contact_duration: None,
     });
-}
-
-/// Gap across `pair` for balls at `x` and walls at `(xs, container length)`, m (`None` for a
-/// wall pair without walls).
-pub fn pair_gap(scene: &Scene, x: &[f64], walls: Option<(f64, f64)>, pair: usize) -> Option<f64> {
-    let n = x.len();
-    let r = |i: usize| scene.balls[i].radius;
-    match (pair, walls) {
-        (0, Some((xs, _))) if n > 0 => Some(x[0] - r(0) - xs),
-        (p, Some((xs, length))) if p == n && n > 0 => Some(xs + length - x[n - 1] - r(n - 1)),
-        (p, _) if p > 0 && p < n => Some(x[p] - r(p) - x[p - 1] - r(p - 1)),
-        _ => None,
-    }
-}
-
-/// The body on the left (`a`) and right (`b`) of `pair` in a chain of `n` balls.
-pub fn pair_bodies(pair: usize, n: usize) -> (Body, Body) {
-    let body = |i: isize| {
-        if i < 0 {
-            Body::LeftWall
-        } else if i as usize >= n {
-            Body::RightWall
-        } else {
-            Body::Ball(i as usize)
-        }
-    };
-    (body(pair as isize - 1), body(pair as isize))
 }
 
 /// Persistent contacts approach slower than this many times what the frame's acceleration

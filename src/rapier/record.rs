@@ -7,9 +7,9 @@ use bevy_rapier3d::prelude::*;
 use bevy_rapier3d::rapier::dynamics::RigidBodyHandle;
 
 use super::resources::{Bodies, DamperScene, FrameState, Recording, StepClock, StepPlan, StepSettings};
-use super::impacts::{pair_bodies, pair_gap, resolve_touching, Instant, PairImpact, TOUCHING};
+use super::impacts::{resolve_touching, Instant, PairImpact, TOUCHING};
 use crate::run::Impact;
-use crate::scene::{Body, Scene};
+use crate::scene::{pair_bodies, pair_gap, Body, Scene};
 
 /// Impulses across the pairs from the balls' momentum changes `dp[i] = J[i] - J[i+1]`, where
 /// pairs that carried no contact have `J = 0`. A run of active pairs is integrated from its
@@ -101,7 +101,7 @@ pub fn feedback(
 
     let wall_v = (frame_end.0 - frame_start.0) / plan.h; // the kinematic velocity Rapier used
     let walls_at_start = scene.frame.and(scene.container).map(|c| (frame_start.0, c.length));
-    let closed_in_step = |p: usize| pair_gap(scene, &rec.x, walls_at_start, p).is_some_and(|g| g > TOUCHING);
+    let closed_in_step = |p: usize| pair_gap(&scene.balls, &rec.x, walls_at_start, p).is_some_and(|g| g > TOUCHING);
     let replaced = only_new_contacts(scene, rec, wall_v, j, &closed_in_step);
     if replaced {
         // Rapier only stopped pairs that closed in the step: the balls flew free until then.
@@ -308,7 +308,7 @@ fn held_runs(scene: &Scene, x: &[f64], v: &[f64], ((xs, vs), t, h): ((f64, f64),
     let stick = super::impacts::sticking_speed(scene, force / f.mass, h);
     let walls = Some((xs, c.length));
     let holds = |ball: usize, pair: usize| {
-        pair_gap(scene, x, walls, pair).is_some_and(|g| g <= TOUCHING) && (v[ball] - vs).abs() <= stick
+        pair_gap(&scene.balls, x, walls, pair).is_some_and(|g| g <= TOUCHING) && (v[ball] - vs).abs() <= stick
     };
     let mut held = [0, 0];
     if force > 0.0 {
@@ -357,7 +357,7 @@ fn book_resolved(
     // The pairs are separating now: none carries a contact into the next step.
     last_impulse.iter_mut().for_each(|j| *j = 0.0);
     for hit in resolved {
-        let gap = pair_gap(scene, x_before, walls, hit.pair).unwrap_or(0.0);
+        let gap = pair_gap(&scene.balls, x_before, walls, hit.pair).unwrap_or(0.0);
         let t = start.t + (gap / hit.approach_speed).clamp(0.0, start.h);
         super::impacts::book(super::impacts::Ledger { impacts, last_impact, struck_at }, n, hit, t, step);
     }
@@ -552,7 +552,7 @@ fn attribute_impacts(
         let lost = if split { shares[p].max(0.0) * total / gross } else { shares[p] };
         let starts = j[p] > impulse_floor && last_impulse[p] <= impulse_floor && u > 0.0;
         if starts {
-            let gap = pair_gap(scene, x_before, walls, p).unwrap_or(0.0);
+            let gap = pair_gap(&scene.balls, x_before, walls, p).unwrap_or(0.0);
             last_impact[p] = Some(impacts.len());
             impacts.push(Impact {
                 t: start.t + (gap / u).clamp(0.0, start.h),
@@ -598,7 +598,7 @@ fn self_check(
                 return Some(format!(
                     "at t = {t:.6e} s {} is {depth:.3e} m into the {} wall, past Rapier's allowed overlap ({ALLOWED_OVERLAP:.1e} m): \
                      Rapier's iterative solver did not hold it (largest neighbouring mass ratio {ratio:.0})",
-                    Scene::body_name(Body::Ball(i)),
+                    Body::Ball(i).name(),
                     if left < right { "left" } else { "right" },
                 ));
             }
@@ -616,8 +616,8 @@ fn self_check(
                 return Some(format!(
                     "the impact of {} and {} at t = {:.6e} s gained {:.3e} J ({:.1e} of the energy put in): \
                      Rapier's simultaneous contact solve added energy",
-                    Scene::body_name(imp.a),
-                    Scene::body_name(imp.b),
+                    imp.a.name(),
+                    imp.b.name(),
                     imp.t,
                     -imp.energy_lost,
                     -imp.energy_lost / scale

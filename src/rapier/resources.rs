@@ -98,10 +98,10 @@ pub struct StepClock {
     pub t: f64,
 }
 
-/// The fastest speed the scene is expected to reach: its motion speed (free swing, forced
-/// response, the balls' initial speeds), doubled for what impacts can add.
+/// The fastest speed the contact model expects: the scene's speed scale
+/// ([`Scene::speed_scale`]), doubled for what impacts can add.
 pub fn speed_scale(scene: &Scene) -> f64 {
-    2.0 * scene.motion_speed()
+    2.0 * scene.speed_scale()
 }
 
 /// The length of the step about to be taken, s.

@@ -182,8 +182,8 @@ impl Solver<'_> {
                 let what = format!(
                     "its contact invariant at t = {} s: {} / {} {} by {:.3e} m (tolerance {:.3e} m)",
                     crate::scene::human(self.t),
-                    Scene::body_name(a),
-                    Scene::body_name(b),
+                    a.name(),
+                    b.name(),
                     if apart { "are apart at their contact" } else { "overlap" },
                     g.abs(),
                     if apart { tol } else { allowed },
@@ -197,7 +197,7 @@ impl Solver<'_> {
 
     /// The bodies either side of pair `p`.
     pub(super) fn pair_bodies(&self, p: usize) -> (Body, Body) {
-        (if p == 0 { Body::LeftWall } else { Body::Ball(p - 1) }, if p == self.n { Body::RightWall } else { Body::Ball(p) })
+        crate::scene::pair_bodies(p, self.n)
     }
 
     /// The frame's position, velocity and acceleration ahead ([`Solver::accel_ahead`]) now.

@@ -235,15 +235,7 @@ impl<'a> Solver<'a> {
         let length = scene.container.map_or(0.0, |c| c.length);
         let osc = Oscillator::new(if frame_mass.is_finite() { frame_mass } else { 1.0 }, damping, stiffness);
         let xs0 = scene.initial_displacement;
-        let span_len = if walls {
-            length
-        } else {
-            match (scene.initial_positions.first(), scene.initial_positions.last()) {
-                (Some(a), Some(b)) => b - a,
-                _ => 0.0,
-            }
-        };
-        let length_scale = span_len.max(xs0.abs()).max(scene.balls.iter().map(|b| b.radius).fold(0.0, f64::max)).max(1e-9);
+        let length_scale = scene.length_scale();
         let time_scale = scene.frame.map_or(scene.horizon, |f| {
             let p = f.damped_period();
             if p > 0.0 {
@@ -253,7 +245,7 @@ impl<'a> Solver<'a> {
             }
         });
         let load = scene.harmonic_load();
-        let speed_scale = scene.motion_speed().max(length_scale / scene.horizon);
+        let speed_scale = scene.speed_scale();
         let samples = scene.sample_count();
         // Where its metrics are exact the reference tallies no samples, and takes none unless
         // the series is kept.

@@ -72,26 +72,6 @@ pub struct TolerancesFile {
     pub seed: Option<u64>,
 }
 
-impl TolerancesFile {
-    /// Each parameter with its spread as written, in [`crate::scene::SWEEP_PARAMETERS`] order.
-    pub fn spreads(&self) -> Vec<(&'static str, Option<Length>)> {
-        vec![
-            ("clearance", self.clearance),
-            ("gap", self.gap),
-            ("mass_ratio", self.mass_ratio),
-            ("restitution", self.restitution),
-            ("large_mass", self.large_mass),
-            ("density", self.density),
-            ("frame_mass", self.frame_mass),
-            ("stiffness", self.stiffness),
-            ("damping", self.damping),
-            ("initial_displacement", self.initial_displacement),
-            ("forcing_amplitude", self.forcing_amplitude),
-            ("forcing_frequency", self.forcing_frequency),
-        ]
-    }
-}
-
 /// How a tolerance spreads a parameter.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize, Serialize, Default)]
 #[serde(rename_all = "lowercase")]

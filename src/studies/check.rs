@@ -21,7 +21,7 @@ use serde::{Deserialize, Serialize};
 
 use super::StudyError;
 use crate::studies::chain::{run_chain, KerRow};
-use crate::metrics::{metrics, Metrics};
+use crate::metrics::{metrics, Headline, Metric, Metrics};
 use crate::model::{Model, RunOptions};
 use crate::scene;
 use crate::studies::sweep::sweep_scenes;
@@ -116,36 +116,43 @@ pub fn read_golden(golden_dir: &Path, g: &Golden) -> Result<Option<Golden>, Stud
     }
 }
 
-/// Tolerance of one metric for a model: `(relative, absolute)`.
-fn tolerance(model: Model, metric: &str) -> (f64, f64) {
+/// The metrics a golden keeps of a damper scene's run, in report order.
+const GOLDEN_METRICS: [Metric; 7] = [
+    Metric::PeakDisplacement,
+    Metric::PeakAcceleration,
+    Metric::RmsDisplacement,
+    Metric::SettlingTime,
+    Metric::EnergyRemaining,
+    Metric::PeakContactForce,
+    Metric::PeakTrueAcceleration,
+];
+
+/// Tolerance of one metric (`None`: a KER row) for a model: `(relative, absolute)`.
+fn tolerance(model: Model, metric: Option<Metric>) -> (f64, f64) {
     if model == Model::Reference {
-        return if metric == "impact_count" { (0.0, 0.0) } else { (1e-9, 1e-15) };
+        return if metric == Some(Metric::ImpactCount) { (0.0, 0.0) } else { (1e-9, 1e-15) };
     }
     match metric {
-        "peak_displacement" | "peak_acceleration" | "peak_contact_force" | "peak_true_acceleration" => (0.02, 0.0),
-        "rms_displacement" => (0.0, 0.5e-3),
-        "settling_time" => (0.0, 0.8),
-        "energy_remaining" => (0.0, 1.3e-3),
-        "impact_count" => (0.15, 1.0),
+        Some(Metric::PeakDisplacement | Metric::PeakAcceleration | Metric::PeakContactForce | Metric::PeakTrueAcceleration) => (0.02, 0.0),
+        Some(Metric::RmsDisplacement) => (0.0, 0.5e-3),
+        Some(Metric::SettlingTime) => (0.0, 0.8),
+        Some(Metric::EnergyRemaining) => (0.0, 1.3e-3),
+        Some(Metric::ImpactCount) => (0.15, 1.0),
         _ => (0.0, 0.01), // KER
     }
 }
 
 /// Compares `now` with `golden` metric by metric.
 pub fn compare(now: &Golden, golden: Option<&Golden>) -> Vec<Row> {
-    let values = |g: &Golden| -> Vec<(String, Option<f64>)> {
-        let mut v = vec![("impact_count".to_string(), Some(g.impact_count as f64))];
-        if let Some(m) = &g.metrics {
-            v.push(("peak_displacement".into(), Some(m.peak_displacement)));
-            v.push(("peak_acceleration".into(), Some(m.peak_acceleration)));
-            v.push(("rms_displacement".into(), Some(m.rms_displacement)));
-            v.push(("settling_time".into(), m.settling_time));
-            v.push(("energy_remaining".into(), m.energy_remaining));
-            v.push(("peak_contact_force".into(), m.peak_contact_force));
-            v.push(("peak_true_acceleration".into(), m.peak_true_acceleration));
+    let values = |g: &Golden| -> Vec<(String, Option<Metric>, Option<f64>)> {
+        let mut v = vec![(Metric::ImpactCount.name().to_string(), Some(Metric::ImpactCount), Some(g.impact_count as f64))];
+        if let Some(metrics) = g.metrics {
+            // A golden keeps no impact totals: only the metrics read here.
+            let headline = Headline { metrics, impact_count: g.impact_count, impact_loss: f64::NAN, impact_rate: f64::NAN };
+            v.extend(GOLDEN_METRICS.iter().map(|&m| (m.name().to_string(), Some(m), headline.value(m))));
         }
         for r in &g.ker {
-            v.push((format!("ker {}L-{}S", r.large, r.small), Some(r.ker)));
+            v.push((format!("ker {}L-{}S", r.large, r.small), None, Some(r.ker)));
         }
         v
     };
@@ -154,9 +161,9 @@ pub fn compare(now: &Golden, golden: Option<&Golden>) -> Vec<Row> {
     now_values
         .into_iter()
         .enumerate()
-        .map(|(i, (metric, value))| {
-            let g = golden_values.as_ref().and_then(|gv| gv.get(i).filter(|(m, _)| *m == metric).map(|(_, v)| *v));
-            let (rel, abs) = tolerance(now.model, &metric);
+        .map(|(i, (metric, kind, value))| {
+            let g = golden_values.as_ref().and_then(|gv| gv.get(i).filter(|(m, ..)| *m == metric).map(|(.., v)| *v));
+            let (rel, abs) = tolerance(now.model, kind);
             let (golden, ok, tol) = match (g, value) {
                 (None, _) => (None, false, abs),
                 (Some(None), None) => (None, true, abs),
@@ -175,5 +182,5 @@ pub fn compare(now: &Golden, golden: Option<&Golden>) -> Vec<Row> {
 pub fn write_golden(golden_dir: &Path, g: &Golden) -> Result<(), StudyError> {
     let path = golden_path(golden_dir, &g.case, g.model);
     let bytes = serde_json::to_vec_pretty(g).expect("serialises");
-    crate::output::write_atomic(&path, &bytes).map_err(|e| StudyError::Io { path: path.display().to_string(), message: e.to_string() })
+    crate::files::write_atomic(&path, &bytes).map_err(|e| StudyError::Io { path: path.display().to_string(), message: e.to_string() })
 }

@@ -12,9 +12,9 @@ use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
 use crate::model::{RunOptions, Model, ModelError};
-use crate::output::{Headline, SUMMARY_METRICS};
+use crate::metrics::{Headline, Metric};
 use crate::run::{refuse_beyond_memory, Record};
-use crate::scene::{self, Distribution, Length, Scene, SceneError, SceneFile, Tolerances};
+use crate::scene::{self, Distribution, Length, Parameter, Scene, SceneError, SceneFile, Tolerances};
 
 /// Draws one member may take before its tolerances are declared too wide for it.
 pub const MAX_DRAWS_PER_MEMBER: u32 = 100;
@@ -63,7 +63,7 @@ pub fn member_rng(seed: u64, k: usize) -> Pcg64 {
 
 /// A draw that made no valid scene: the parameter to blame and why.
 struct Failure {
-    parameter: &'static str,
+    parameter: Parameter,
     rule: String,
 }
 
@@ -103,13 +103,13 @@ pub fn draw_range(
     }
     let count = range.len();
     check_members_memory(nominal, count).map_err(|rule| invalid("--ensemble", rule))?;
-    let spreads: &[(&'static str, f64)] = tolerances.map_or(&[], |t| &t.spreads);
+    let spreads: &[(Parameter, f64)] = tolerances.map_or(&[], |t| &t.spreads);
     let normal = tolerances.is_some_and(|t| t.distribution == Distribution::Normal);
     let seed = seed.or(tolerances.map(|t| t.seed)).unwrap_or(DEFAULT_SEED);
     let n = nominal.balls.len();
     let columns = spreads
         .iter()
-        .flat_map(|&(p, _)| if p == "gap" { (1..=n).map(|i| format!("gap{i}")).collect() } else { vec![p.to_string()] })
+        .flat_map(|&(p, _)| if p == Parameter::Gap { (1..=n).map(|i| format!("gap{i}")).collect() } else { vec![p.to_string()] })
         .collect();
     let mut base = scene::with_settings_of(file, nominal);
     base.sweep = None;
@@ -119,12 +119,12 @@ pub fn draw_range(
         range.into_par_iter().map(|k| drawer.member(seed, k)).collect::<Result<_, _>>()?;
     let redraws: u64 = drawn.iter().map(|d| d.1.len() as u64).sum();
     if redraws > count as u64 {
-        let mut blame: BTreeMap<&str, (usize, &str)> = BTreeMap::new();
+        let mut blame: BTreeMap<Parameter, (usize, &str)> = BTreeMap::new();
         for f in drawn.iter().flat_map(|d| &d.1) {
             let e = blame.entry(f.parameter).or_insert((0, &f.rule));
             e.0 += 1;
         }
-        let (parameter, (times, rule)) = blame.into_iter().max_by_key(|b| b.1 .0).unwrap_or(("gap", (0, "")));
+        let (parameter, (times, rule)) = blame.into_iter().max_by_key(|b| b.1 .0).unwrap_or((Parameter::Gap, (0, "")));
         return Err(invalid(
             &format!("tolerances.{parameter}"),
             format!(
@@ -137,12 +137,12 @@ pub fn draw_range(
 }
 
 /// The table of an ensemble's members (`members.csv`, `members.parquet`, the Python
-/// binding's columns): `member`, the drawn values, then every metric ([`SUMMARY_METRICS`]),
+/// binding's columns): `member`, the drawn values, then every metric ([`Metric::ALL`]),
 /// one row per member in member order; `metrics` is `[member][metric]`.
 pub fn members_table(columns: &[String], members: &[Member], metrics: &[Vec<Option<f64>>]) -> (Vec<String>, Vec<Vec<Option<f64>>>) {
     let mut header = vec!["member".to_string()];
     header.extend(columns.iter().cloned());
-    header.extend(SUMMARY_METRICS.iter().map(|m| m.to_string()));
+    header.extend(Metric::ALL.iter().map(|m| m.name().to_string()));
     let rows = members
         .iter()
         .zip(metrics)
@@ -201,7 +201,7 @@ pub fn members_bytes(scene: &Scene, count: usize) -> f64 {
     let per_member = std::mem::size_of::<Member>() as f64
         + balls * (std::mem::size_of::<crate::scene::Ball>() as f64 + 16.0)
         + (balls + 12.0) * 8.0
-        + SUMMARY_METRICS.len() as f64 * 16.0
+        + Metric::ALL.len() as f64 * 16.0
         // The allocator's overhead on the name, the balls, positions, velocities, draws, metrics.
         + 6.0 * 32.0;
     count as f64 * per_member
@@ -217,7 +217,7 @@ struct Drawer<'a> {
     base: SceneFile,
     path: &'a str,
     nominal: &'a Scene,
-    spreads: &'a [(&'static str, f64)],
+    spreads: &'a [(Parameter, f64)],
     normal: bool,
 }
 
@@ -232,7 +232,7 @@ impl Drawer<'_> {
                 Err(f) => failures.push(f),
             }
         }
-        let last = failures.pop().unwrap_or(Failure { parameter: "gap", rule: String::new() });
+        let last = failures.pop().unwrap_or(Failure { parameter: Parameter::Gap, rule: String::new() });
         Err(SceneError::Invalid {
             file: self.path.into(),
             field: format!("tolerances.{}", last.parameter),
@@ -259,30 +259,28 @@ impl Drawer<'_> {
         let deviations: Vec<Vec<f64>> = self
             .spreads
             .iter()
-            .map(|&(p, w)| (0..if p == "gap" { n } else { 1 }).map(|_| self.deviation(rng, w)).collect())
+            .map(|&(p, w)| (0..if p == Parameter::Gap { n } else { 1 }).map(|_| self.deviation(rng, w)).collect())
             .collect();
         let mut file: Option<SceneFile> = None;
         let mut values = vec![];
         for (&(p, _), d) in self.spreads.iter().zip(&deviations) {
-            if p == "gap" {
+            if p == Parameter::Gap {
                 continue;
             }
-            let value = scene::parameter_value(&self.base, self.nominal, p).unwrap_or(f64::NAN) + d[0];
+            let value = p.value(&self.base, self.nominal).unwrap_or(f64::NAN) + d[0];
             values.push(value);
             let f = file.as_ref().unwrap_or(&self.base);
-            file = Some(
-                scene::apply_sweep_value(f, p, Length::Metres(value)).map_err(|rule| Failure { parameter: p, rule })?,
-            );
+            file = Some(p.apply(f, Length::Metres(value)).map_err(|rule| Failure { parameter: p, rule })?);
         }
         let name = format!("{}#{k}", self.nominal.name);
         // A failure the scene's rules cannot pin on a drawn parameter is blamed on the first.
-        let first = self.spreads.first().map_or("gap", |s| s.0);
+        let first = self.spreads.first().map_or(Parameter::Gap, |s| s.0);
         let mut scene = match file {
             None => self.nominal.clone(),
             Some(f) => scene::from_file(f, self.path, &name)
                 .map_err(|e| match e {
                     SceneError::Invalid { field, rule, .. } => {
-                        Failure { parameter: scene::parameter_of_field(&field).unwrap_or(first), rule: format!("{field} {rule}") }
+                        Failure { parameter: Parameter::of_field(&field).unwrap_or(first), rule: format!("{field} {rule}") }
                     }
                     other => Failure { parameter: first, rule: other.to_string() },
                 })?
@@ -293,7 +291,7 @@ impl Drawer<'_> {
         let mut drawn = vec![];
         let mut values = values.into_iter();
         for (&(p, _), d) in self.spreads.iter().zip(&deviations) {
-            if p == "gap" {
+            if p == Parameter::Gap {
                 drawn.extend(shift_gaps(&mut scene, d)?);
             } else {
                 drawn.extend(values.next());
@@ -311,11 +309,11 @@ fn shift_gaps(scene: &mut Scene, deviation: &[f64]) -> Result<Vec<f64>, Failure>
     let gaps: Vec<f64> = deviation.iter().map(|d| container.gap + d).collect();
     let clearance = container.clearance - deviation.iter().sum::<f64>();
     if let Some((i, g)) = gaps.iter().enumerate().find(|(_, g)| **g < 0.0) {
-        return Err(Failure { parameter: "gap", rule: format!("gap {} of {} m overlaps its neighbours", i + 1, scene::human(*g)) });
+        return Err(Failure { parameter: Parameter::Gap, rule: format!("gap {} of {} m overlaps its neighbours", i + 1, scene::human(*g)) });
     }
     if clearance < 0.0 {
         return Err(Failure {
-            parameter: "gap",
+            parameter: Parameter::Gap,
             rule: format!("the gaps leave a clearance of {} m: the last ball overlaps the wall", scene::human(clearance)),
         });
     }
@@ -344,7 +342,7 @@ pub fn map_members<T: Send, E: Send>(
         .collect()
 }
 
-/// What an ensemble's runs leave: every member's metrics ([`SUMMARY_METRICS`] order) and, when
+/// What an ensemble's runs leave: every member's metrics ([`Metric::ALL`] order) and, when
 /// asked for, every member's frame displacement at the common sample times.
 #[derive(Debug, Clone, Default)]
 pub struct EnsembleRuns {
@@ -522,24 +520,24 @@ impl EnsembleSummary {
     }
 }
 
-/// Each metric's distribution over `metrics` (`[member][metric]`, [`SUMMARY_METRICS`] order).
+/// Each metric's distribution over `metrics` (`[member][metric]`, [`Metric::ALL`] order).
 pub fn metric_stats(metrics: &[Vec<Option<f64>>]) -> BTreeMap<String, Stats> {
-    SUMMARY_METRICS
+    Metric::ALL
         .iter()
         .enumerate()
-        .map(|(j, name)| (name.to_string(), Stats::of(metrics.iter().map(|m| m[j]))))
+        .map(|(j, metric)| (metric.name().to_string(), Stats::of(metrics.iter().map(|m| m[j]))))
         .collect()
 }
 
 /// Each metric's `q` quantile over the members that define it (`None` when none does).
 pub fn metric_quantiles(metrics: &[Vec<Option<f64>>], q: f64) -> BTreeMap<String, Option<f64>> {
-    SUMMARY_METRICS
+    Metric::ALL
         .iter()
         .enumerate()
-        .map(|(j, name)| {
+        .map(|(j, metric)| {
             let mut v: Vec<f64> = metrics.iter().filter_map(|m| m[j]).collect();
             v.sort_by(f64::total_cmp);
-            (name.to_string(), (!v.is_empty()).then(|| quantile(&v, q)))
+            (metric.name().to_string(), (!v.is_empty()).then(|| quantile(&v, q)))
         })
         .collect()
 }
@@ -607,12 +605,12 @@ pub struct Agreement {
 }
 
 /// Each metric's [`Agreement`] of `model` with `reference` (`[member][metric]` each,
-/// [`SUMMARY_METRICS`] order).
+/// [`Metric::ALL`] order).
 pub fn agreement(model: &[Vec<Option<f64>>], reference: &[Vec<Option<f64>>]) -> BTreeMap<String, Agreement> {
-    SUMMARY_METRICS
+    Metric::ALL
         .iter()
         .enumerate()
-        .map(|(j, name)| {
+        .map(|(j, metric)| {
             let values = |runs: &[Vec<Option<f64>>]| runs.iter().filter_map(|m| m[j]).collect::<Vec<f64>>();
             let (m, r) = (values(model), values(reference));
             let (sm, sr) = (Stats::of(m.iter().map(|&x| Some(x))), Stats::of(r.iter().map(|&x| Some(x))));
@@ -625,7 +623,7 @@ pub fn agreement(model: &[Vec<Option<f64>>], reference: &[Vec<Option<f64>>]) -> 
                 ks,
                 differ_at_5_percent: ks.map(|d| d > 1.358 * ((n + k) / (n * k)).sqrt()),
             };
-            (name.to_string(), a)
+            (metric.name().to_string(), a)
         })
         .collect()
 }

@@ -13,7 +13,7 @@ use serde::{Deserialize, Serialize};
 use super::StudyError;
 use crate::studies::frf;
 use crate::model::{Model, RunOptions};
-use crate::scene::{self, Arrangement, Length, Loaded, Scene, SceneError};
+use crate::scene::{self, Arrangement, Length, Loaded, Parameter, Scene, SceneError};
 use crate::studies::ensemble;
 use crate::studies::sweep::Axis;
 
@@ -111,7 +111,7 @@ pub fn optimize(
 ) -> Result<Search, StudyError> {
     let Judging { objective, model, refinements, robust } = judging;
     let invalid = |field: &str, rule: String| SceneError::Invalid { file: loaded.path.clone(), field: field.into(), rule };
-    if axes.iter().any(|a| a.parameter == "clearance") {
+    if axes.iter().any(|a| a.parameter == Parameter::Clearance) {
         return Err(invalid("clearance", "follows from the container length here: vary gap, mass_ratio, ... instead".into()).into());
     }
     if matches!(objective, Objective::ResonantAmplitude { .. }) && loaded.file.forcing.is_none() {
@@ -212,8 +212,10 @@ fn evaluate(
         .map(|point| {
             let mut f = file.clone();
             for (axis, value) in axes.iter().zip(point) {
-                f = scene::apply_sweep_value(&f, &axis.parameter, *value)
-                    .map_err(|rule| SceneError::Invalid { file: loaded.path.clone(), field: axis.parameter.clone(), rule })?;
+                f = axis
+                    .parameter
+                    .apply(&f, *value)
+                    .map_err(|rule| SceneError::Invalid { file: loaded.path.clone(), field: axis.parameter.to_string(), rule })?;
             }
             // A design whose balls do not fit is infeasible, not an error.
             let Ok(valid) = scene::from_file(f.clone(), &loaded.path, &name) else {
@@ -255,7 +257,7 @@ fn evaluate(
             progress();
             Ok(Some(Design {
                 arrangement: arrangement.to_string(),
-                values: axes.iter().zip(point).map(|(a, v)| (a.parameter.clone(), v.raw())).collect(),
+                values: axes.iter().zip(point).map(|(a, v)| (a.parameter.to_string(), v.raw())).collect(),
                 clearance: scene.container.map_or(0.0, |c| c.clearance),
                 objective: value,
                 band: None,

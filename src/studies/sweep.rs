@@ -6,8 +6,8 @@ use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
 use crate::model::{RunOptions, Model, ModelError};
-use crate::output::RunSummary;
-use crate::scene::{self, Length, Loaded, Scene, SceneError};
+use crate::metrics::{Headline, Metric, RunSummary};
+use crate::scene::{self, Length, Loaded, Parameter, Scene, SceneError};
 
 /// Where a point of a sweep lies (the first fields of `lpc sweep`'s JSON).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -67,8 +67,8 @@ pub struct EnsemblePoint {
 /// One swept parameter and its values.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Axis {
-    /// One of [`scene::SWEEP_PARAMETERS`].
-    pub parameter: String,
+    /// The parameter.
+    pub parameter: Parameter,
     /// Values (lengths may be Rr multiples).
     pub values: Vec<Length>,
 }
@@ -80,9 +80,10 @@ pub fn file_axes(loaded: &Loaded) -> Result<Vec<Axis>, SceneError> {
         field: "sweep".into(),
         rule: "is missing: this command needs a scene file with a [sweep] table (or axes on the command line)".into(),
     })?;
-    let mut axes = vec![Axis { parameter: sweep.parameter.clone(), values: sweep.values.clone() }];
+    let parameter = |field: &str, name: &str| name.parse::<Parameter>().map_err(|rule| invalid(loaded, field, &rule));
+    let mut axes = vec![Axis { parameter: parameter("sweep.parameter", &sweep.parameter)?, values: sweep.values.clone() }];
     match (&sweep.parameter_y, &sweep.values_y) {
-        (Some(p), Some(v)) => axes.push(Axis { parameter: p.clone(), values: v.clone() }),
+        (Some(p), Some(v)) => axes.push(Axis { parameter: parameter("sweep.parameter_y", p)?, values: v.clone() }),
         (None, None) => {}
         (Some(_), None) => return Err(invalid(loaded, "sweep.values_y", "is missing: `parameter_y` needs its values")),
         (None, Some(_)) => return Err(invalid(loaded, "sweep.parameter_y", "is missing: `values_y` needs its parameter")),
@@ -109,10 +110,7 @@ pub fn tidy(x: f64) -> f64 {
 pub fn parse_axis(text: &str) -> Result<Axis, String> {
     let (parameter, values) =
         text.split_once('=').ok_or_else(|| format!("`{text}`: write `PARAM=V1,V2,...` or `PARAM=A..B:N`"))?;
-    let parameter = parameter.trim().to_string();
-    if !scene::SWEEP_PARAMETERS.contains(&parameter.as_str()) {
-        return Err(format!("`{parameter}` cannot be swept; choose one of {}", scene::SWEEP_PARAMETERS.join(", ")));
-    }
+    let parameter: Parameter = parameter.trim().parse()?;
     let value = |s: &str| -> Result<Length, String> {
         let s = s.trim();
         match s.parse::<f64>() {
@@ -169,7 +167,9 @@ pub fn grid_scenes(loaded: &Loaded, axes: &[Axis]) -> Result<Vec<GridScene>, Sce
         for (coords, file) in &points {
             for (i, value) in axis.values.iter().enumerate() {
                 let field = if a == 0 { format!("sweep.values[{i}]") } else { format!("sweep.values_y[{i}]") };
-                let varied = scene::apply_sweep_value(file, &axis.parameter, *value)
+                let varied = axis
+                    .parameter
+                    .apply(file, *value)
                     .map_err(|rule| SceneError::Invalid { file: loaded.path.clone(), field: field.clone(), rule })?;
                 let mut c = coords.clone();
                 c.push((i, *value));
@@ -236,11 +236,11 @@ pub fn run_grid(
 
 /// The table of a sweep (`sweep.parquet`, the Python binding's columns): `cell` (its index,
 /// the first axis varying fastest), each axis' value as written, then every metric
-/// ([`crate::output::SUMMARY_METRICS`]), one row per cell.
+/// ([`Metric::ALL`]), one row per cell.
 pub fn cells_table(parameters: &[String], cells: &[(usize, SweepPoint)]) -> (Vec<String>, Vec<Vec<Option<f64>>>) {
     let mut header = vec!["cell".to_string()];
     header.extend(parameters.iter().cloned());
-    header.extend(crate::output::SUMMARY_METRICS.iter().map(|m| m.to_string()));
+    header.extend(Metric::ALL.iter().map(|m| m.name().to_string()));
     let rows = cells
         .iter()
         .map(|(cell, p)| {
@@ -248,7 +248,7 @@ pub fn cells_table(parameters: &[String], cells: &[(usize, SweepPoint)]) -> (Vec
             if parameters.len() > 1 {
                 row.push(p.at.value_y);
             }
-            row.extend(crate::output::Headline::of_summary(&p.summary).values());
+            row.extend(Headline::of_summary(&p.summary).values());
             row
         })
         .collect();
@@ -258,5 +258,3 @@ pub fn cells_table(parameters: &[String], cells: &[(usize, SweepPoint)]) -> (Vec
 /// Columns of [`cells_table`] that hold integers.
 pub const INTEGER_COLUMNS: &[&str] = &["cell", "impact_count"];
 
-/// Metrics a design map can show: every metric of a run's summary.
-pub use crate::output::{metric_value, SUMMARY_METRICS as MAP_METRICS};

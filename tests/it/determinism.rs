@@ -1,6 +1,6 @@
 //! The same scene and settings give identical results across runs and thread counts, for every model.
 
-use lpc_damper::output::RunSummary;
+use lpc_damper::metrics::RunSummary;
 use lpc_damper::scene::{load, scenes_dir};
 use lpc_damper::studies::sweep::{run_sweep, sweep_scenes};
 use lpc_damper::Model;

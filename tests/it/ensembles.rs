@@ -6,7 +6,7 @@
 use lpc_damper::model::RunOptions;
 use std::f64::consts::PI;
 
-use lpc_damper::output::Headline;
+use lpc_damper::metrics::Headline;
 use lpc_damper::scene::{self, Loaded};
 use lpc_damper::studies::ensemble::{self, quantile};
 use lpc_damper::Model;
@@ -208,7 +208,7 @@ fn run_ensemble_json_has_every_metric_distribution() {
     let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
     assert_eq!(v["members"], 16);
     assert_eq!(v["redraws"], 0);
-    for name in lpc_damper::output::SUMMARY_METRICS {
+    for name in lpc_damper::metrics::Metric::ALL.iter().map(|m| m.name()) {
         let s = &v["metrics"][name];
         assert!(s.is_object(), "{name} missing");
         if let (Some(lo), Some(med), Some(hi)) = (s["p05"].as_f64(), s["median"].as_f64(), s["p95"].as_f64()) {

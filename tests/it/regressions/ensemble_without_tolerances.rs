@@ -2,7 +2,7 @@
 //! the first toleranced parameter, of which there was none). Every member is the nominal scene.
 
 use lpc_damper::model::RunOptions;
-use lpc_damper::output::Headline;
+use lpc_damper::metrics::Headline;
 use lpc_damper::studies::ensemble;
 use lpc_damper::Model;
 

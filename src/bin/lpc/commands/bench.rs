@@ -2,7 +2,7 @@
 
 use std::path::PathBuf;
 
-use lpc_damper::output::write_atomic;
+use lpc_damper::files::write_atomic;
 use lpc_damper::scene::Overrides;
 use lpc_damper::Model;
 

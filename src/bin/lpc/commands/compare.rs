@@ -7,10 +7,11 @@ use anyhow::Context;
 
 use lpc_damper::model::RunOptions;
 use lpc_damper::studies::compare::{errors, Errors};
-use lpc_damper::output::{write_run_dir, RunSummary};
+use lpc_damper::metrics::RunSummary;
+use lpc_damper::output::write_run_dir;
 use lpc_damper::Model;
 
-use lpc_damper::output::SUMMARY_METRICS;
+use lpc_damper::metrics::Metric;
 use lpc_damper::studies::ensemble::{self, Agreement, Ensemble, Stats};
 
 use crate::args::{load_nominal, print_json, progress_bar, EnsembleArgs, Format, ModelArgs};
@@ -191,11 +192,12 @@ fn compare_ensembles(a: &Args, scene: &str, members: &Ensemble) -> Result<ExitSt
                 right("differ 5 %", 10),
             ]);
             table.print_header();
-            for name in SUMMARY_METRICS {
+            for metric in Metric::ALL {
+                let name = metric.name();
                 let mut rows = vec![("reference", &comparison.reference)];
                 rows.extend(comparison.models.iter().map(|(n, d)| (n.as_str(), d)));
                 for (model, d) in rows {
-                    let (s, g) = (&d.metrics[*name], &d.agreement[*name]);
+                    let (s, g) = (&d.metrics[name], &d.agreement[name]);
                     if s.median.is_none() {
                         continue;
                     }

@@ -5,7 +5,7 @@ use std::path::PathBuf;
 use anyhow::Context;
 use clap::ValueEnum;
 
-use lpc_damper::output::write_atomic;
+use lpc_damper::files::write_atomic;
 use lpc_damper::scene::{self, Overrides};
 use lpc_damper::Model;
 

@@ -6,10 +6,10 @@ use std::path::{Path, PathBuf};
 
 use anyhow::Context;
 
-use lpc_damper::output::write_atomic;
+use lpc_damper::files::write_atomic;
 use lpc_damper::scene::SceneError;
 use lpc_damper::studies::ensemble::{self, EnsembleSummary, ShardInfo};
-use lpc_damper::output::SUMMARY_METRICS;
+use lpc_damper::metrics::Metric;
 
 use crate::args::Format;
 use crate::commands::run::{print_ensemble, write_table};
@@ -59,9 +59,10 @@ fn read_shard(dir: &Path) -> std::result::Result<Shard, SceneError> {
         .map(String::from)
         .collect();
     // The table ends with the summary's metrics, in order: the merged summary reads them there.
-    let tail = header.len().checked_sub(SUMMARY_METRICS.len()).map(|k| &header[k..]);
-    if tail.is_none_or(|t| t.iter().zip(SUMMARY_METRICS).any(|(h, m)| h.as_str() != *m)) {
-        return Err(bad(dir, "members.csv", format!("does not end with the metrics columns {}", SUMMARY_METRICS.join(", "))));
+    let tail = header.len().checked_sub(Metric::ALL.len()).map(|k| &header[k..]);
+    if tail.is_none_or(|t| t.iter().zip(Metric::ALL).any(|(h, m)| h.as_str() != m.name())) {
+        let names: Vec<&str> = Metric::ALL.iter().map(|m| m.name()).collect();
+        return Err(bad(dir, "members.csv", format!("does not end with the metrics columns {}", names.join(", "))));
     }
     let mut rows = vec![];
     for (r, record) in reader.records().enumerate() {
@@ -109,7 +110,7 @@ pub fn run(a: Args) -> Result<ExitStatus> {
     }
     let header = first.header.clone();
     let rows: Vec<Vec<Option<f64>>> = shards.iter().flat_map(|s| s.rows.iter().cloned()).collect();
-    let metrics: Vec<Vec<Option<f64>>> = rows.iter().map(|r| r[r.len() - SUMMARY_METRICS.len()..].to_vec()).collect();
+    let metrics: Vec<Vec<Option<f64>>> = rows.iter().map(|r| r[r.len() - Metric::ALL.len()..].to_vec()).collect();
     let info = &first.info;
     let summary = EnsembleSummary {
         scene: info.scene.clone(),

@@ -6,8 +6,10 @@ use std::path::{Path, PathBuf};
 
 use anyhow::Context;
 
-use lpc_damper::output::{table_csv, text_summary, write_atomic, write_run_dir, RunSummary, SUMMARY_METRICS};
-use lpc_damper::output::parquet::{table_parquet, Constant, TOOL_VERSION};
+use lpc_damper::files::write_atomic;
+use lpc_damper::metrics::{Metric, RunSummary};
+use lpc_damper::output::parquet::{provenance, table_parquet};
+use lpc_damper::output::{table_csv, text_summary, write_run_dir};
 use lpc_damper::studies::ensemble::{self, Ensemble, EnsembleSummary, ShardInfo};
 use lpc_damper::Model;
 
@@ -218,11 +220,7 @@ pub fn write_members(dir: &Path, model: Model, seed: u64, columns: &[String], me
 /// `NAME.csv` and `NAME.parquet` of a members table.
 pub fn write_table(dir: &Path, name: &str, header: &[String], rows: &[Vec<Option<f64>>], model: Model, seed: u64) -> anyhow::Result<()> {
     write_atomic(&dir.join(format!("{name}.csv")), &table_csv(header, rows.iter().cloned()))?;
-    let constants = [
-        ("seed", Constant::Unsigned(seed)),
-        ("model", Constant::Text(model.name().into())),
-        ("version", Constant::Text(TOOL_VERSION.into())),
-    ];
+    let constants = provenance(model, Some(seed));
     write_atomic(&dir.join(format!("{name}.parquet")), &table_parquet(header, rows, ensemble::INTEGER_COLUMNS, &constants)?)?;
     Ok(())
 }
@@ -253,8 +251,9 @@ pub fn print_ensemble(summary: &EnsembleSummary, format: Format, wrote: Option<(
                 right("undefined", 10),
             ]);
             table.print_header();
-            for name in SUMMARY_METRICS {
-                let s = &summary.metrics[*name];
+            for metric in Metric::ALL {
+                let name = metric.name();
+                let s = &summary.metrics[name];
                 table.print_row(&[
                     name.to_string(),
                     statistic(s.median),

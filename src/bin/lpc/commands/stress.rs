@@ -2,7 +2,7 @@
 
 use std::path::PathBuf;
 
-use lpc_damper::output::write_atomic;
+use lpc_damper::files::write_atomic;
 use lpc_damper::Model;
 
 use crate::args::{print_json, progress_bar, Format};

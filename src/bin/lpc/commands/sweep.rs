@@ -4,8 +4,9 @@ use std::path::PathBuf;
 
 use anyhow::Context;
 
-use lpc_damper::output::parquet::{table_parquet, Constant, TOOL_VERSION};
-use lpc_damper::output::{write_atomic, SUMMARY_METRICS};
+use lpc_damper::files::write_atomic;
+use lpc_damper::metrics::{Headline, Metric};
+use lpc_damper::output::parquet::{provenance, table_parquet, Constant};
 use lpc_damper::scene;
 use lpc_damper::Model;
 
@@ -40,10 +41,10 @@ pub struct Args {
     /// Second axis (makes a grid): same syntax as --x.
     #[arg(long)]
     y: Option<String>,
-    /// Metric of the design map (one of settling_time, energy_remaining, peak_contact_force,
-    /// peak_displacement, peak_acceleration, rms_displacement, impact_count).
+    /// Metric of the design map: any metric of a run's summary (settling_time,
+    /// energy_remaining, dissipation_time_99, peak_displacement, impact_count, ...).
     #[arg(long, default_value = "settling_time")]
-    metric: String,
+    metric: Metric,
     #[command(flatten)]
     settings: ModelArgs,
     #[command(flatten)]
@@ -57,9 +58,6 @@ pub struct Args {
 pub fn run(a: Args) -> Result<ExitStatus> {
     let loaded = scene::load(&a.scene)?;
     let invalid = |field: &str, rule: String| invalid(&a.scene, field, rule);
-    if !lpc_damper::studies::sweep::MAP_METRICS.contains(&a.metric.as_str()) {
-        return Err(invalid("--metric", format!("`{}` is not one of {}", a.metric, lpc_damper::studies::sweep::MAP_METRICS.join(", "))).into());
-    }
     let mut axes = match &a.x {
         Some(x) => vec![lpc_damper::studies::sweep::parse_axis(x).map_err(|rule| invalid("--x", rule))?],
         None if a.y.is_some() => return Err(invalid("--y", "needs --x".into()).into()),
@@ -76,7 +74,7 @@ pub fn run(a: Args) -> Result<ExitStatus> {
     for g in &mut grid {
         override_scene(&mut g.scene, a.settings.overrides(a.horizon, None), &a.scene)?;
     }
-    let parameters: Vec<String> = axes.iter().map(|x| x.parameter.clone()).collect();
+    let parameters: Vec<String> = axes.iter().map(|x| x.parameter.to_string()).collect();
     if a.ensemble.ensemble.is_some() {
         let q = quantile_arg(a.quantile, &a.scene)?;
         let nominal = Nominal::of(&loaded, a.settings.overrides(a.horizon, None))?;
@@ -89,12 +87,12 @@ pub fn run(a: Args) -> Result<ExitStatus> {
     bar.finish_and_clear();
     let elapsed = start.elapsed().as_secs_f64();
     if let Some(dir) = &a.out {
-        let cells: Vec<Option<f64>> = points.iter().map(|p| lpc_damper::studies::sweep::metric_value(&p.summary, &a.metric)).collect();
+        let cells: Vec<Option<f64>> = points.iter().map(|p| Headline::of_summary(&p.summary).value(a.metric)).collect();
         let title = format!("{}: {} ({})", loaded.scene.as_ref().map_or("", |s| s.name.as_str()), a.metric, a.model.name());
         let numbered: Vec<(usize, SweepPoint)> = points.iter().cloned().enumerate().collect();
         let (header, rows) = lpc_damper::studies::sweep::cells_table(&parameters, &numbered);
-        let table = SweepTable { header, rows, constants: vec![("model", Constant::Text(a.model.name().into())), ("version", Constant::Text(TOOL_VERSION.into()))] };
-        write_sweep(dir, &points, &axes, &cells, title, a.metric.clone(), &table)?;
+        let table = SweepTable { header, rows, constants: provenance(a.model, None) };
+        write_sweep(dir, &points, &axes, &cells, title, a.metric.to_string(), &table)?;
     }
     match a.format {
         Format::Json => print_json(&points)?,
@@ -145,7 +143,7 @@ fn axis_title(axis: &lpc_damper::studies::sweep::Axis) -> String {
     if rr {
         format!("{} (Rr)", axis.parameter)
     } else {
-        axis.parameter.clone()
+        axis.parameter.to_string()
     }
 }
 
@@ -208,12 +206,12 @@ fn sweep_ensembles(a: &Args, nominal: &Nominal, axes: &[Axis], parameters: &[Str
     bar.finish_and_clear();
     let elapsed = start.elapsed().as_secs_f64();
     if let Some(dir) = &a.out {
-        let cells: Vec<Option<f64>> = points.iter().map(|p| p.at_quantile[&a.metric]).collect();
+        let cells: Vec<Option<f64>> = points.iter().map(|p| p.at_quantile[a.metric.name()]).collect();
         let title = format!("{}: {} at quantile {q} of {per_point} members ({})", nominal.scene.name, a.metric, a.model.name());
         // One row per cell: each metric at the quantile the map shows.
         let mut header = vec!["cell".to_string()];
         header.extend(parameters.iter().cloned());
-        header.extend(SUMMARY_METRICS.iter().map(|m| m.to_string()));
+        header.extend(Metric::ALL.iter().map(|m| m.name().to_string()));
         let rows = points
             .iter()
             .enumerate()
@@ -222,16 +220,12 @@ fn sweep_ensembles(a: &Args, nominal: &Nominal, axes: &[Axis], parameters: &[Str
                 if parameters.len() > 1 {
                     row.push(p.at.value_y);
                 }
-                row.extend(SUMMARY_METRICS.iter().map(|m| p.at_quantile[*m]));
+                row.extend(Metric::ALL.iter().map(|m| p.at_quantile[m.name()]));
                 row
             })
             .collect();
-        let constants = vec![
-            ("members", Constant::Unsigned(per_point as u64)),
-            ("quantile", Constant::Text(q.to_string())),
-            ("model", Constant::Text(a.model.name().into())),
-            ("version", Constant::Text(TOOL_VERSION.into())),
-        ];
+        let mut constants = vec![("members", Constant::Unsigned(per_point as u64)), ("quantile", Constant::Text(q.to_string()))];
+        constants.extend(provenance(a.model, None));
         let table = SweepTable { header, rows, constants };
         write_sweep(dir, &points, axes, &cells, title, format!("{} (q {q})", a.metric), &table)?;
     }
@@ -251,10 +245,10 @@ fn sweep_ensembles(a: &Args, nominal: &Nominal, axes: &[Axis], parameters: &[Str
             let table = Table::new(columns);
             table.print_header();
             for p in &points {
-                let s = &p.metrics[&a.metric];
+                let s = &p.metrics[a.metric.name()];
                 let mut cells = vec![p.at.value.to_string()];
                 cells.extend(p.at.value_y.map(|v| v.to_string()));
-                cells.extend([statistic(s.median), statistic(s.p05), statistic(s.p95), statistic(p.at_quantile[&a.metric]), s.undefined.to_string()]);
+                cells.extend([statistic(s.median), statistic(s.p05), statistic(s.p95), statistic(p.at_quantile[a.metric.name()]), s.undefined.to_string()]);
                 table.print_row(&cells);
             }
         }

@@ -3,7 +3,90 @@
 //! motion are tallied sample by sample as a model runs ([`SampleTally`]), so a run that keeps no
 //! series (an ensemble member) has exactly the metrics of one that does.
 
+mod summary;
+
+pub use summary::{EnergySummary, Headline, ImpactSummary, RunSummary};
+
 use crate::run::Run;
+
+/// Declares the metrics of a run's summary, each with the name it has in outputs, on the command
+/// line and in Python, in report order.
+macro_rules! metrics {
+    ($($(#[$doc:meta])* $variant:ident = $name:literal,)*) => {
+        /// A number of a run's summary that studies tabulate, map, rank and draw distributions of.
+        #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
+        pub enum Metric {
+            $($(#[$doc])* $variant,)*
+        }
+
+        impl Metric {
+            /// Every metric, in report order.
+            pub const ALL: &'static [Metric] = &[$(Metric::$variant),*];
+
+            /// Its name in outputs (`settling_time`).
+            pub fn name(self) -> &'static str {
+                match self {
+                    $(Metric::$variant => $name,)*
+                }
+            }
+        }
+    };
+}
+
+metrics! {
+    /// max `|xs|` for `t >= T`, m.
+    PeakDisplacement = "peak_displacement",
+    /// max `|a|` for `t >= T`, m/s^2.
+    PeakAcceleration = "peak_acceleration",
+    /// RMS of `xs` over the horizon, m.
+    RmsDisplacement = "rms_displacement",
+    /// Last time `|xs| >= 5 % |xs0|`, s.
+    SettlingTime = "settling_time",
+    /// Mechanical energy at the horizon over the initial.
+    EnergyRemaining = "energy_remaining",
+    /// First time the energy has fallen to 10 %, s.
+    DissipationTime90 = "dissipation_time_90",
+    /// First time the energy has fallen to 1 %, s.
+    DissipationTime99 = "dissipation_time_99",
+    /// Largest contact force, N (compliant contact).
+    PeakContactForce = "peak_contact_force",
+    /// max `|a|` for `t >= T` with contact forces, m/s^2 (compliant contact).
+    PeakTrueAcceleration = "peak_true_acceleration",
+    /// Impacts.
+    ImpactCount = "impact_count",
+    /// Energy lost in impacts, J.
+    ImpactLoss = "impact_loss",
+    /// Impacts per simulated second.
+    ImpactRate = "impact_rate",
+}
+
+impl std::fmt::Display for Metric {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
+impl std::str::FromStr for Metric {
+    type Err = String;
+    fn from_str(s: &str) -> Result<Self, String> {
+        Metric::ALL.iter().copied().find(|m| m.name() == s).ok_or_else(|| {
+            format!("`{s}` is not one of {}", Metric::ALL.iter().map(|m| m.name()).collect::<Vec<_>>().join(", "))
+        })
+    }
+}
+
+impl serde::Serialize for Metric {
+    fn serialize<S: serde::Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
+        s.serialize_str(self.name())
+    }
+}
+
+impl<'de> serde::Deserialize<'de> for Metric {
+    fn deserialize<D: serde::Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        let name = String::deserialize(d)?;
+        name.parse().map_err(serde::de::Error::custom)
+    }
+}
 
 /// The headline metrics of one run.
 #[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]

@@ -1,36 +1,12 @@
-//! Files of `--out DIR`. Every file is written to a temporary name in the same directory and
-//! renamed into place, so an interrupted run never leaves a half file that looks complete.
+//! The files of a run's `--out DIR` (`series.csv`, `impacts.csv`, `summary.json`) and CSV
+//! tables, each written whole or not at all ([`crate::files`]).
 
 use std::io::Write;
 use std::path::Path;
 
-use super::RunSummary;
+use crate::files::{write_atomic, write_atomic_with};
+use crate::metrics::RunSummary;
 use crate::run::Run;
-use crate::scene::Scene;
-
-/// Writes `bytes` to `path` atomically (temporary file + rename).
-pub fn write_atomic(path: &Path, bytes: &[u8]) -> std::io::Result<()> {
-    write_atomic_with(path, |w| w.write_all(bytes))
-}
-
-/// Writes to `path` atomically what `write` puts into the (buffered) writer it is given, so a
-/// large file is streamed to disk instead of built in memory first.
-pub fn write_atomic_with(path: &Path, write: impl FnOnce(&mut dyn Write) -> std::io::Result<()>) -> std::io::Result<()> {
-    let dir = path.parent().filter(|p| !p.as_os_str().is_empty()).unwrap_or(Path::new("."));
-    std::fs::create_dir_all(dir)?;
-    let name = path.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default();
-    let tmp = dir.join(format!(".{name}.tmp-{}", std::process::id()));
-    let written = (|| {
-        let mut f = std::io::BufWriter::new(std::fs::File::create(&tmp)?);
-        write(&mut f)?;
-        f.into_inner().map_err(|e| e.into_error())?.sync_all()
-    })();
-    if let Err(e) = written {
-        let _ = std::fs::remove_file(&tmp);
-        return Err(e);
-    }
-    std::fs::rename(&tmp, path)
-}
 
 /// `series.csv`: `t, xs, vs, a`, then `x` and `v` of each ball.
 pub fn series_csv(run: &Run) -> Vec<u8> {
@@ -72,8 +48,8 @@ pub fn impacts_csv(run: &Run) -> Vec<u8> {
     for i in &run.impacts {
         w.write_record([
             i.t.to_string(),
-            Scene::body_name(i.a),
-            Scene::body_name(i.b),
+            i.a.name(),
+            i.b.name(),
             i.approach_speed.to_string(),
             i.energy_lost.to_string(),
             optional(i.peak_force),

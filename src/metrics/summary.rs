@@ -1,0 +1,161 @@
+//! A run as the tool reports it: the JSON contract of `summary.json` and `lpc run --format
+//! json` ([`RunSummary`]), and the numbers studies tabulate ([`Headline`]).
+
+use serde::{Deserialize, Serialize};
+
+use super::{metrics, noise, Metric, Metrics, Noise};
+use crate::run::Run;
+
+/// One impact as in the JSON contract.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct ImpactSummary {
+    /// s.
+    pub t: f64,
+    /// `[A, B]`, e.g. `["left-wall", "ball1"]`.
+    pub bodies: [String; 2],
+    /// m/s.
+    pub approach_speed: f64,
+    /// J.
+    pub energy_lost: f64,
+    /// Largest contact force, N (compliant model only).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub peak_force: Option<f64>,
+    /// Contact duration, s (compliant model only).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub contact_duration: Option<f64>,
+}
+
+/// The energy account as in the JSON contract.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct EnergySummary {
+    /// J.
+    pub initial: f64,
+    /// J.
+    #[serde(rename = "final")]
+    pub final_: f64,
+    /// J.
+    pub damping_loss: f64,
+    /// J.
+    pub impact_loss: f64,
+    /// Work done by the excitation, J (0 in free vibration).
+    #[serde(default)]
+    pub forcing_work: f64,
+    /// Relative.
+    pub balance_error: f64,
+}
+
+/// A run as in the JSON contract (`summary.json`, `lpc run --format json`).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct RunSummary {
+    /// Scene name.
+    pub scene: String,
+    /// Model name.
+    pub model: crate::run::Model,
+    /// s.
+    pub horizon: f64,
+    /// Number of impacts.
+    pub impact_count: usize,
+    /// Every impact.
+    pub impacts: Vec<ImpactSummary>,
+    /// Headline metrics.
+    pub metrics: Metrics,
+    /// Energy account.
+    pub energy: EnergySummary,
+    /// Noise proxy: impact rate, energy lost, approach speed and peak force per impact.
+    #[serde(default)]
+    pub noise: Noise,
+    /// Computing time, s.
+    pub wall_time_s: f64,
+    /// Present when the series keeps only every `k`-th sample, to fit in memory
+    /// ([`crate::run::series_every`]); the metrics use every sample.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub series_every: Option<usize>,
+}
+
+impl RunSummary {
+    /// The summary of `run`.
+    pub fn of(run: &Run) -> Self {
+        RunSummary {
+            scene: run.scene.clone(),
+            model: run.model,
+            horizon: run.horizon,
+            impact_count: run.impacts.len(),
+            impacts: run
+                .impacts
+                .iter()
+                .map(|i| ImpactSummary {
+                    t: i.t,
+                    bodies: [i.a.name(), i.b.name()],
+                    approach_speed: i.approach_speed,
+                    energy_lost: i.energy_lost,
+                    peak_force: i.peak_force,
+                    contact_duration: i.contact_duration,
+                })
+                .collect(),
+            metrics: metrics(run),
+            energy: EnergySummary {
+                initial: run.energy.initial,
+                final_: run.energy.final_,
+                damping_loss: run.energy.damping_loss,
+                impact_loss: run.energy.impact_loss,
+                forcing_work: run.energy.forcing_work,
+                balance_error: run.energy.balance_error,
+            },
+            noise: noise(run),
+            wall_time_s: run.wall_time_s,
+            series_every: (run.series.every > 1).then_some(run.series.every),
+        }
+    }
+}
+
+/// The numbers of a run that studies tabulate, map and draw distributions of: its metrics and
+/// its impact totals ([`Metric::ALL`]).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Headline {
+    /// The metrics.
+    pub metrics: Metrics,
+    /// Number of impacts.
+    pub impact_count: usize,
+    /// Energy lost in impacts, J.
+    pub impact_loss: f64,
+    /// Impacts per simulated second.
+    pub impact_rate: f64,
+}
+
+impl Headline {
+    /// The headline of `run`, without building its summary (an ensemble member's).
+    pub fn of_run(run: &Run) -> Self {
+        Headline {
+            metrics: metrics(run),
+            impact_count: run.impacts.len(),
+            impact_loss: run.energy.impact_loss,
+            impact_rate: crate::metrics::impact_rate(run),
+        }
+    }
+    /// The headline of a run's summary.
+    pub fn of_summary(s: &RunSummary) -> Self {
+        Headline { metrics: s.metrics, impact_count: s.impact_count, impact_loss: s.energy.impact_loss, impact_rate: s.noise.impact_rate }
+    }
+    /// The value of `metric`; `None` when the run has none (not settled, no contact forces).
+    pub fn value(&self, metric: Metric) -> Option<f64> {
+        let m = &self.metrics;
+        match metric {
+            Metric::PeakDisplacement => Some(m.peak_displacement),
+            Metric::PeakAcceleration => Some(m.peak_acceleration),
+            Metric::RmsDisplacement => Some(m.rms_displacement),
+            Metric::SettlingTime => m.settling_time,
+            Metric::EnergyRemaining => m.energy_remaining,
+            Metric::DissipationTime90 => m.dissipation_time_90,
+            Metric::DissipationTime99 => m.dissipation_time_99,
+            Metric::PeakContactForce => m.peak_contact_force,
+            Metric::PeakTrueAcceleration => m.peak_true_acceleration,
+            Metric::ImpactCount => Some(self.impact_count as f64),
+            Metric::ImpactLoss => Some(self.impact_loss),
+            Metric::ImpactRate => Some(self.impact_rate),
+        }
+    }
+    /// Every metric, in [`Metric::ALL`] order.
+    pub fn values(&self) -> Vec<Option<f64>> {
+        Metric::ALL.iter().map(|&m| self.value(m)).collect()
+    }
+}

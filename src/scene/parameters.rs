@@ -1,0 +1,172 @@
+//! The parameters a study may vary (a sweep's axes, an ensemble's tolerances, an optimisation's
+//! design space): each names itself once, says whether it is a length, sets itself in a scene
+//! file, and reads its value from a scene built from that file.
+
+use super::format::{Distribution, Length, SceneFile};
+use super::Scene;
+
+/// Declares the parameters, each with its name (in files, on the command line and in outputs),
+/// the scene file's field that holds it, and whether it is a length (a value or a spread may
+/// then be written `"<k> Rr"`).
+macro_rules! parameters {
+    ($($(#[$doc:meta])* $variant:ident = $name:literal, $field:literal, $length:literal;)*) => {
+        /// A parameter of a damper scene that a study may vary.
+        #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
+        pub enum Parameter {
+            $($(#[$doc])* $variant,)*
+        }
+
+        impl Parameter {
+            /// Every parameter, in the order tables list them.
+            pub const ALL: &'static [Parameter] = &[$(Parameter::$variant),*];
+
+            /// Its name (`mass_ratio`).
+            pub fn name(self) -> &'static str {
+                match self {
+                    $(Parameter::$variant => $name,)*
+                }
+            }
+
+            /// The scene file's field that holds it (`balls.mass_ratio`).
+            pub fn field(self) -> &'static str {
+                match self {
+                    $(Parameter::$variant => $field,)*
+                }
+            }
+
+            /// Whether it is a length, in metres or `Rr`.
+            pub fn is_length(self) -> bool {
+                match self {
+                    $(Parameter::$variant => $length,)*
+                }
+            }
+        }
+    };
+}
+
+parameters! {
+    /// `Lc`, m.
+    Clearance = "clearance", "balls.clearance", true;
+    /// `Delta`, m.
+    Gap = "gap", "balls.gap", true;
+    /// `m_L / m_S`.
+    MassRatio = "mass_ratio", "balls.mass_ratio", false;
+    /// `e`.
+    Restitution = "restitution", "balls.restitution", false;
+    /// `m_L`, kg.
+    LargeMass = "large_mass", "balls.large_mass", false;
+    /// kg/m^3.
+    Density = "density", "balls.density", false;
+    /// `ms`, kg.
+    FrameMass = "frame_mass", "frame.mass", false;
+    /// `ks`, N/m.
+    Stiffness = "stiffness", "frame.stiffness", false;
+    /// `cs`, N s/m.
+    Damping = "damping", "frame.damping", false;
+    /// `xs0`, m.
+    InitialDisplacement = "initial_displacement", "frame.initial_displacement", true;
+    /// The forcing's amplitude, N or m.
+    ForcingAmplitude = "forcing_amplitude", "forcing.amplitude", false;
+    /// The forcing's frequency, Hz.
+    ForcingFrequency = "forcing_frequency", "forcing.frequency", false;
+}
+
+impl std::fmt::Display for Parameter {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
+impl std::str::FromStr for Parameter {
+    type Err = String;
+    fn from_str(s: &str) -> Result<Self, String> {
+        Parameter::ALL.iter().copied().find(|p| p.name() == s).ok_or_else(|| {
+            format!("`{s}` cannot be swept; choose one of {}", Parameter::ALL.iter().map(|p| p.name()).collect::<Vec<_>>().join(", "))
+        })
+    }
+}
+
+impl Parameter {
+    /// The parameter whose value a scene file's field holds (`balls.container_length` holds
+    /// the clearance through Eq. 11).
+    pub fn of_field(field: &str) -> Option<Parameter> {
+        if field == "balls.container_length" {
+            return Some(Parameter::Clearance);
+        }
+        Parameter::ALL.iter().copied().find(|p| p.field() == field)
+    }
+
+    /// `file` with this parameter set to `value` (its `[sweep]` dropped): the rule broken when
+    /// the file has no such part or the value has the wrong unit.
+    pub fn apply(self, file: &SceneFile, value: Length) -> Result<SceneFile, String> {
+        let mut f = file.clone();
+        f.sweep = None;
+        let number = || match value {
+            Length::Metres(x) => Ok(x),
+            Length::Rr(_) => Err(format!("`{self}` is not a length: its values must be plain numbers")),
+        };
+        let frame = f.frame.as_mut().ok_or("needs a [frame] table")?;
+        match self {
+            Parameter::FrameMass => frame.mass = number()?,
+            Parameter::Stiffness => frame.stiffness = number()?,
+            Parameter::Damping => frame.damping = number()?,
+            Parameter::InitialDisplacement => frame.initial_displacement = value,
+            Parameter::ForcingAmplitude | Parameter::ForcingFrequency => {
+                let x = number()?;
+                let g = f.forcing.as_mut().ok_or("needs a [forcing] table")?;
+                if self == Parameter::ForcingAmplitude {
+                    g.amplitude = x;
+                } else {
+                    g.frequency = x;
+                }
+            }
+            Parameter::Clearance | Parameter::Gap | Parameter::MassRatio | Parameter::Restitution | Parameter::LargeMass | Parameter::Density => {
+                let balls = f.balls.as_mut().ok_or("needs a [balls] table")?;
+                match self {
+                    Parameter::Clearance => {
+                        balls.clearance = Some(value);
+                        balls.container_length = None;
+                    }
+                    Parameter::Gap => balls.gap = value,
+                    Parameter::MassRatio => balls.mass_ratio = number()?,
+                    Parameter::Restitution => balls.restitution = number()?,
+                    Parameter::LargeMass => balls.large_mass = number()?,
+                    _ => balls.density = number()?,
+                }
+            }
+        }
+        Ok(f)
+    }
+
+    /// Its value in `scene`, built from `file`: in the file's unit, lengths in metres; `None`
+    /// when the scene has no such part (no forcing).
+    pub fn value(self, file: &SceneFile, scene: &Scene) -> Option<f64> {
+        let balls = file.balls.as_ref();
+        match self {
+            Parameter::Clearance => scene.container.map(|c| c.clearance),
+            Parameter::Gap => scene.container.map(|c| c.gap),
+            Parameter::InitialDisplacement => Some(scene.initial_displacement),
+            Parameter::Restitution => Some(scene.restitution),
+            Parameter::MassRatio => balls.map(|b| b.mass_ratio),
+            Parameter::LargeMass => balls.map(|b| b.large_mass),
+            Parameter::Density => balls.map(|b| b.density),
+            Parameter::FrameMass => scene.frame.map(|f| f.mass),
+            Parameter::Stiffness => scene.frame.map(|f| f.stiffness),
+            Parameter::Damping => scene.frame.map(|f| f.damping),
+            Parameter::ForcingAmplitude => scene.forcing.map(|g| g.amplitude),
+            Parameter::ForcingFrequency => scene.forcing.map(|g| g.frequency),
+        }
+    }
+}
+
+/// The validated `[tolerances]` of a damper scene: what an ensemble draws.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Tolerances {
+    /// Each parameter given, in [`Parameter::ALL`] order, with its spread in the parameter's
+    /// unit (lengths in metres): the half-width, or the standard deviation when normal.
+    pub spreads: Vec<(Parameter, f64)>,
+    /// How the spreads are drawn.
+    pub distribution: Distribution,
+    /// Seed of the draws.
+    pub seed: u64,
+}

@@ -1,0 +1,434 @@
+//! The rules of a scene file: every value checked where it is read, and an error that names
+//! the file, the field (or the flag it came from) and the rule broken. A [`Scene`] exists only
+//! once every rule holds.
+
+use super::excitation::Forcing;
+use super::format::{self, Arrangement, Length, SceneFile};
+use super::geometry::{ball_radius, Ball, BallKind, Container};
+use super::parameters::{Parameter, Tolerances};
+use super::settings::{CompliantSettings, RapierSettings};
+use super::structure::Frame;
+use super::{human, ChainCase, Loaded, Scene, SceneError, CHAIN_HORIZON, DEFAULT_HORIZON, DEFAULT_SAMPLE_DT, MAX_SAMPLES};
+
+/// Validates an already parsed file.
+pub fn from_file(parsed: SceneFile, file: &str, default_name: &str) -> Result<Loaded, SceneError> {
+    let v = Validator { file, flags: &[] };
+    let name = parsed.name.clone().unwrap_or_else(|| default_name.to_string());
+    if parsed.chain.is_some() && (parsed.frame.is_some() || parsed.balls.is_some()) {
+        return Err(v.err("chain", "cannot be combined with [frame] or [balls]: a chain file describes only the KER experiment"));
+    }
+    let scene = match (&parsed.frame, &parsed.chain) {
+        (Some(_), _) => Some(build_damper(&parsed, &name, &v)?),
+        (None, None) => return Err(v.err("frame", "is missing: a scene needs a [frame] table (or a [chain] table)")),
+        (None, Some(_)) => None,
+    };
+    let chain = match &parsed.chain {
+        Some(c) => Some(build_chain(c, &parsed.run, &name, &v)?),
+        None => None,
+    };
+    if let (Some(sweep), Some(_)) = (&parsed.sweep, &scene) {
+        if sweep.values.is_empty() {
+            return Err(v.err("sweep.values", "is empty: give at least one value"));
+        }
+        let second = match (&sweep.parameter_y, &sweep.values_y) {
+            (Some(p), Some(values)) if !values.is_empty() => Some((p, values)),
+            (Some(_), Some(_)) => return Err(v.err("sweep.values_y", "is empty: give at least one value")),
+            (None, None) => None,
+            (Some(_), None) => return Err(v.err("sweep.values_y", "is missing: `parameter_y` needs its values")),
+            (None, Some(_)) => return Err(v.err("sweep.parameter_y", "is missing: `values_y` needs its parameter")),
+        };
+        // Each value alone must make a valid scene (a grid's combinations are checked when run).
+        let axes = std::iter::once(("sweep.parameter", "sweep.values", &sweep.parameter, &sweep.values))
+            .chain(second.map(|(p, values)| ("sweep.parameter_y", "sweep.values_y", p, values)));
+        for (parameter_field, values_field, parameter, values) in axes {
+            for (i, value) in values.iter().enumerate() {
+                let varied = parameter
+                    .parse::<Parameter>()
+                    .and_then(|p| p.apply(&parsed, *value))
+                    .map_err(|rule| v.err(parameter_field, &rule))?;
+                build_damper(&varied, &name, &v).map_err(|e| match e {
+                    SceneError::Invalid { file, field, rule } => SceneError::Invalid {
+                        file,
+                        field: format!("{values_field}[{i}] (as {field})"),
+                        rule,
+                    },
+                    other => other,
+                })?;
+            }
+        }
+    } else if parsed.sweep.is_some() {
+        return Err(v.err("sweep", "needs a damper scene ([frame] and [balls])"));
+    }
+    let tolerances = match (&parsed.tolerances, &scene) {
+        (Some(t), Some(s)) => Some(tolerances(t, &parsed, s, &v)?),
+        (Some(_), None) => return Err(v.err("tolerances", "needs a damper scene ([frame] and [balls])")),
+        (None, _) => None,
+    };
+    Ok(Loaded { file: parsed, path: file.to_string(), scene, chain, tolerances })
+}
+
+/// Checks values against the scene's rules and names what broke one.
+pub(super) struct Validator<'a> {
+    pub(super) file: &'a str,
+    /// Fields whose value came from a command-line flag, and that flag (`run.horizon` ->
+    /// `--horizon`): an error names what the user typed.
+    pub(super) flags: &'a [(&'static str, &'static str)],
+}
+
+impl Validator<'_> {
+    pub(super) fn err(&self, field: &str, rule: &str) -> SceneError {
+        let field = self.flags.iter().find(|(f, _)| *f == field).map_or(field, |(_, flag)| flag);
+        SceneError::Invalid { file: self.file.into(), field: field.into(), rule: rule.into() }
+    }
+    pub(super) fn finite(&self, field: &str, x: f64) -> Result<f64, SceneError> {
+        if x.is_finite() {
+            Ok(x)
+        } else {
+            Err(self.err(field, &format!("must be a finite number (got {})", human(x))))
+        }
+    }
+    pub(super) fn positive(&self, field: &str, x: f64) -> Result<f64, SceneError> {
+        self.finite(field, x)?;
+        if x > 0.0 {
+            Ok(x)
+        } else {
+            Err(self.err(field, &format!("must be positive (got {})", human(x))))
+        }
+    }
+    pub(super) fn non_negative(&self, field: &str, x: f64) -> Result<f64, SceneError> {
+        self.finite(field, x)?;
+        if x >= 0.0 {
+            Ok(x)
+        } else {
+            Err(self.err(field, &format!("must not be negative (got {})", human(x))))
+        }
+    }
+    pub(super) fn restitution(&self, field: &str, e: f64) -> Result<f64, SceneError> {
+        self.finite(field, e)?;
+        if (0.0..=1.0).contains(&e) {
+            Ok(e)
+        } else {
+            Err(self.err(field, &format!("is a coefficient of restitution and must lie in [0, 1] (got {})", human(e))))
+        }
+    }
+    pub(super) fn run(&self, run: &format::RunFile, default_horizon: f64) -> Result<(f64, f64), SceneError> {
+        let horizon = self.positive("run.horizon", run.horizon.unwrap_or(default_horizon))?;
+        let dt = self.positive("run.sample_dt", run.sample_dt.unwrap_or(DEFAULT_SAMPLE_DT))?;
+        validate_sample_dt(horizon, dt).map_err(|rule| self.err("run.sample_dt", &rule))?;
+        Ok((horizon, dt))
+    }
+}
+
+/// The rule an output step must keep: no longer than the horizon, at most [`MAX_SAMPLES`] samples.
+pub fn validate_sample_dt(horizon: f64, dt: f64) -> Result<(), String> {
+    if !(dt.is_finite() && dt > 0.0) {
+        return Err(format!("must be a positive finite step (got {})", human(dt)));
+    }
+    if dt > horizon {
+        return Err(format!(
+            "({} s) is longer than the horizon ({} s): no sample would be written",
+            human(dt),
+            human(horizon)
+        ));
+    }
+    if horizon / dt > MAX_SAMPLES {
+        return Err(format!(
+            "({} s) would write {} samples over {} s; at most {} are allowed",
+            human(dt),
+            human(horizon / dt),
+            human(horizon),
+            human(MAX_SAMPLES)
+        ));
+    }
+    Ok(())
+}
+
+pub(super) fn build_damper(f: &SceneFile, name: &str, v: &Validator) -> Result<Scene, SceneError> {
+    let fr = f.frame.as_ref().expect("checked by caller");
+    let frame = Frame {
+        mass: v.positive("frame.mass", fr.mass)?,
+        stiffness: v.non_negative("frame.stiffness", fr.stiffness)?,
+        damping: v.non_negative("frame.damping", fr.damping)?,
+    };
+    let (horizon, sample_dt) = v.run(&f.run, DEFAULT_HORIZON)?;
+    let rapier = rapier_settings(&f.rapier, v)?;
+    let compliant = compliant_settings(&f.compliant, v)?;
+    let forcing = match &f.forcing {
+        None => None,
+        Some(g) => Some(forcing(g, &frame, v)?),
+    };
+    let Some(b) = &f.balls else {
+        let xs0 = v.finite("frame.initial_displacement", fr.initial_displacement.metres(0.0))?;
+        if matches!(fr.initial_displacement, Length::Rr(_)) {
+            return Err(v.err("frame.initial_displacement", "is given in Rr but the scene has no balls to define Rr"));
+        }
+        return Ok(Scene {
+            name: name.into(),
+            frame: Some(frame),
+            container: None,
+            balls: vec![],
+            restitution: 1.0,
+            initial_displacement: xs0,
+            initial_positions: vec![],
+            initial_velocities: vec![],
+            horizon,
+            sample_dt,
+            rapier,
+            compliant,
+            forcing,
+            reference_radius: 0.0,
+        });
+    };
+    let large_mass = v.positive("balls.large_mass", b.large_mass)?;
+    let mass_ratio = v.positive("balls.mass_ratio", b.mass_ratio)?;
+    let density = v.positive("balls.density", b.density)?;
+    let restitution = v.restitution("balls.restitution", b.restitution)?;
+    let rr = ball_radius(large_mass, density);
+    let balls = arrangement_balls(&b.arrangement, large_mass, mass_ratio, density, "balls.arrangement", v)?;
+    let xs0 = v.finite("frame.initial_displacement", fr.initial_displacement.metres(rr))?;
+    let gap = v.finite("balls.gap", b.gap.metres(rr))?;
+    if gap < 0.0 {
+        return Err(v.err("balls.gap", &format!("must not be negative: neighbouring balls would overlap (got {gap} m)")));
+    }
+    let sum_d: f64 = balls.iter().map(|b| 2.0 * b.radius).sum();
+    let n = balls.len() as f64;
+    let (length, clearance) = match (b.clearance, b.container_length) {
+        (Some(_), Some(_)) => {
+            return Err(v.err("balls.container_length", "and `balls.clearance` are both given: give one (Eq. 11 ties them)"))
+        }
+        (None, None) => return Err(v.err("balls.clearance", "is missing: give the clearance or the container length")),
+        (Some(lc), None) => {
+            let lc = v.non_negative("balls.clearance", lc.metres(rr))?;
+            (n * gap + sum_d + lc, lc)
+        }
+        (None, Some(le)) => {
+            let le = v.positive("balls.container_length", le.metres(rr))?;
+            let lc = le - n * gap - sum_d;
+            if lc < 0.0 {
+                return Err(v.err(
+                    "balls.container_length",
+                    &format!(
+                        "is {le} m but the balls and gaps need {} m: the balls cannot fit",
+                        n * gap + sum_d
+                    ),
+                ));
+            }
+            (le, lc)
+        }
+    };
+    if !length.is_finite() {
+        return Err(v.err("balls.gap", &format!("and the clearance make the container {} m long, more than a number can hold", human(length))));
+    }
+    let mut positions = Vec::with_capacity(balls.len());
+    let mut x = xs0 + gap;
+    for ball in &balls {
+        positions.push(x + ball.radius);
+        x += 2.0 * ball.radius + gap;
+    }
+    Ok(Scene {
+        name: name.into(),
+        frame: Some(frame),
+        container: Some(Container { length, gap, clearance }),
+        initial_velocities: vec![0.0; balls.len()],
+        balls,
+        restitution,
+        initial_displacement: xs0,
+        initial_positions: positions,
+        horizon,
+        sample_dt,
+        rapier,
+        compliant,
+        forcing,
+        reference_radius: rr,
+    })
+}
+
+pub(super) fn compliant_settings(c: &format::CompliantFile, v: &Validator) -> Result<CompliantSettings, SceneError> {
+    let d = CompliantSettings::default();
+    let youngs_modulus = v.positive("compliant.youngs_modulus", c.youngs_modulus.unwrap_or(d.youngs_modulus))?;
+    let poisson_ratio = v.finite("compliant.poisson_ratio", c.poisson_ratio.unwrap_or(d.poisson_ratio))?;
+    if !(poisson_ratio > -1.0 && poisson_ratio < 0.5) {
+        return Err(v.err("compliant.poisson_ratio", &format!("must lie in (-1, 0.5) for a stable solid (got {poisson_ratio})")));
+    }
+    let tolerance = v.positive("compliant.tolerance", c.tolerance.unwrap_or(d.tolerance))?;
+    if tolerance > 1e-2 {
+        return Err(v.err("compliant.tolerance", &format!("must lie in (0, 1e-2] (got {})", human(tolerance))));
+    }
+    Ok(CompliantSettings { youngs_modulus, poisson_ratio, tolerance })
+}
+
+pub(super) fn forcing(g: &format::ForcingFile, frame: &Frame, v: &Validator) -> Result<Forcing, SceneError> {
+    let amplitude = v.non_negative("forcing.amplitude", g.amplitude)?;
+    let frequency = v.positive("forcing.frequency", g.frequency)?;
+    let forcing = Forcing { kind: g.kind, amplitude, frequency };
+    // An undamped frame driven exactly at resonance has no bounded particular solution.
+    if frame.resonance_without_steady_state(frequency, frequency).is_some() {
+        return Err(v.err(
+            "forcing.frequency",
+            &format!("({frequency} Hz) drives an undamped frame exactly at resonance: its amplitude grows without bound"),
+        ));
+    }
+    Ok(forcing)
+}
+
+pub(super) fn rapier_settings(r: &format::RapierFile, v: &Validator) -> Result<RapierSettings, SceneError> {
+    if let Some(dt) = r.dt {
+        v.positive("rapier.dt", dt)?;
+        if dt > 0.1 {
+            return Err(v.err("rapier.dt", &format!("({dt} s) is longer than 0.1 s: far too long for centimetre balls")));
+        }
+    }
+    if let Some(it) = r.solver_iterations {
+        if it == 0 || it > 1000 {
+            return Err(v.err("rapier.solver_iterations", &format!("must lie in 1..=1000 (got {it})")));
+        }
+    }
+    Ok(RapierSettings { stepping: r.stepping, dt: r.dt, solver_iterations: r.solver_iterations, ccd: r.ccd })
+}
+
+pub(super) fn arrangement_balls(
+    a: &Arrangement,
+    large_mass: f64,
+    mass_ratio: f64,
+    density: f64,
+    field: &str,
+    v: &Validator,
+) -> Result<Vec<Ball>, SceneError> {
+    let small_mass = large_mass / mass_ratio;
+    let balls: Vec<Ball> = match a {
+        Arrangement::Letters(s) => s
+            .chars()
+            .filter(|c| !c.is_whitespace() && *c != '-')
+            .map(|c| match c.to_ascii_uppercase() {
+                'L' => Ok(Ball { mass: large_mass, radius: ball_radius(large_mass, density), kind: BallKind::Large }),
+                'S' => Ok(Ball { mass: small_mass, radius: ball_radius(small_mass, density), kind: BallKind::Small }),
+                other => Err(v.err(field, &format!("has the unknown letter `{other}`: use L (large) and S (small)"))),
+            })
+            .collect::<Result<_, _>>()?,
+        Arrangement::List(list) => list
+            .iter()
+            .enumerate()
+            .map(|(i, b)| {
+                let m = v.positive(&format!("{field}[{i}].mass"), b.mass)?;
+                let rho = v.positive(&format!("{field}[{i}].density"), b.density.unwrap_or(density))?;
+                Ok(Ball { mass: m, radius: ball_radius(m, rho), kind: BallKind::Custom })
+            })
+            .collect::<Result<_, _>>()?,
+    };
+    // What the typed values make must be numbers too: a mass below the smallest normal f64,
+    // or a radius beyond the largest, is not a ball any model can move.
+    if balls.iter().any(|b| b.kind == BallKind::Small) && !small_mass.is_normal() {
+        return Err(v.err(
+            "balls.mass_ratio",
+            &format!("makes the small balls' mass large_mass / mass_ratio = {} kg, too small for a number to hold", human(small_mass)),
+        ));
+    }
+    if let Some(b) = balls.iter().find(|b| !(b.mass.is_normal() && b.radius.is_normal())) {
+        return Err(v.err(
+            field,
+            &format!("has a ball of mass {} kg and radius {} m (from its density): not a size a number can hold", human(b.mass), human(b.radius)),
+        ));
+    }
+    Ok(balls)
+}
+
+pub(super) fn build_chain(c: &format::ChainFile, run: &format::RunFile, name: &str, v: &Validator) -> Result<Vec<ChainCase>, SceneError> {
+    let large_mass = v.positive("chain.large_mass", c.large_mass)?;
+    let mass_ratio = v.positive("chain.mass_ratio", c.mass_ratio)?;
+    let density = v.positive("chain.density", c.density)?;
+    let restitution = v.restitution("chain.restitution", c.restitution)?;
+    let speed = v.positive("chain.incident_speed", c.incident_speed)?;
+    let rr = ball_radius(large_mass, density);
+    let gap = v.non_negative("chain.gap", c.gap.metres(rr))?;
+    let (horizon, sample_dt) = v.run(run, CHAIN_HORIZON)?;
+    if c.large_counts.is_empty() {
+        return Err(v.err("chain.large_counts", "is empty"));
+    }
+    if c.small_balls.is_empty() {
+        return Err(v.err("chain.small_balls", "is empty: give [false], [true] or both"));
+    }
+    let mut cases = Vec::new();
+    for &small in &c.small_balls {
+        for &nl in &c.large_counts {
+            if !(1..=1000).contains(&nl) {
+                return Err(v.err("chain.large_counts", &format!("must lie in 1..=1000 (got {nl})")));
+            }
+            let mut letters = String::from("L");
+            for i in 0..nl {
+                if i > 0 && small {
+                    letters.push('S');
+                }
+                letters.push('L');
+            }
+            let balls = arrangement_balls(&Arrangement::Letters(letters), large_mass, mass_ratio, density, "chain", v)?;
+            let mut positions = Vec::with_capacity(balls.len());
+            let mut x = 0.0;
+            for (i, b) in balls.iter().enumerate() {
+                if i > 0 {
+                    x += gap + b.radius;
+                }
+                positions.push(x);
+                x += b.radius;
+            }
+            let mut velocities = vec![0.0; balls.len()];
+            velocities[0] = speed;
+            cases.push(ChainCase {
+                large: nl,
+                small,
+                scene: Scene {
+                    name: format!("{name}-{nl}L{}", if small { format!("-{}S", nl - 1) } else { String::new() }),
+                    frame: None,
+                    container: None,
+                    balls,
+                    restitution,
+                    initial_displacement: 0.0,
+                    initial_positions: positions,
+                    initial_velocities: velocities,
+                    horizon,
+                    sample_dt,
+                    rapier: RapierSettings::default(),
+                    compliant: CompliantSettings::default(),
+                    forcing: None,
+                    reference_radius: rr,
+                },
+            });
+        }
+    }
+    Ok(cases)
+}
+
+/// Each parameter's spread as written in `[tolerances]`, in [`Parameter::ALL`] order.
+fn tolerance_spreads(t: &format::TolerancesFile) -> [(Parameter, Option<Length>); 12] {
+    [
+        (Parameter::Clearance, t.clearance),
+        (Parameter::Gap, t.gap),
+        (Parameter::MassRatio, t.mass_ratio),
+        (Parameter::Restitution, t.restitution),
+        (Parameter::LargeMass, t.large_mass),
+        (Parameter::Density, t.density),
+        (Parameter::FrameMass, t.frame_mass),
+        (Parameter::Stiffness, t.stiffness),
+        (Parameter::Damping, t.damping),
+        (Parameter::InitialDisplacement, t.initial_displacement),
+        (Parameter::ForcingAmplitude, t.forcing_amplitude),
+        (Parameter::ForcingFrequency, t.forcing_frequency),
+    ]
+}
+
+pub(super) fn tolerances(t: &format::TolerancesFile, parsed: &SceneFile, scene: &Scene, v: &Validator) -> Result<Tolerances, SceneError> {
+    let mut spreads = vec![];
+    for (parameter, spread) in tolerance_spreads(t) {
+        let Some(spread) = spread else { continue };
+        let field = format!("tolerances.{parameter}");
+        let x = match spread {
+            Length::Rr(k) if parameter.is_length() => k * scene.reference_radius,
+            Length::Rr(_) => return Err(v.err(&field, &format!("is not a length: `{parameter}`'s spread must be a plain number"))),
+            Length::Metres(x) => x,
+        };
+        v.non_negative(&field, x)?;
+        parameter.apply(parsed, Length::Metres(0.0)).map_err(|rule| v.err(&field, &rule))?;
+        spreads.push((parameter, x));
+    }
+    Ok(Tolerances { spreads, distribution: t.distribution, seed: t.seed.unwrap_or(1) })
+}
+
