@@ -4,7 +4,7 @@
 //! lose nothing there, while each contact lands at a step boundary, where the plug-in resolves
 //! it with the two-body law before Rapier's next step (`super::impacts`). With `Fixed` steps a
 //! contact closes inside a step; Rapier holds it plastically and the plug-in adds the bounce
-//! afterwards (`super::record`), the impact up to a step late.
+//! afterwards (`super::feedback`), the impact up to a step late.
 
 use bevy::prelude::*;
 use bevy_rapier3d::parry::math::Pose;
@@ -12,7 +12,7 @@ use bevy_rapier3d::parry::query::{cast_shapes, ShapeCastOptions};
 use bevy_rapier3d::parry::shape::{Ball, HalfSpace};
 use bevy_rapier3d::prelude::*;
 
-use super::resources::{DamperScene, FrameState, Recording, StepClock, StepPlan, StepSettings};
+use crate::rapier::resources::{DamperScene, FrameState, Recording, StepClock, StepPlan, StepSettings};
 use crate::scene::Stepping;
 
 /// Shortest step, s.

@@ -1,13 +1,15 @@
 //! After each Rapier step: the balls' velocity jumps give the contact impulses (`m dv`, not the
-//! impulses Rapier reports, which are unreliable in rapier 0.35.0), the frame receives the
-//! opposite of their sum, impacts are attributed to their pair, and samples are written.
+//! impulses Rapier reports, which are unreliable), the bounces Rapier skipped are restored, the
+//! frame receives the opposite of the balls' momentum change, and impacts are attributed to
+//! their pair.
 
 use bevy::prelude::*;
 use bevy_rapier3d::prelude::*;
 use bevy_rapier3d::rapier::dynamics::RigidBodyHandle;
 
-use super::resources::{Bodies, DamperScene, FrameState, Recording, StepClock, StepPlan, StepSettings};
-use super::impacts::{resolve_touching, Instant, PairImpact, TOUCHING};
+use crate::rapier::contacts::{self, resolve_touching, write_velocities, Instant, PairImpact, TOUCHING};
+use crate::rapier::resources::{Bodies, DamperScene, FrameState, Recording, StepClock, StepPlan, StepSettings};
+use crate::rapier::{ALLOWED_OVERLAP, ENERGY_GAIN_TOLERANCE, WALL_CHORD_ERROR};
 use crate::run::Impact;
 use crate::scene::{pair_bodies, pair_gap, Body, Scene};
 
@@ -110,7 +112,7 @@ pub fn feedback(
         let mut vs = frame_end.1;
         let walls = scene.frame.zip(scene.container).map(|(f, c)| (frame_end.0, &mut vs, f.mass, c.length));
         let mut now = Instant { x: x_new, v: v_new, frame: walls };
-        let floor = super::impacts::approach_floor(scene);
+        let floor = contacts::approach_floor(scene);
         resolve_touching(scene, &mut now, |_| floor, resolved);
         write_velocities(&mut set, handles, &bodies.balls, &mut velocities, v_new);
         step_impulses(scene, v_new, &rec.v, active, dp, j);
@@ -305,7 +307,7 @@ fn held_runs(scene: &Scene, x: &[f64], v: &[f64], ((xs, vs), t, h): ((f64, f64),
     let (Some(f), Some(c)) = (scene.frame, scene.container) else { return [0, 0] };
     let n = x.len();
     let force = scene.frame_force(t, xs, vs);
-    let stick = super::impacts::sticking_speed(scene, force / f.mass, h);
+    let stick = contacts::sticking_speed(scene, force / f.mass, h);
     let walls = Some((xs, c.length));
     let holds = |ball: usize, pair: usize| {
         pair_gap(&scene.balls, x, walls, pair).is_some_and(|g| g <= TOUCHING) && (v[ball] - vs).abs() <= stick
@@ -359,7 +361,7 @@ fn book_resolved(
     for hit in resolved {
         let gap = pair_gap(&scene.balls, x_before, walls, hit.pair).unwrap_or(0.0);
         let t = start.t + (gap / hit.approach_speed).clamp(0.0, start.h);
-        super::impacts::book(super::impacts::Ledger { impacts, last_impact, struck_at }, n, hit, t, step);
+        contacts::book(contacts::Ledger { impacts, last_impact, struck_at }, n, hit, t, step);
     }
 }
 
@@ -381,10 +383,10 @@ fn hold_loaded_contacts(
 ) -> bool {
     let (Some(f), Some(c)) = (scene.frame, scene.container) else { return false };
     let mut vs = frame_end.1 - dp.iter().sum::<f64>() / f.mass;
-    let floor = super::impacts::approach_floor(scene);
+    let floor = contacts::approach_floor(scene);
     let mut now = Instant { x, v: v_new, frame: Some((frame_end.0, &mut vs, f.mass, c.length)) };
     let threshold = |p: usize| if j[p] > rec.impulse_floor { floor } else { f64::INFINITY };
-    super::impacts::resolve_touching_with(scene, 0.0, &mut now, threshold, held);
+    contacts::resolve_touching_with(scene, 0.0, &mut now, threshold, held);
     !held.is_empty()
 }
 
@@ -434,32 +436,6 @@ fn restore_bounces(
         corrected = true;
     }
     corrected
-}
-
-/// Phase 3b: the corrected velocities into Rapier's bodies (rounded to what Rapier carries on
-/// with) and into the balls' `Velocity` components.
-pub(super) fn write_velocities(
-    set: &mut RapierRigidBodySet,
-    handles: &[RigidBodyHandle],
-    balls: &[Entity],
-    velocities: &mut Query<&mut Velocity>,
-    v_new: &mut [f64],
-) {
-    for (i, &h) in handles.iter().enumerate() {
-        let body = &mut set.bodies[h];
-        let mut lin = body.linvel();
-        lin.x = v_new[i] as f32;
-        body.set_linvel(lin, true);
-        v_new[i] = lin.x as f64; // what Rapier will carry on with
-        // bevy_rapier wrote the step's velocity into the ball's `Velocity` before this system
-        // ran, and in an app driven by `app.update()` it copies a changed `Velocity` back into
-        // the body at the next step: it must hold the corrected one.
-        if let Ok(mut velocity) = velocities.get_mut(balls[i]) {
-            if velocity.linear != lin {
-                velocity.linear = lin;
-            }
-        }
-    }
 }
 
 /// Phase 4: the frame takes the opposite of the balls' total momentum change. Returns its
@@ -588,13 +564,12 @@ fn self_check(
     forcing_work: f64,
     t: f64,
 ) -> Option<String> {
-    use super::{ALLOWED_OVERLAP, ENERGY_GAIN_TOLERANCE};
     if let Some(c) = scene.container {
         for (i, b) in scene.balls.iter().enumerate() {
             let (left, right) = (x[i] - b.radius - xs, xs + c.length - x[i] - b.radius);
             let depth = -left.min(right);
             if depth > ALLOWED_OVERLAP + 1e-6 {
-                let ratio = super::neighbour_mass_ratio(scene);
+                let ratio = crate::rapier::neighbour_mass_ratio(scene);
                 return Some(format!(
                     "at t = {t:.6e} s {} is {depth:.3e} m into the {} wall, past Rapier's allowed overlap ({ALLOWED_OVERLAP:.1e} m): \
                      Rapier's iterative solver did not hold it (largest neighbouring mass ratio {ratio:.0})",
@@ -634,7 +609,7 @@ fn self_check(
 
 /// Overlap a projected contact keeps: Rapier's allowed error (`0.005 length_unit`), less the
 /// walls' chord error within a step, so that samples inside a step stay within the allowed error.
-pub const PROJECTED_OVERLAP: f64 = super::ALLOWED_OVERLAP - super::WALL_CHORD_ERROR;
+pub const PROJECTED_OVERLAP: f64 = ALLOWED_OVERLAP - WALL_CHORD_ERROR;
 /// Deepest overlap projected back, as a fraction of the ball's radius: anything deeper is a
 /// failure of the contact model and is left for the checks to see.
 pub const MAX_PROJECTION: f64 = 0.25;
@@ -667,46 +642,3 @@ pub fn project_inside(x: &mut [f64], balls: &[crate::scene::Ball], left: f64, le
     moved
 }
 
-/// Writes the samples that fall in the step just taken: the frame exactly (closed form from the
-/// step's start; impulses land at its end), the balls along their straight path within the step.
-pub fn record_samples(
-    clock: Res<StepClock>,
-    plan: Res<StepPlan>,
-    scene: Res<DamperScene>,
-    frame: Option<Res<FrameState>>,
-    mut rec: ResMut<Recording>,
-) {
-    let scene = &scene.0;
-    let dt = plan.h;
-    let t1 = clock.t;
-    let t0 = t1 - dt;
-    let rec: &mut Recording = &mut rec;
-    while rec.next_sample < rec.sample_count {
-        let k = rec.next_sample;
-        let ts = k as f64 * scene.sample_dt;
-        // A sample on the step's end (within round-off) belongs to this step, after impulses.
-        let at_end = (ts - t1).abs() <= 1e-9 * dt;
-        if ts > t1 && !at_end {
-            break;
-        }
-        let (xs, vs) = match &frame {
-            Some(_) if k == 0 => (scene.initial_displacement, 0.0),
-            Some(fr) if at_end => fr.now,
-            Some(fr) => fr.motion.state(fr.start.0, fr.start.1, fr.t_start, ts.max(fr.t_start)),
-            None => (0.0, 0.0),
-        };
-        let (x, v, prev_x, prev_v) = (&rec.x, &rec.v, &rec.prev_x, &rec.prev_v);
-        rec.recorder.sample(scene, ts, xs, vs, |i| {
-            if k == 0 {
-                (scene.initial_positions[i], scene.initial_velocities[i])
-            } else if at_end {
-                (x[i], v[i])
-            } else {
-                // Impulses land at the step's end: inside it, balls keep their old velocity.
-                let w = ((ts - t0) / dt).clamp(0.0, 1.0);
-                (prev_x[i] + w * (x[i] - prev_x[i]), prev_v[i])
-            }
-        });
-        rec.next_sample += 1;
-    }
-}

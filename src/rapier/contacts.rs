@@ -1,36 +1,29 @@
-//! Before each Rapier step: the impacts of touching pairs that approach, resolved by the plug-in
-//! with the two-body law of docs/MODEL.md §3 (Eq. 9-10), one pair at a time, the fastest
-//! approach first, until no touching pair approaches (the sequential reading of simultaneous
-//! impacts, as in the reference).
+//! The plug-in's own contact resolution, which the impact and feedback phases share: the
+//! two-body law of docs/MODEL.md §3 (Eq. 9-10) applied one pair at a time, the fastest approach
+//! first, until no touching pair approaches (the sequential reading of simultaneous impacts, as
+//! in the reference); the booking of impacts; and the velocities written back into Rapier.
 //!
 //! Rapier itself is left only what it does well, keeping bodies apart: every contact it solves
-//! is plastic (restitution 0). Three things it cannot do, and why the plug-in does them here:
+//! is plastic (restitution 0). Three things it cannot do, and why the plug-in does them:
 //! - a chain of touching balls struck at one end: Rapier's solve is simultaneous, so the pairs
 //!   that touched at rest keep a relative velocity of zero and the chain moves off as one block
-//!   instead of passing the momentum along as Newton's cradle does (and stays glued for good:
-//!   on `forced-lsl` at 3 Hz the three balls became one lump after 6 s);
+//!   instead of passing the momentum along as Newton's cradle does;
 //! - a contact that persists: Rapier bounces a contact only in the step it is new, so a ball
 //!   that stays within its prediction distance of a wall is struck plastically ever after;
 //! - a wall impact with the frame's finite mass: the frame is kinematic in Rapier, infinitely
 //!   heavy, and no restitution against it gives Eq. 9-10 for a ball heavier than `e` times the
 //!   frame, or for `e = 0`; here the frame's mass enters the law itself.
-//!
-//! Pairs that carried a contact impulse in the last step and approach slower than the frame's
-//! acceleration can explain over a step are persistent contacts (a ball riding the wall, a
-//! squeezed pack): Rapier holds them plastically, which is the reference's persistent-contact
-//! rule (docs/MODEL.md §4) at the scale of a step.
 
 use bevy::prelude::*;
 use bevy_rapier3d::prelude::*;
 use bevy_rapier3d::rapier::dynamics::RigidBodyHandle;
 
-use super::resources::{held_balls, Bodies, DamperScene, FrameState, Recording, StepClock, StepPlan};
 use crate::impact_law::impact_law;
 use crate::run::Impact;
 use crate::scene::{pair_bodies, pair_gap, Scene};
 
 /// Pairs closer than this are touching, m (the same tolerance the step planner aims at).
-pub const TOUCHING: f64 = super::stepping::TOUCHING as f64;
+pub const TOUCHING: f64 = super::phases::plan::TOUCHING as f64;
 /// Pair impacts resolved at one instant at most, per pair of the chain: a light ball squeezed
 /// between heavy bodies bounces ever faster (inelastic collapse); past this the rest of the
 /// approach is left to Rapier's plastic solve.
@@ -190,94 +183,28 @@ pub fn sticking_speed(scene: &Scene, acceleration: f64, h: f64) -> f64 {
     approach_floor(scene).max(PERSISTENT_APPROACH * acceleration.abs() * h)
 }
 
-/// The system: resolves the impacts of the touching pairs at the start of the step, writes
-/// the new velocities into Rapier's bodies and the balls' `Velocity`, the frame's into its
-/// state, and books the impacts.
-#[allow(clippy::too_many_arguments)]
-pub fn resolve_impacts(
-    clock: Res<StepClock>,
-    plan: Res<StepPlan>,
-    scene: Res<DamperScene>,
-    mut frame: Option<ResMut<FrameState>>,
-    bodies: Option<Res<Bodies>>,
-    mut rec: ResMut<Recording>,
-    mut sets: Query<&mut RapierRigidBodySet>,
-    mut velocities: Query<&mut Velocity>,
-    mut resolved: Local<Vec<PairImpact>>,
-    mut handles: Local<Vec<RigidBodyHandle>>,
+/// The corrected velocities into Rapier's bodies (rounded to what Rapier carries on with) and
+/// into the balls' `Velocity` components.
+pub fn write_velocities(
+    set: &mut RapierRigidBodySet,
+    handles: &[RigidBodyHandle],
+    balls: &[Entity],
+    velocities: &mut Query<&mut Velocity>,
+    v_new: &mut [f64],
 ) {
-    let Some(bodies) = bodies else { return };
-    let scene = &scene.0;
-    let n = scene.balls.len();
-    let floor = approach_floor(scene);
-    // What the frame's acceleration now builds over the last step: a slower approach of a
-    // loaded pair is the wall or the chain pressing on, not a new impact.
-    let acceleration =
-        frame.as_deref().zip(scene.frame).map_or(0.0, |(f, sf)| scene.frame_force(clock.t, f.now.0, f.now.1) / sf.mass);
-    let stick = sticking_speed(scene, acceleration, plan.h);
-    let Recording { x, v, last_impulse, impulse_floor, impacts, last_impact, struck_at, impact_loss, .. } = &mut *rec;
-    // Pairs within a run the walls hold ride the frame: persistent too.
-    let [left, right] = frame.as_deref().map_or([0, 0], |f| f.held);
-    let in_held = |p: usize| p < left.min(n) || p > n - right.min(n);
-    let threshold = |p: usize| if last_impulse[p] > *impulse_floor || in_held(p) { stick } else { floor };
-    let walls = frame.as_deref_mut().zip(scene.frame).zip(scene.container);
-    let mut now = Instant { x, v, frame: walls.map(|((f, sf), c)| (f.now.0, &mut f.now.1, sf.mass, c.length)) };
-    resolve_touching(scene, &mut now, threshold, &mut resolved);
-    // A struck held run is free again: the feedback decides afresh what the walls hold.
-    let touches_held = |p: usize| in_held(p) || (left > 0 && p == left) || (right > 0 && p == n - right);
-    if resolved.iter().any(|hit| touches_held(hit.pair)) {
-        if let Some(f) = frame.as_deref_mut() {
-            f.held = [0, 0];
-        }
-    }
-    // A held run rides the frame: it takes the frame's velocity now, momentum kept (the balls
-    // were within the sticking speed of it), the kinetic energy given up booked.
-    let mut merged = false;
-    if let (Some(f), Some(sf)) = (frame.as_deref_mut(), scene.frame) {
-        let carried = held_balls(f.held, n);
-        let (mass, momentum) = carried.clone().fold((sf.mass, sf.mass * f.now.1), |(m, p), i| {
-            (m + scene.balls[i].mass, p + scene.balls[i].mass * v[i])
-        });
-        if mass > sf.mass {
-            let common = momentum / mass;
-            let ke = |m: f64, u: f64| 0.5 * m * u * u;
-            let mut lost = ke(sf.mass, f.now.1) - ke(sf.mass, common);
-            for i in carried {
-                lost += ke(scene.balls[i].mass, v[i]) - ke(scene.balls[i].mass, common);
-                v[i] = common;
+    for (i, &h) in handles.iter().enumerate() {
+        let body = &mut set.bodies[h];
+        let mut lin = body.linvel();
+        lin.x = v_new[i] as f32;
+        body.set_linvel(lin, true);
+        v_new[i] = lin.x as f64; // what Rapier will carry on with
+        // bevy_rapier wrote the step's velocity into the ball's `Velocity` before this system
+        // ran, and in an app driven by `app.update()` it copies a changed `Velocity` back into
+        // the body at the next step: it must hold the corrected one.
+        if let Ok(mut velocity) = velocities.get_mut(balls[i]) {
+            if velocity.linear != lin {
+                velocity.linear = lin;
             }
-            f.now.1 = common;
-            *impact_loss += lost;
-            let wall_pair = if f.held[0] > 0 { 0 } else { n };
-            if let Some(k) = last_impact[wall_pair] {
-                impacts[k].energy_lost += lost;
-            }
-            merged = true;
-        }
-    }
-    if resolved.is_empty() && !merged {
-        return;
-    }
-    for hit in resolved.iter() {
-        *impact_loss += hit.energy_lost;
-        // The steps end just short of contact: the impact is when the gap closes.
-        let t = clock.t + hit.gap.max(0.0) / hit.approach_speed;
-        book(Ledger { impacts, last_impact, struck_at }, n, hit, t, clock.steps);
-    }
-    // Before the first step bevy_rapier has not made the bodies yet: it will from `Velocity`.
-    if let Ok(mut set) = sets.single_mut() {
-        if handles.len() != n {
-            handles.clear();
-            handles.extend(bodies.balls.iter().map_while(|e| set.entity2body().get(e).copied()));
-        }
-        if handles.len() == n {
-            super::record::write_velocities(&mut set, &handles, &bodies.balls, &mut velocities, v);
-            return;
-        }
-    }
-    for (ball, &vi) in bodies.balls.iter().zip(v.iter()) {
-        if let Ok(mut velocity) = velocities.get_mut(*ball) {
-            velocity.linear.x = vi as f32;
         }
     }
 }
