@@ -12,7 +12,7 @@
 //! and one Schur complement. The integrals (damper and forcing work, contact dissipation)
 //! depend on the bodies but nothing depends on them: their increments follow explicitly.
 
-use super::{Pair, Side, System, VS, XS};
+use super::system::{Pair, Side, System, VS, XS};
 
 /// One contact's partial derivatives at the start of a step.
 #[derive(Debug, Clone, Copy, Default)]
@@ -258,7 +258,7 @@ impl System<'_> {
 
 #[cfg(test)]
 mod tests {
-    use super::super::{System, VS, XS};
+    use super::super::system::{System, VS, XS};
     use super::Stage;
     use crate::scene::{load_scene, scenes_dir};
 
