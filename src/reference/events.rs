@@ -3,95 +3,97 @@
 
 use super::*;
 
-impl Solver<'_> {
-    pub(super) fn advance(&mut self, t: f64) {
-        let dt = t - self.t;
-        for i in 0..self.n {
-            if self.hold[i] == Hold::Free {
-                let step = self.v[i] * dt;
-                self.x[i] += step;
-                // Every ball moves at every event, so a pair that moves as one (equal
-                // velocities, no event of its own) sees its gap wander by this rounding.
-                self.drift[i] += f64::EPSILON * (self.x[i].abs() + step.abs());
-            }
+/// The run's impacts, in time order, and its energy account so far.
+pub(super) struct Ledger {
+    pub(super) impacts: Vec<Impact>,
+    /// Index in `impacts` of each pair's latest impact.
+    pub(super) last_impact: Vec<Option<usize>>,
+    /// Lost in impacts, J.
+    pub(super) impact_loss: f64,
+    /// Dissipated by the frame's damper, J.
+    pub(super) damping_loss: f64,
+    /// Put in by the excitation, J.
+    pub(super) forcing_work: f64,
+}
+
+impl Ledger {
+    pub(super) fn new(n: usize) -> Self {
+        Ledger {
+            // Room for a paper scene's impacts: growing a vector of them copies it each time.
+            impacts: Vec::with_capacity(IMPACTS_RESERVED),
+            last_impact: vec![None; n + 1],
+            impact_loss: 0.0,
+            damping_loss: 0.0,
+            forcing_work: 0.0,
         }
+    }
+}
+
+impl Solver<'_> {
+    /// Moves time on to `t`: the free balls fly there.
+    pub(super) fn advance(&mut self, t: f64) {
+        self.balls.advance(t - self.t);
         self.t = t;
     }
 
-    /// Starts a new frame segment at the current time with velocity `v` and the current load.
+    /// Starts a new frame segment at the current time with velocity `v` and the current load,
+    /// booking what the frame's damper dissipated and the excitation put in over the last one.
     pub(super) fn set_frame(&mut self, v: f64) {
         self.book_segment_energy();
-        let (xs, _, _) = self.frame_now();
-        let osc = if self.seg.osc.mass == self.frame_mass + self.held_mass {
-            self.seg.osc
-        } else {
-            Oscillator::new(self.frame_mass + self.held_mass, self.damping, self.stiffness)
-        };
-        self.seg = Segment::new(self.t, xs, v, osc, self.load);
-        self.segment += 1;
-        self.span = self.group_span();
-        self.frame_dirty = true;
+        let (xs, _, _) = self.frame.now(self.t);
+        self.frame.restart(self.t, xs, v);
+        self.search.frame_dirty = true;
     }
 
-    /// Books what the frame's damper dissipated, and the excitation put in, over the current
-    /// segment up to now: closed form when free; when forced, Gauss-Legendre on pieces of a
-    /// sixteenth of the shorter period (exact to round-off, see [`gauss_legendre`]).
+    /// Books the energy the frame's damper and excitation exchanged over the current segment
+    /// up to now ([`FrameMotion::segment_energy`]).
     pub(super) fn book_segment_energy(&mut self) {
-        let tau = self.t - self.seg.t0;
-        let Some(f) = self.seg.forced else {
-            self.damping_loss += self.seg.osc.dissipated(self.seg.x0, self.seg.v0, tau);
-            return;
-        };
-        let seg = self.seg;
-        let scene = self.scene;
-        let [damping, work] = gauss_legendre(seg.t0, self.t, f.scan, |t| {
-            let (xs, vs) = seg.state(t);
-            [scene.damping_power(t, vs), scene.forcing_power(t, xs, vs)]
-        });
-        self.damping_loss += damping;
-        self.forcing_work += work;
+        let (damping, work) = self.frame.segment_energy(self.t, self.scene);
+        self.ledger.damping_loss += damping;
+        if self.frame.seg.forced.is_some() {
+            self.ledger.forcing_work += work;
+        }
     }
 
     pub(super) fn touch_ball(&mut self, i: usize) {
-        self.dirty[i] = true;
-        self.dirty[i + 1] = true;
+        self.search.touch_ball(i);
     }
 
     pub(super) fn record(&mut self, p: usize, approach_speed: f64, energy_lost: f64, impulses: u32) {
         let (a, b) = self.pair_bodies(p);
-        self.fastest = self.fastest.max(approach_speed);
-        self.impact_loss += energy_lost;
+        self.limits.fastest = self.limits.fastest.max(approach_speed);
+        self.ledger.impact_loss += energy_lost;
         // Sequential impulses across one pair at one instant are one impact of that pair.
-        if let Some(k) = self.last_impact[p] {
-            let last = &mut self.impacts[k];
+        if let Some(k) = self.ledger.last_impact[p] {
+            let last = &mut self.ledger.impacts[k];
             if last.t == self.t {
                 last.energy_lost += energy_lost;
                 last.impulses += impulses;
                 return;
             }
         }
-        self.last_impact[p] = Some(self.impacts.len());
-        self.impacts.push(Impact { t: self.t, a, b, approach_speed, energy_lost, impulses, peak_force: None, contact_duration: None });
+        self.ledger.last_impact[p] = Some(self.ledger.impacts.len());
+        self.ledger.impacts.push(Impact { t: self.t, a, b, approach_speed, energy_lost, impulses, peak_force: None, contact_duration: None });
     }
 
     /// An impact with restitution `e` across pair `p`.
     pub(super) fn collide(&mut self, p: usize, approach_speed: f64) {
-        match self.gap(p) {
+        match self.balls.gap(p) {
             Gap::Fixed => {}
             Gap::Linear { .. } => {
                 let (i, j) = (p - 1, p);
-                let (vi, vj, lost) = impact_law(self.mass[i], self.v[i], self.mass[j], self.v[j], self.e);
-                self.v[i] = vi;
-                self.v[j] = vj;
+                let (vi, vj, lost) = impact_law(self.balls.mass[i], self.balls.v[i], self.balls.mass[j], self.balls.v[j], self.e);
+                self.balls.v[i] = vi;
+                self.balls.v[j] = vj;
                 self.touch_ball(i);
                 self.touch_ball(j);
                 self.record(p, approach_speed, lost, 1);
             }
             Gap::Frame { ball, .. } => {
-                let (_, vs, _) = self.frame_now();
-                let group = self.frame_mass + self.held_mass;
-                let (vb, vf, lost) = impact_law(self.mass[ball], self.v[ball], group, vs, self.e);
-                self.v[ball] = vb;
+                let (_, vs, _) = self.frame.now(self.t);
+                let group = self.frame.mass + self.frame.held_mass;
+                let (vb, vf, lost) = impact_law(self.balls.mass[ball], self.balls.v[ball], group, vs, self.e);
+                self.balls.v[ball] = vb;
                 self.touch_ball(ball);
                 self.set_frame(vf);
                 self.record(p, approach_speed, lost, 1);
@@ -101,7 +103,7 @@ impl Solver<'_> {
 
     /// Is pair `p` touching and slow enough (relative speed below `v_stick`) to move as one?
     pub(super) fn stuck_pair(&self, p: usize) -> bool {
-        self.pair_now(p).is_some_and(|q| q.g <= q.tol && q.rate.abs() < self.v_stick)
+        self.pair_now(p).is_some_and(|q| q.g <= q.tol && q.rate.abs() < self.limits.v_stick)
     }
 
     /// Perfectly inelastic merge of the run of touching slow bodies around pair `p`; a run that
@@ -110,24 +112,24 @@ impl Solver<'_> {
         let range = self.pair_range();
         let (mut lo, mut hi) = (p, p);
         // Extend across pairs of free balls only: the frame's group is one body already.
-        while lo > range.start && self.left_body_free(lo) && self.stuck_pair(lo - 1) {
+        while lo > range.start && self.balls.left_body_free(lo) && self.stuck_pair(lo - 1) {
             lo -= 1;
         }
-        while hi + 1 < range.end && self.right_body_free(hi) && self.stuck_pair(hi + 1) {
+        while hi + 1 < range.end && self.balls.right_body_free(hi) && self.stuck_pair(hi + 1) {
             hi += 1;
         }
         // The run holds bodies lo-1 ..= hi (body -1 and body n being the walls).
-        let reaches_left = lo == 0 || self.hold[lo - 1] != Hold::Free;
-        let reaches_right = hi == self.n || self.hold[hi] != Hold::Free;
-        let with_frame = self.has_frame() && self.walls && (reaches_left || reaches_right);
+        let reaches_left = lo == 0 || self.balls.hold[lo - 1] != Hold::Free;
+        let reaches_right = hi == self.balls.n || self.balls.hold[hi] != Hold::Free;
+        let with_frame = self.has_frame() && self.balls.walls && (reaches_left || reaches_right);
         let balls: Vec<usize> =
-            (lo.saturating_sub(1)..(hi + 1).min(self.n)).filter(|&i| self.hold[i] == Hold::Free).collect();
-        let (_, vs, _) = self.frame_now();
-        let group = self.frame_mass + self.held_mass;
+            (lo.saturating_sub(1)..(hi + 1).min(self.balls.n)).filter(|&i| self.balls.hold[i] == Hold::Free).collect();
+        let (_, vs, _) = self.frame.now(self.t);
+        let group = self.frame.mass + self.frame.held_mass;
         let (mut pm, mut m) = (0.0, 0.0);
         for &i in &balls {
-            pm += self.mass[i] * self.v[i];
-            m += self.mass[i];
+            pm += self.balls.mass[i] * self.balls.v[i];
+            m += self.balls.mass[i];
         }
         if with_frame {
             pm += group * vs;
@@ -136,60 +138,53 @@ impl Solver<'_> {
         let vc = pm / m;
         let mut lost = 0.0;
         for &i in &balls {
-            lost += 0.5 * self.mass[i] * (self.v[i] - vc).powi(2);
-            self.v[i] = vc;
+            lost += 0.5 * self.balls.mass[i] * (self.balls.v[i] - vc).powi(2);
+            self.balls.v[i] = vc;
             self.touch_ball(i);
         }
         if with_frame {
             lost += 0.5 * group * (vs - vc).powi(2);
-            let (xs, _, _) = self.frame_now();
+            let (xs, _, _) = self.frame.now(self.t);
             let side = if reaches_left { Hold::Left } else { Hold::Right };
             for &i in &balls {
-                self.hold[i] = side;
-                self.offset[i] = self.x[i] - xs;
-                self.held_mass += self.mass[i];
+                self.balls.hold[i] = side;
+                self.balls.offset[i] = self.balls.x[i] - xs;
+                self.frame.held_mass += self.balls.mass[i];
             }
             if reaches_left && reaches_right {
-                self.packed = true;
+                self.balls.packed = true;
             }
             self.set_frame(vc);
         }
         self.record(p, approach_speed, lost, balls.len() as u32 + with_frame as u32);
     }
 
-    pub(super) fn left_body_free(&self, p: usize) -> bool {
-        p >= 1 && self.hold[p - 1] == Hold::Free
-    }
-    pub(super) fn right_body_free(&self, p: usize) -> bool {
-        p < self.n && self.hold[p] == Hold::Free
-    }
-
     /// Releases the held runs whose wall would now pull on them.
     pub(super) fn release(&mut self) -> bool {
-        if self.held_mass == 0.0 || self.packed {
+        if self.frame.held_mass == 0.0 || self.balls.packed {
             return false;
         }
-        let (xs, vs, a) = self.frame_now();
+        let (xs, vs, a) = self.frame.now(self.t);
         let mut released = false;
-        for i in 0..self.n {
-            let pulled = match self.hold[i] {
+        for i in 0..self.balls.n {
+            let pulled = match self.balls.hold[i] {
                 Hold::Left => a < 0.0,
                 Hold::Right => a > 0.0,
                 Hold::Free => false,
             };
             if pulled {
-                self.hold[i] = Hold::Free;
-                self.x[i] = xs + self.offset[i];
-                self.drift[i] += f64::EPSILON * self.x[i].abs();
-                self.v[i] = vs;
-                self.held_mass -= self.mass[i];
+                self.balls.hold[i] = Hold::Free;
+                self.balls.x[i] = xs + self.balls.offset[i];
+                self.balls.drift[i] += f64::EPSILON * self.balls.x[i].abs();
+                self.balls.v[i] = vs;
+                self.frame.held_mass -= self.balls.mass[i];
                 self.touch_ball(i);
                 released = true;
             }
         }
         if released {
-            if self.hold.iter().all(|h| *h == Hold::Free) {
-                self.held_mass = 0.0; // no round-off residue
+            if self.balls.hold.iter().all(|h| *h == Hold::Free) {
+                self.frame.held_mass = 0.0; // no round-off residue
             }
             self.set_frame(vs);
         }
@@ -217,7 +212,7 @@ impl Solver<'_> {
         let drifting_off = curvature.is_some_and(|c| self.reopens(rate, c));
         Contact {
             approach: (rate < 0.0 && !drifting_off).then_some(-rate),
-            pressed: curvature.is_some_and(|c| c < 0.0) && rate < self.v_stick,
+            pressed: curvature.is_some_and(|c| c < 0.0) && rate < self.limits.v_stick,
             frame,
         }
     }
@@ -231,9 +226,9 @@ impl Solver<'_> {
     /// the first pass takes the pairs [`Solver::check_contacts`] has just read at this state.
     pub(super) fn resolve(&mut self, checked: bool) -> Result<(), ModelError> {
         let range = self.pair_range();
-        let mut contacts = std::mem::take(&mut self.contacts);
+        let mut contacts = std::mem::take(&mut self.scratch.contacts);
         contacts.clear();
-        contacts.resize(self.n + 1, Contact { approach: None, pressed: false, frame: false });
+        contacts.resize(self.balls.n + 1, Contact { approach: None, pressed: false, frame: false });
         let mut impulses = 0usize;
         // Pairs to re-read: all, or the neighbours of `changed` (and the frame's pairs).
         let mut all = true;
@@ -242,11 +237,11 @@ impl Solver<'_> {
         // Each pass changes the state (an impulse, a merge or a release); more passes than the
         // impulse cap allows plus a few per body means two judgements disagree and would
         // cycle: a stall to report, not a hang.
-        let most_passes = MAX_IMPULSES_PER_INSTANT + 8 * (self.n + 1);
+        let most_passes = MAX_IMPULSES_PER_INSTANT + 8 * (self.balls.n + 1);
         for _ in 0..most_passes {
             if first {
                 for p in range.clone() {
-                    contacts[p] = self.contact_of(self.pairs_now[p]);
+                    contacts[p] = self.contact_of(self.scratch.pairs_now[p]);
                 }
                 first = false;
             } else if all {
@@ -283,20 +278,20 @@ impl Solver<'_> {
             }
             all = true;
             if let Some((p, u)) = fastest {
-                let bounce_returns_fast = match self.gap(p) {
+                let bounce_returns_fast = match self.balls.gap(p) {
                     Gap::Frame { s, .. } => {
-                        let a = -s * self.frame_now().2;
-                        a < 0.0 && 2.0 * self.e * u / -a < self.t_stick
+                        let a = -s * self.frame.now(self.t).2;
+                        a < 0.0 && 2.0 * self.e * u / -a < self.limits.t_stick
                     }
                     _ => false,
                 };
                 // With e = 0 a touching approaching run ends as one body: merge it at once
                 // instead of converging to that through a geometric series of impulses.
                 // A pair striking again within a contact duration is in persistent contact.
-                let repeats_within_contact = self.last_impact[p]
-                    .is_some_and(|k| self.impacts[k].t < self.t && self.t - self.impacts[k].t < CONTACT_DURATION);
+                let repeats_within_contact = self.ledger.last_impact[p]
+                    .is_some_and(|k| self.ledger.impacts[k].t < self.t && self.t - self.ledger.impacts[k].t < CONTACT_DURATION);
                 if self.e > 0.0
-                    && u >= self.v_stick
+                    && u >= self.limits.v_stick
                     && !bounce_returns_fast
                     && !repeats_within_contact
                     && impulses < MAX_IMPULSES_PER_INSTANT
@@ -314,7 +309,7 @@ impl Solver<'_> {
                 continue;
             }
             if !self.release() {
-                self.contacts = contacts;
+                self.scratch.contacts = contacts;
                 return Ok(());
             }
         }

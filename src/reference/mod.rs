@@ -24,18 +24,23 @@
 //! releases, one instant's resolution), `output` (samples and the finished run); this file
 //! holds the solver's state, its limits and the event loop.
 
+mod balls;
 mod events;
 mod exact;
+mod frame;
 mod geometry;
 mod output;
 mod search;
 mod segment;
 
+use balls::{Balls, Gap, Hold};
+use events::Ledger;
 use exact::ExactTally;
-use geometry::*;
-use output::*;
-use search::*;
-use segment::*;
+use frame::FrameMotion;
+use geometry::{Contact, Limits, PairNow, Scratch};
+use output::Sampler;
+use search::Search;
+use segment::{Segment, Zeros};
 
 use crate::model::{Budget, Checks, Meter, Model, ModelError, OverBudget, RunOptions, Setting, Simulator};
 use crate::run::{EnergyAccount, Impact, Record, Recorder, Run};
@@ -106,7 +111,7 @@ impl Simulator for Reference {
             run.wall_time_s = meter.elapsed();
             return Ok(run);
         };
-        let cost = format!("{} impacts so far", solver.impacts.len());
+        let cost = format!("{} impacts so far", solver.ledger.impacts.len());
         let mut partial = solver.finish_at(t);
         let wall_s = meter.elapsed();
         partial.wall_time_s = wall_s;
@@ -149,93 +154,35 @@ impl Simulator for Reference {
     }
 }
 
-/// Which wall a stuck ball is held by.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-enum Hold {
-    Free,
-    Left,
-    Right,
-}
-
+/// The solver of one run: the parts that own its state, composed by the event loop
+/// ([`Solver::run`]). Each part's own file says what it holds; the methods that need several
+/// parts (a gap needs the balls and the frame) are the solver's, in the file of their phase.
 struct Solver<'a> {
     scene: &'a Scene,
-    n: usize,
-    walls: bool,
-    mass: Vec<f64>,
-    radius: Vec<f64>,
+    /// The balls: where they are, how they move, which the frame holds.
+    balls: Balls,
+    /// The frame's closed-form motion since its last change.
+    frame: FrameMotion,
+    /// Each pair's next event and the release of held balls.
+    search: Search,
+    /// The contact and sticking tolerances, and what the run has needed of them so far.
+    limits: Limits,
+    /// Impacts and the energy account.
+    ledger: Ledger,
+    /// The samples and the metrics.
+    sampler: Sampler,
+    /// Scratch of one instant: each pair as the postcondition read it, and its contact.
+    scratch: Scratch,
+    /// `e`.
     e: f64,
-    frame_mass: f64,
-    damping: f64,
-    stiffness: f64,
-    length: f64,
-    seg: Segment,
-    /// Serial number of `seg` (segments can start at the same instant).
-    segment: u64,
-    sign_changes: std::cell::RefCell<SignChanges>,
-    /// The frame's state and acceleration ahead at `t` under segment `segment`, kept while
-    /// neither changes (a cascade of impulses at one instant asks for them every pass).
-    now: std::cell::Cell<Option<FrameNow>>,
-    /// The last frame state evaluated, `(segment, t, xs, vs)`: the searches of both walls and
-    /// the checks ask for the same instant in turn, and each evaluation costs an `exp` and a
-    /// `sin_cos` ([`Solver::frame_state`]).
-    last_state: std::cell::Cell<(u64, f64, f64, f64)>,
-    /// Scratch of `resolve`: each pair's contact now.
-    contacts: Vec<Contact>,
-    /// Each pair as [`Solver::check_contacts`] last read it (for `resolve`'s first pass).
-    pairs_now: Vec<Option<PairNow>>,
     t: f64,
-    x: Vec<f64>,
-    v: Vec<f64>,
-    /// A bound on the rounding that advancing has added to each ball's position `x` so far.
-    drift: Vec<f64>,
-    hold: Vec<Hold>,
-    offset: Vec<f64>,
-    held_mass: f64,
-    packed: bool,
-    cand: Vec<Candidate>,
-    dirty: Vec<bool>,
-    frame_dirty: bool,
-    release_at: f64,
-    tol: f64,
-    v_stick: f64,
-    /// The scene's speed scale (the frame's initial or forced speed, or a length per
-    /// horizon), raised to the fastest approach of any impact so far: the speed at which
-    /// contacts can be placed no closer than two ulps of time (see
-    /// [`Solver::frame_gap_tolerance`]). It never falls, so bodies that met fast and move on
-    /// together keep a tolerance their meeting needed.
-    fastest: f64,
-    /// The largest contact tolerance a touching pair has had so far (see
-    /// [`Solver::check_contacts`]).
-    accepted_overlap: f64,
-    t_stick: f64,
-    span: f64,
     horizon: f64,
-    damping_loss: f64,
-    forcing_work: f64,
-    /// The harmonic load `(P, Q, w)` on the frame, when forced.
-    load: Option<(f64, f64, f64)>,
-    impact_loss: f64,
-    impacts: Vec<Impact>,
-    last_impact: Vec<Option<usize>>,
     events: u64,
-    recorder: Recorder,
-    /// Exact metrics of a free run (`None` when forced or frameless: read at the samples).
-    exact: Option<ExactTally>,
-    next_sample: usize,
-    sample_count: usize,
-    cursor: SampleCursor,
 }
 
 impl<'a> Solver<'a> {
     fn new(scene: &'a Scene, record: Record) -> Self {
         let n = scene.balls.len();
-        let (frame_mass, damping, stiffness) =
-            scene.frame.map_or((f64::INFINITY, 0.0, 0.0), |f| (f.mass, f.damping, f.stiffness));
-        let walls = scene.container.is_some();
-        let length = scene.container.map_or(0.0, |c| c.length);
-        let osc = Oscillator::new(if frame_mass.is_finite() { frame_mass } else { 1.0 }, damping, stiffness);
-        let xs0 = scene.initial_displacement;
-        let length_scale = scene.length_scale();
         let time_scale = scene.frame.map_or(scene.horizon, |f| {
             let p = f.damped_period();
             if p > 0.0 {
@@ -244,85 +191,37 @@ impl<'a> Solver<'a> {
                 scene.horizon
             }
         });
-        let load = scene.harmonic_load();
         let speed_scale = scene.speed_scale();
-        let samples = scene.sample_count();
-        // Where its metrics are exact the reference tallies no samples, and takes none unless
-        // the series is kept.
-        let exact = ExactTally::new(scene);
-        let recorder = Recorder::new(scene, record);
-        let mut s = Solver {
+        Solver {
             scene,
-            n,
-            walls,
-            mass: scene.balls.iter().map(|b| b.mass).collect(),
-            radius: scene.balls.iter().map(|b| b.radius).collect(),
+            balls: Balls::new(scene),
+            frame: FrameMotion::new(scene),
+            search: Search::new(n),
+            limits: Limits {
+                tol: LENGTH_TOLERANCE * scene.length_scale(),
+                v_stick: STICK_SPEED * speed_scale,
+                fastest: speed_scale,
+                accepted_overlap: 0.0,
+                t_stick: STICK_TIME * time_scale,
+            },
+            ledger: Ledger::new(n),
+            sampler: Sampler::new(scene, record),
+            scratch: Scratch::default(),
             e: scene.restitution,
-            frame_mass,
-            damping,
-            stiffness,
-            length,
-            seg: Segment::new(0.0, xs0, 0.0, osc, load),
-            segment: 1,
-            sign_changes: Default::default(),
-            now: Default::default(),
-            last_state: std::cell::Cell::new((0, f64::NAN, 0.0, 0.0)),
-            contacts: Vec::new(),
-            pairs_now: Vec::new(),
             t: 0.0,
-            x: scene.initial_positions.clone(),
-            v: scene.initial_velocities.clone(),
-            drift: vec![0.0; n],
-            hold: vec![Hold::Free; n],
-            offset: vec![0.0; n],
-            held_mass: 0.0,
-            packed: false,
-            cand: vec![NO_EVENT; n + 1],
-            dirty: vec![true; n + 1],
-            frame_dirty: true,
-            release_at: f64::INFINITY,
-            tol: LENGTH_TOLERANCE * length_scale,
-            v_stick: STICK_SPEED * speed_scale,
-            fastest: speed_scale,
-            accepted_overlap: 0.0,
-            t_stick: STICK_TIME * time_scale,
-            span: f64::INFINITY,
             horizon: scene.horizon,
-            damping_loss: 0.0,
-            forcing_work: 0.0,
-            load,
-            impact_loss: 0.0,
-            // Room for a paper scene's impacts: growing a vector of them copies it each time.
-            impacts: Vec::with_capacity(IMPACTS_RESERVED),
-            last_impact: vec![None; n + 1],
             events: 0,
-            recorder: if exact.is_some() { recorder.untallied() } else { recorder },
-            exact,
-            next_sample: 0,
-            sample_count: samples,
-            cursor: SampleCursor { seg_t0: f64::NAN, k: 0, x: 0.0, v: 0.0, steps: 0, mass: f64::NAN, transition: [[0.0; 2]; 2] },
-        };
-        s.span = s.group_span();
-        s
+        }
     }
 
     fn has_frame(&self) -> bool {
-        self.frame_mass.is_finite()
-    }
-
-    /// One damped period of the frame with what it carries, or the horizon.
-    fn group_span(&self) -> f64 {
-        self.seg.osc.damped_omega().map_or(self.horizon, |w| 2.0 * std::f64::consts::PI / w)
+        self.frame.exists()
     }
 
     /// Pairs that can touch: `p` lies between body `p - 1` and body `p` (body `-1` is the left
     /// wall, body `n` the right wall).
     fn pair_range(&self) -> std::ops::Range<usize> {
-        if self.walls {
-            0..self.n + 1
-        } else {
-            1..self.n.max(1)
-        }
+        self.balls.pair_range()
     }
 
     /// Runs the events to the horizon: `Some(budget)` when a budget stopped it first.
@@ -336,24 +235,24 @@ impl<'a> Solver<'a> {
             let mut next = (self.horizon, None);
             let mut next_exact = true;
             for p in self.pair_range() {
-                let c = self.cand[p];
+                let c = self.search.cand[p];
                 if c.t < next.0 || (c.t == next.0 && c.exact && !next_exact && next.1.is_some()) {
                     next = (c.t, Some(p));
                     next_exact = c.exact;
                 }
             }
             // The release is an exact event too: it goes before a search stopped at its time.
-            let release = self.release_at < next.0 || (self.release_at == next.0 && !next_exact);
+            let release = self.search.release_at < next.0 || (self.search.release_at == next.0 && !next_exact);
             if release {
-                next = (self.release_at, None);
+                next = (self.search.release_at, None);
             }
             let (t, pair) = next;
             if !release && pair.is_none() {
                 break;
             }
             if let Some(p) = pair {
-                if !self.cand[p].exact {
-                    self.cand[p] = self.candidate(p, t, self.exact_event_bound(Some(p)));
+                if !self.search.cand[p].exact {
+                    self.search.cand[p] = self.candidate(p, t, self.exact_event_bound(Some(p)));
                     continue;
                 }
             }
@@ -375,13 +274,13 @@ impl<'a> Solver<'a> {
                 return Err(self.stalled(why));
             }
             if release {
-                self.release_at = f64::INFINITY;
-                self.frame_dirty = true;
+                self.search.release_at = f64::INFINITY;
+                self.search.frame_dirty = true;
             }
             if let Some(p) = pair {
                 // Searched again from now even if resolving changes nothing (a contact that
                 // turns out not to be one), or its cached time would fire forever.
-                self.dirty[p] = true;
+                self.search.dirty[p] = true;
             }
             self.resolve(true)?;
         }

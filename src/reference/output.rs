@@ -18,68 +18,95 @@ pub(super) struct SampleCursor {
     pub(super) transition: [[f64; 2]; 2],
 }
 
+/// The run's samples and metrics: the recorder, the exact tally of a free run, and where the
+/// sampling of the frame stands.
+pub(super) struct Sampler {
+    pub(super) recorder: Recorder,
+    /// Exact metrics of a free run (`None` when forced or frameless: read at the samples).
+    pub(super) exact: Option<ExactTally>,
+    pub(super) next_sample: usize,
+    pub(super) sample_count: usize,
+    pub(super) cursor: SampleCursor,
+}
+
+impl Sampler {
+    pub(super) fn new(scene: &Scene, record: Record) -> Self {
+        // Where its metrics are exact the reference tallies no samples, and takes none unless
+        // the series is kept.
+        let exact = ExactTally::new(scene);
+        let recorder = Recorder::new(scene, record);
+        Sampler {
+            recorder: if exact.is_some() { recorder.untallied() } else { recorder },
+            exact,
+            next_sample: 0,
+            sample_count: scene.sample_count(),
+            cursor: SampleCursor { seg_t0: f64::NAN, k: 0, x: 0.0, v: 0.0, steps: 0, mass: f64::NAN, transition: [[0.0; 2]; 2] },
+        }
+    }
+}
+
 impl Solver<'_> {
     /// Writes every sample with time `<= until` (strictly before when `inclusive` is false).
     pub(super) fn sample_until(&mut self, until: f64, inclusive: bool) {
         // Samples serve the series, or the metrics when they are not exact.
-        if !self.recorder.keeps_series() && self.exact.is_some() {
+        if !self.sampler.recorder.keeps_series() && self.sampler.exact.is_some() {
             return;
         }
         let dt = self.scene.sample_dt;
-        while self.next_sample < self.sample_count {
-            let ts = self.next_sample as f64 * dt;
+        while self.sampler.next_sample < self.sampler.sample_count {
+            let ts = self.sampler.next_sample as f64 * dt;
             if ts > until || (!inclusive && ts == until) {
                 break;
             }
             let has_frame = self.has_frame();
             let (xs, vs) = if has_frame { self.frame_sample(ts) } else { (0.0, 0.0) };
-            let (hold, x, v, offset, t) = (&self.hold, &self.x, &self.v, &self.offset, self.t);
-            self.recorder.sample(self.scene, ts, xs, vs, |i| match hold[i] {
+            let (hold, x, v, offset, t) = (&self.balls.hold, &self.balls.x, &self.balls.v, &self.balls.offset, self.t);
+            self.sampler.recorder.sample(self.scene, ts, xs, vs, |i| match hold[i] {
                 Hold::Free => (x[i] + v[i] * (ts - t), v[i]),
                 _ => (xs + offset[i], vs),
             });
-            self.next_sample += 1;
+            self.sampler.next_sample += 1;
         }
     }
 
     /// Adds the motion from now to `until` (no event between) to the exact metrics.
     pub(super) fn tally_until(&mut self, until: f64) {
-        if self.exact.is_none() {
+        if self.sampler.exact.is_none() {
             return;
         }
         // The state now is kept by the last event's contact check (`frame_now`); the
         // searches since have evaluated other instants.
-        let (xs, vs, _) = self.frame_now();
-        let ends = [(xs, vs), self.frame_state(until)];
-        let Some(exact) = &mut self.exact else { return };
+        let (xs, vs, _) = self.frame.now(self.t);
+        let ends = [(xs, vs), self.frame.state(until)];
+        let Some(exact) = &mut self.sampler.exact else { return };
         let free_energy = if exact.wants_energy() {
-            (0..self.n).filter(|&i| self.hold[i] == Hold::Free).map(|i| 0.5 * self.mass[i] * self.v[i] * self.v[i]).sum()
+            (0..self.balls.n).filter(|&i| self.balls.hold[i] == Hold::Free).map(|i| 0.5 * self.balls.mass[i] * self.balls.v[i] * self.balls.v[i]).sum()
         } else {
             0.0
         };
-        exact.interval(&self.seg, self.t, until, ends, free_energy);
+        exact.interval(&self.frame.seg, self.t, until, ends, free_energy);
     }
 
-    /// The frame's state at sample `self.next_sample` (time `ts`): one step of the exact
+    /// The frame's state at sample `self.sampler.next_sample` (time `ts`): one step of the exact
     /// transition matrix from the previous sample when it lies in the same segment, the closed
     /// form every [`REANCHOR`] samples so that round-off cannot drift.
     pub(super) fn frame_sample(&mut self, ts: f64) -> (f64, f64) {
-        if self.seg.forced.is_some() {
-            return self.seg.state(ts);
+        if self.frame.seg.forced.is_some() {
+            return self.frame.seg.state(ts);
         }
-        let c = &mut self.cursor;
-        let k = self.next_sample;
-        if c.seg_t0 == self.seg.t0 && c.k + 1 == k && c.steps < REANCHOR && k > 0 {
+        let c = &mut self.sampler.cursor;
+        let k = self.sampler.next_sample;
+        if c.seg_t0 == self.frame.seg.t0 && c.k + 1 == k && c.steps < REANCHOR && k > 0 {
             let [[a, b], [cc, d]] = c.transition;
             (c.x, c.v) = (a * c.x + b * c.v, cc * c.x + d * c.v);
             c.steps += 1;
         } else {
-            if c.mass != self.seg.osc.mass {
-                c.transition = self.seg.osc.transition(self.scene.sample_dt);
-                c.mass = self.seg.osc.mass;
+            if c.mass != self.frame.seg.osc.mass {
+                c.transition = self.frame.seg.osc.transition(self.scene.sample_dt);
+                c.mass = self.frame.seg.osc.mass;
             }
-            (c.x, c.v) = self.seg.state(ts);
-            c.seg_t0 = self.seg.t0;
+            (c.x, c.v) = self.frame.seg.state(ts);
+            c.seg_t0 = self.frame.seg.t0;
             c.steps = 0;
         }
         c.k = k;
@@ -87,13 +114,13 @@ impl Solver<'_> {
     }
 
     pub(super) fn mechanical_energy(&self) -> f64 {
-        let (xs, vs) = if self.has_frame() { self.seg.state(self.t) } else { (0.0, 0.0) };
+        let (xs, vs) = if self.has_frame() { self.frame.seg.state(self.t) } else { (0.0, 0.0) };
         let frame = self.scene.frame_energy(self.t, xs, vs);
         frame
-            + (0..self.n)
+            + (0..self.balls.n)
                 .map(|i| {
-                    let v = if self.hold[i] == Hold::Free { self.v[i] } else { vs };
-                    0.5 * self.mass[i] * v * v
+                    let v = if self.balls.hold[i] == Hold::Free { self.balls.v[i] } else { vs };
+                    0.5 * self.balls.mass[i] * v * v
                 })
                 .sum::<f64>()
     }
@@ -102,7 +129,7 @@ impl Solver<'_> {
     /// before `t`, its impacts, its energy account to `t`.
     pub(super) fn finish_at(mut self, t: f64) -> Run {
         self.horizon = t;
-        if let Some(exact) = &mut self.exact {
+        if let Some(exact) = &mut self.sampler.exact {
             exact.cut_at(t);
         }
         self.finish()
@@ -112,18 +139,18 @@ impl Solver<'_> {
         if self.has_frame() {
             self.book_segment_energy();
         }
-        let (_, vs) = if self.has_frame() { self.seg.state(self.t) } else { (0.0, 0.0) };
+        let (_, vs) = if self.has_frame() { self.frame.seg.state(self.t) } else { (0.0, 0.0) };
         let final_velocities =
-            (0..self.n).map(|i| if self.hold[i] == Hold::Free { self.v[i] } else { vs }).collect();
+            (0..self.balls.n).map(|i| if self.balls.hold[i] == Hold::Free { self.balls.v[i] } else { vs }).collect();
         let energy = EnergyAccount::forced(
             self.scene.initial_energy(),
             self.mechanical_energy(),
-            self.damping_loss,
-            self.impact_loss,
-            self.forcing_work,
+            self.ledger.damping_loss,
+            self.ledger.impact_loss,
+            self.ledger.forcing_work,
         );
-        let (series, sampled) = self.recorder.finish();
-        let motion = self.exact.map_or(sampled, |e| e.finish());
+        let (series, sampled) = self.sampler.recorder.finish();
+        let motion = self.sampler.exact.map_or(sampled, |e| e.finish());
         Run {
             scene: self.scene.name.clone(),
             model: Model::Reference,
@@ -133,7 +160,7 @@ impl Solver<'_> {
             damped_period: self.scene.frame.map_or(0.0, |f| f.damped_period()),
             series,
             motion,
-            impacts: self.impacts,
+            impacts: self.ledger.impacts,
             energy,
             events: self.events,
             final_velocities,

@@ -13,45 +13,36 @@ pub(super) struct Candidate {
 
 pub(super) const NO_EVENT: Candidate = Candidate { t: f64::INFINITY, exact: true };
 
-impl Solver<'_> {
-    /// Next time after `t` at which the frame's acceleration changes sign, or `limit` if none
-    /// comes first (unforced segments ignore `limit`: their sign changes are closed form).
-    /// A forced segment's sign changes are scanned once and kept ([`SignChanges`]).
-    pub(super) fn next_sign_change(&self, t: f64, limit: f64) -> f64 {
-        let Some(f) = &self.seg.forced else {
-            return self.seg.free_sign_change(t);
-        };
-        if !(limit > t) {
-            return limit;
-        }
-        let mut c = self.sign_changes.borrow_mut();
-        if c.segment != self.segment {
-            *c = SignChanges { segment: self.segment, pieces: 0, roots: Vec::new() };
-        }
-        // Searches start at the current time or later: older roots are never asked for again.
-        if c.roots.len() > SIGN_CHANGES_KEPT {
-            let now = self.t;
-            c.roots.retain(|&r| r >= now);
-        }
-        loop {
-            let k = c.roots.partition_point(|&r| r <= t);
-            if let Some(&root) = c.roots.get(k) {
-                return root.min(limit);
-            }
-            let scanned = self.seg.t0 + c.pieces as f64 * f.scan;
-            if scanned >= limit {
-                return limit;
-            }
-            let end = self.seg.t0 + (c.pieces + 1) as f64 * f.scan;
-            self.seg.forced_sign_changes(f, scanned, end, &mut c.roots);
-            c.pieces += 1;
-        }
+/// Each pair's next event, whether it must be searched again, and when the frame releases the
+/// balls it holds.
+pub(super) struct Search {
+    /// Pair `p`'s next event.
+    pub(super) cand: Vec<Candidate>,
+    /// Pair `p` changed since its candidate was found.
+    pub(super) dirty: Vec<bool>,
+    /// The frame's motion changed: every ball-frame pair and the release are searched again.
+    pub(super) frame_dirty: bool,
+    /// When the frame's force next turns away from the balls it holds.
+    pub(super) release_at: f64,
+}
+
+impl Search {
+    pub(super) fn new(n: usize) -> Self {
+        Search { cand: vec![NO_EVENT; n + 1], dirty: vec![true; n + 1], frame_dirty: true, release_at: f64::INFINITY }
     }
 
+    /// Ball `i` changed: both its pairs are searched again.
+    pub(super) fn touch_ball(&mut self, i: usize) {
+        self.dirty[i] = true;
+        self.dirty[i + 1] = true;
+    }
+}
+
+impl Solver<'_> {
     /// Pair `p`'s next contact after `from`, searched no further than `bound` (a later contact
     /// is reported as "none before `bound`").
     pub(super) fn candidate(&self, p: usize, from: f64, bound: f64) -> Candidate {
-        match self.gap(p) {
+        match self.balls.gap(p) {
             Gap::Fixed => NO_EVENT,
             Gap::Linear { g, rate } => {
                 if rate < 0.0 {
@@ -73,18 +64,18 @@ impl Solver<'_> {
         // Only a forced segment's search is cut at `bound`: its sign changes are scanned, so
         // looking further costs, where an unforced segment's come in closed form (and cutting
         // its pieces would change the roots' last bits, which chaotic runs amplify).
-        let bound = if self.seg.forced.is_some() { bound } else { self.horizon };
-        let limit = (from + self.span).min(self.horizon).min(bound);
+        let bound = if self.frame.seg.forced.is_some() { bound } else { self.horizon };
+        let limit = (from + self.frame.span).min(self.horizon).min(bound);
         if !self.frame_may_reach(ball, s, k, from, limit) {
             // What the search below would conclude, without evaluating the frame's motion.
             return if limit >= self.horizon { NO_EVENT } else { Candidate { t: limit, exact: false } };
         }
         let mut a = from;
         loop {
-            let b = self.next_sign_change(a, limit).min(limit);
+            let b = self.frame.next_sign_change(a, limit, self.t).min(limit);
             // The sign just after `a` holds over the whole piece; judged as `resolve` judges it,
             // so that the two agree even where the acceleration is round-off (a frame at rest).
-            let curvature = -s * self.accel_ahead(a);
+            let curvature = -s * self.frame.accel_ahead(a);
             let root = if curvature >= 0.0 {
                 self.convex_root(ball, s, k, a, b)
             } else {
@@ -113,22 +104,22 @@ impl Solver<'_> {
     /// its extremes, twice over), which also keeps every Newton step of the search longer than
     /// an ulp of time.
     pub(super) fn frame_may_reach(&self, ball: usize, s: f64, k: f64, from: f64, limit: f64) -> bool {
-        let seg = &self.seg;
+        let seg = &self.frame.seg;
         let Some(reach) = seg.reach else { return true };
         let speed = seg.osc.w0() * reach;
-        let (x, v) = (self.x[ball], self.v[ball]);
+        let (x, v) = (self.balls.x[ball], self.balls.v[ball]);
         let line = |t: f64| s * (x + v * (t - self.t)) + k;
         let nearest = line(from).min(line(limit));
         let eps = f64::EPSILON;
         let farthest = x.abs() + v.abs() * (limit - self.t).abs();
         let err = 2.0
-            * (self.drift[ball]
+            * (self.balls.drift[ball]
                 + seg.position_roundoff(limit)
                 + 4.0 * eps * (farthest + reach + k.abs())
-                + 2.0 * eps * limit.abs() * (v.abs() + speed).max(self.fastest))
+                + 2.0 * eps * limit.abs() * (v.abs() + speed).max(self.limits.fastest))
             + 4.0 * eps * reach;
         // Written so that a NaN anywhere answers "may reach" (the search then decides).
-        !(nearest - reach - err > self.tol)
+        !(nearest - reach - err > self.limits.tol)
     }
 
     /// The first root of a gap that is convex on `[a, b]`: Newton from the left, whose
@@ -145,10 +136,10 @@ impl Solver<'_> {
                     return Some(self.bisect_crossing(ball, s, k, l, t));
                 }
             }
-            if gp >= 0.0 || (t == a && g <= self.tol && self.reopens(gp, -s * self.accel_ahead(a))) {
+            if gp >= 0.0 || (t == a && g <= self.limits.tol && self.reopens(gp, -s * self.frame.accel_ahead(a))) {
                 return None; // convex and not decreasing (or about to): it only rises from here on
             }
-            if g <= self.tol {
+            if g <= self.limits.tol {
                 return Some(t);
             }
             let next = t - g / gp;
@@ -171,7 +162,7 @@ impl Solver<'_> {
     /// than `v_stick t_stick / 2`, far below the contact tolerance. `resolve` and the contact
     /// search judge it alike, so they never disagree about a contact now.
     pub(super) fn reopens(&self, rate: f64, curvature: f64) -> bool {
-        rate < 0.0 && -rate < self.v_stick && curvature > 0.0 && -rate < curvature * self.t_stick
+        rate < 0.0 && -rate < self.limits.v_stick && curvature > 0.0 && -rate < curvature * self.limits.t_stick
     }
 
     /// A crossing of the gap between `l` (gap above the tolerance) and `h` (below it): a time
@@ -183,7 +174,7 @@ impl Solver<'_> {
                 break;
             }
             let (g, _) = self.frame_gap_at(ball, s, k, m);
-            if g.abs() <= self.tol {
+            if g.abs() <= self.limits.tol {
                 return m;
             }
             if g > 0.0 {
@@ -197,18 +188,18 @@ impl Solver<'_> {
 
     pub(super) fn concave_root(&self, ball: usize, s: f64, k: f64, a: f64, b: f64) -> Option<f64> {
         let (ga, gpa) = self.frame_gap_at(ball, s, k, a);
-        if ga <= self.tol && gpa <= 0.0 {
+        if ga <= self.limits.tol && gpa <= 0.0 {
             // Touching and not separating: a contact now if the wall presses, judged exactly as
             // `resolve` judges it (a piece can be an ulp long at a sign change, and its
             // midpoint then disagrees); otherwise the ball is about to leave the wall.
-            return (-s * self.accel_ahead(a) < 0.0).then_some(a);
+            return (-s * self.frame.accel_ahead(a) < 0.0).then_some(a);
         }
         let (gb, _) = self.frame_gap_at(ball, s, k, b);
-        if gb > self.tol {
+        if gb > self.limits.tol {
             return None; // a concave function's minimum lies at an end of the piece
         }
         let mut lo = a;
-        if ga <= self.tol {
+        if ga <= self.limits.tol {
             // Touching but separating: the return is after the maximum of g (where g' = 0,
             // g' decreasing on a concave piece).
             let (mut l, mut h) = (a, b);
@@ -224,7 +215,7 @@ impl Solver<'_> {
                 }
             }
             lo = l;
-            if self.frame_gap_at(ball, s, k, lo).0 <= self.tol {
+            if self.frame_gap_at(ball, s, k, lo).0 <= self.limits.tol {
                 return Some(lo);
             }
         }
@@ -233,7 +224,7 @@ impl Solver<'_> {
         let mut t = b;
         for _ in 0..MAX_ROOT_ITERATIONS {
             let (g, gp) = self.frame_gap_at(ball, s, k, t);
-            if g >= -self.tol && g <= self.tol {
+            if g >= -self.limits.tol && g <= self.limits.tol {
                 return Some(t);
             }
             if g > 0.0 {
@@ -251,21 +242,21 @@ impl Solver<'_> {
     }
 
     pub(super) fn refresh_candidates(&mut self) {
-        if self.frame_dirty && self.has_frame() {
+        if self.search.frame_dirty && self.has_frame() {
             for p in self.pair_range() {
-                if self.is_frame_pair(p) {
-                    self.dirty[p] = true;
+                if self.balls.is_frame_pair(p) {
+                    self.search.dirty[p] = true;
                 }
             }
-            self.release_at = if self.held_mass > 0.0 && !self.packed {
+            self.search.release_at = if self.frame.held_mass > 0.0 && !self.balls.packed {
                 // Forced: at most one span ahead; if nothing changed sign by then, `release`
                 // finds nothing to let go and the search goes on from there.
-                self.next_sign_change(self.t, (self.t + self.span).min(self.horizon))
+                self.frame.next_sign_change(self.t, (self.t + self.frame.span).min(self.horizon), self.t)
             } else {
                 f64::INFINITY
             };
         }
-        self.frame_dirty = false;
+        self.search.frame_dirty = false;
         // A pair's search need not look past the earliest exact event already known (the
         // frame pairs' searches are the costly ones): exact ball-ball times first, then the
         // frame pairs, each bounded by everything found so far.
@@ -273,38 +264,38 @@ impl Solver<'_> {
         let mut frame = [usize::MAX; 2];
         let mut frames = 0;
         for p in self.pair_range() {
-            if !self.dirty[p] {
+            if !self.search.dirty[p] {
                 continue;
             }
-            if self.is_frame_pair(p) {
+            if self.balls.is_frame_pair(p) {
                 // At most two: the free balls next to the walls (or to balls the frame holds).
                 frame[frames.min(1)] = p;
                 frames += 1;
             } else {
-                self.cand[p] = self.candidate(p, self.t, bound);
-                self.dirty[p] = false;
-                if self.cand[p].exact {
-                    bound = bound.min(self.cand[p].t);
+                self.search.cand[p] = self.candidate(p, self.t, bound);
+                self.search.dirty[p] = false;
+                if self.search.cand[p].exact {
+                    bound = bound.min(self.search.cand[p].t);
                 }
             }
         }
         debug_assert!(frames <= 2, "more than two ball-frame pairs");
         let frame = &frame[..frames.min(2)];
-        match self.seg.forced {
+        match self.frame.seg.forced {
             // Both frame pairs searched side by side over windows that double from a scan
             // step: the far wall's search then stops where the near wall's contact is. As
             // unforced, no search looks more than a span ahead; one that finds nothing by then
             // goes on when its time comes.
             Some(f) => {
                 let (mut reached, mut window) = (self.t, f.scan);
-                let mut bound = bound.min(self.t + self.span);
+                let mut bound = bound.min(self.t + self.frame.span);
                 loop {
                     let until = (reached + window).min(bound);
                     for &p in frame {
-                        if let Gap::Frame { ball, s, k } = self.gap(p) {
-                            self.cand[p] = self.search_frame_pair(ball, s, k, reached, until);
-                            if self.cand[p].exact {
-                                bound = bound.min(self.cand[p].t);
+                        if let Gap::Frame { ball, s, k } = self.balls.gap(p) {
+                            self.search.cand[p] = self.search_frame_pair(ball, s, k, reached, until);
+                            if self.search.cand[p].exact {
+                                bound = bound.min(self.search.cand[p].t);
                             }
                         }
                     }
@@ -312,26 +303,26 @@ impl Solver<'_> {
                         break;
                     }
                     reached = until;
-                    window = (2.0 * window).min(self.span);
+                    window = (2.0 * window).min(self.frame.span);
                 }
             }
             None => {
                 for &p in frame {
-                    self.cand[p] = self.candidate(p, self.t, bound);
+                    self.search.cand[p] = self.candidate(p, self.t, bound);
                 }
             }
         }
         for &p in frame {
-            self.dirty[p] = false;
+            self.search.dirty[p] = false;
         }
     }
 
     /// The earliest exact event among the clean pairs but `except`, the release and the horizon.
     pub(super) fn exact_event_bound(&self, except: Option<usize>) -> f64 {
-        let mut bound = self.release_at.min(self.horizon);
+        let mut bound = self.search.release_at.min(self.horizon);
         for p in self.pair_range() {
-            if Some(p) != except && !self.dirty[p] && self.cand[p].exact {
-                bound = bound.min(self.cand[p].t);
+            if Some(p) != except && !self.search.dirty[p] && self.search.cand[p].exact {
+                bound = bound.min(self.search.cand[p].t);
             }
         }
         bound
@@ -355,14 +346,14 @@ mod tests {
             let mut s = Solver::new(&scene, Record::MetricsOnly);
             let (x0, v0) = (rng.random_range(-0.02..0.02), rng.random_range(-1.0..1.0));
             let t0 = rng.random_range(0.0..2.0);
-            s.seg = Segment::new(t0, x0, v0, s.seg.osc, None);
-            s.segment += 1;
+            s.frame.seg = Segment::new(t0, x0, v0, s.frame.seg.osc, None);
+            s.frame.segment += 1;
             s.t = t0;
-            let ball = if rng.random_bool(0.5) { 0 } else { s.n - 1 };
-            s.v[ball] = rng.random_range(-0.5..0.5);
-            s.x[ball] += rng.random_range(-0.01..0.01);
-            let p = if ball == 0 { 0 } else { s.n };
-            let Gap::Frame { ball, s: side, k } = s.gap(p) else { panic!("pair {p} is not a ball-frame pair") };
+            let ball = if rng.random_bool(0.5) { 0 } else { s.balls.n - 1 };
+            s.balls.v[ball] = rng.random_range(-0.5..0.5);
+            s.balls.x[ball] += rng.random_range(-0.01..0.01);
+            let p = if ball == 0 { 0 } else { s.balls.n };
+            let Gap::Frame { ball, s: side, k } = s.balls.gap(p) else { panic!("pair {p} is not a ball-frame pair") };
             let limit = t0 + rng.random_range(0.0..0.3);
             if s.frame_may_reach(ball, side, k, t0, limit) {
                 kept += 1;
@@ -372,7 +363,7 @@ mod tests {
             for i in 0..=2000 {
                 let t = t0 + (limit - t0) * i as f64 / 2000.0;
                 let (g, _) = s.frame_gap_at(ball, side, k, t);
-                assert!(g > s.tol, "ruled out, but the gap is {g:e} m at t = {t} (window {t0}..{limit})");
+                assert!(g > s.limits.tol, "ruled out, but the gap is {g:e} m at t = {t} (window {t0}..{limit})");
             }
         }
         assert!(ruled_out > 100 && kept > 100, "{ruled_out} ruled out, {kept} kept");
