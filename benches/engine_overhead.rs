@@ -5,7 +5,7 @@
 use bevy_rapier3d::rapier::prelude::*;
 use criterion::{criterion_group, criterion_main, BatchSize, Criterion};
 use lpc_damper::oscillator::Oscillator;
-use lpc_damper::rapier::plugin::integration_parameters;
+use lpc_damper::rapier::integration_parameters;
 use lpc_damper::rapier::DamperStep;
 use lpc_damper::rapier::{headless_app, StepSettings};
 use lpc_damper::scene::{load_scene, scenes_dir, Scene};

@@ -127,13 +127,6 @@ impl Dopri5 {
         let th1 = 1.0 - theta;
         r[0][i] + theta * (r[1][i] + th1 * (r[2][i] + theta * (r[3][i] + th1 * r[4][i])))
     }
-
-    /// The whole dense output at `t + theta h` into `out`.
-    pub fn dense(&self, theta: f64, out: &mut [f64]) {
-        for (i, o) in out.iter_mut().enumerate() {
-            *o = self.dense_component(i, theta);
-        }
-    }
 }
 
 /// The next step length after a step of length `h` with error norm `err` (accepted or not):

@@ -1,70 +1,20 @@
-//! The compliant model: balls and walls deform. Every contact is a Hertz spring with
-//! Hunt-Crossley damping ([`contact`]), resolved in time by an adaptive integration of the
-//! whole system, so impacts last tens of microseconds instead of an instant, and their peak
-//! forces and durations are outputs. Steps are Dormand-Prince 5(4) ([`integrator`]) while that
-//! explicit pair is stable, and RODAS4 ([`rosenbrock`], L-stable, with the system's Jacobian
-//! solved in O(n): `jacobian`) while an open contact damps faster than an explicit step could
-//! follow: a low-restitution contact pressed at a small speed has a damping rate of
-//! `c K d^(3/2) / (v m)` with `v` near the floor speed, up to 1e9 per second, which held the
-//! explicit steps to nanoseconds for as long as the contact lasted.
+//! The compliant model of docs/MODEL.md §9: balls and walls deform, every contact a Hertz
+//! spring with Hunt-Crossley damping ([`contact`]) chosen so that an isolated impact has the
+//! scene's restitution at any speed, and the whole system integrated adaptively through every
+//! contact, so impacts last tens of microseconds and have peak forces and durations.
 //!
-//! What it adds to the impulse models, and how it stays comparable with them:
-//! - **Restitution.** Each contact's damping is `alpha = c / v0` with `c` chosen once per
-//!   scene so that an isolated impact at any approach speed `v0` has the scene's `e`
-//!   ([`contact::damping_for`]). `v0` is the contact's largest overlap rate so far: for an
-//!   isolated impact the rate is largest at onset, so this is the onset speed and `alpha` stays
-//!   fixed through the contact; a pair that starts touching at rest and is then squeezed by a
-//!   neighbour (chains with zero gaps) gets the speed it is driven at, not a near-zero onset
-//!   speed that would make it plastic. Rates below the floor speed
-//!   ([`FLOOR_SPEED_FRACTION`] of the scene's speed scale: resting and grazing contacts) count
-//!   as the floor speed, so `alpha` stays bounded. `e` below [`contact::MIN_RESTITUTION`] is
-//!   raised to it.
-//! - **Frame.** Wall contact forces act on the frame (equal and opposite), so the frame moves
-//!   under its true force. The reported acceleration series stays the smooth part
-//!   `frame_force / ms` (docs/MODEL.md §6). The frame's true acceleration is
-//!   `(frame_force + wall contact force) / ms`; a wall impact's `peak_force` is the wall's
-//!   largest contact force, so the true acceleration during it reaches
-//!   `|a| + peak_force / ms`.
-//! - **Events.** A contact starts when a pair's overlap becomes positive. Every accepted step
-//!   is scanned at eight points for a closed pair's overlap turning positive; the first onset
-//!   is located on the dense output to round-off and the step is redone up to it, so no stage
-//!   sees past it and the onset speed is that of a smooth step: exact for free flight. A step
-//!   is never longer than 1.5 times the time any closed pair needs to close at its speed and a
-//!   bound on its acceleration, so onsets are found inside steps, not approached by ever
-//!   shorter ones. (A graze that enters and leaves between two scan points is not an event,
-//!   but its force acts and its dissipation is booked: only its line in the impact list is
-//!   missing.) A contact ends when its bodies come apart by more than the pair's rest band
-//!   (the largest overlap of an impact at the floor speed, nanometres): bodies resting
-//!   against each other tremble across zero overlap, and each tremble is not a new impact nor
-//!   a reason to cut a step (the contact force and its slope are continuous at zero overlap,
-//!   so nothing needs a step boundary there). Its duration runs to where its overlap last
-//!   fell to zero, located on the dense output. An impact is recorded when its contact ends,
-//!   at its onset time; a contact still open at the horizon is recorded with its duration so
-//!   far. Its energy lost is the Hunt-Crossley dissipation over the contact, and its approach
-//!   speed the contact's largest overlap rate (the onset speed of an isolated impact).
-//!   [`Run::events`] counts accepted steps.
-//! - **Energy.** Damper dissipation, forcing work and each pair's contact dissipation are
-//!   integrated with the state, and the final energy includes the elastic energy of open
-//!   contacts, so the balance closes to the integration tolerance.
-//! - **Steps.** Error control on positions relative to the smallest Hertz length
-//!   `(m v^2 / K)^(2/5)` at the scene's speed scale and on velocities relative to that speed:
-//!   an error of one scale is an energy error of about the tolerance times the scene's energy
-//!   scale, whichever contacts are open. An explicit step within a contact is at most a tenth
-//!   of `1 / omega` of the contact's linearised stiffness at its largest overlap, about 40
-//!   steps per elastic impact; an explicit step longer than [`STIFF_LIMIT`] over the fastest
-//!   contact damping rate is taken by RODAS4 instead, whose steps only the error control and
-//!   the closing bound limit. A step shrinking to round-off or a non-finite state end the run
-//!   with a [`ModelError`] naming the scene; so does a budget, which keeps the run so far and
-//!   says what its steps cost (the impacts so far, the last step, the open contacts, the
-//!   stiffest of them).
+//! `system` is the scene as an ODE; `driver` the step loop, stepping by Dormand-Prince 5(4), or
+//! by RODAS4 with the Jacobian solved in O(n) (`jacobian`) while a contact damps faster than an
+//! explicit step could follow, both behind one `stepper` interface; `events` finds contact
+//! onsets and ends on the dense output; `output` writes the samples and the run.
 
 pub mod contact;
 mod driver;
 mod events;
-pub mod integrator;
+mod integrator;
 mod jacobian;
 mod output;
-pub mod rosenbrock;
+mod rosenbrock;
 mod stepper;
 mod system;
 

@@ -1,6 +1,6 @@
 //! Headline metrics of docs/MODEL.md §7, the same way for every model: peaks after one bare
 //! period, RMS, settling time, energy remaining, dissipation times. Those that read the sampled
-//! motion are tallied sample by sample as a model runs ([`SampleTally`]), so a run that keeps no
+//! motion are tallied sample by sample as a model runs ([`crate::run::SampleTally`]), so a run that keeps no
 //! series (an ensemble member) has exactly the metrics of one that does.
 
 mod summary;

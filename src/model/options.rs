@@ -116,7 +116,7 @@ impl<'a> Meter<'a> {
     #[inline]
     pub fn look(&self, t: f64, steps: u64) -> Option<Budget> {
         let over_steps = self.max_steps.is_some_and(|m| steps > m);
-        if !over_steps && steps % self.every != 0 {
+        if !over_steps && !steps.is_multiple_of(self.every) {
             return None;
         }
         if let Some(p) = self.progress {

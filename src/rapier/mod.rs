@@ -1,30 +1,27 @@
-//! The contact model: the balls are Rapier colliders in a headless Bevy app, the frame is a
-//! kinematic body moved by the exact damped-oscillator step, and every ball-wall impact is fed
-//! back into the frame as the opposite of the balls' momentum change.
+//! The contact model of docs/MODEL.md §9: the balls are Rapier colliders in a Bevy app, the
+//! frame a kinematic body moved by its exact oscillator, fed back the opposite of the balls'
+//! momentum change. Rapier keeps bodies apart; the plug-in resolves the impacts with Eq. 9-10
+//! and the frame's finite mass, one pair at a time (`contacts`), since Rapier bounces a contact
+//! only in the step it is new, solves a touching chain at once and sees the kinematic frame as
+//! infinitely heavy.
 //!
-//! Where it departs from the impulse model (docs/MODEL.md §3-4, "Rapier"), and why:
-//! - Rapier only keeps bodies apart (every contact plastic); the plug-in resolves impacts with
-//!   Eq. 9-10 and the frame's finite mass, one pair at a time (`impacts`), because Rapier
-//!   bounces a contact only in the step it is new, solves a touching chain at once, and sees
-//!   the kinematic frame as infinitely heavy.
-//! - Steps end as pairs come into contact (`stepping`); with fixed steps an impact lands at the
-//!   end of the step in which it happens, up to `dt` late. The frame's motion between impulses
-//!   is exact.
-//! - Velocities are f32.
+//! The plug-in group (`plugin`) runs the phases of a step (`phases`) in one order; `spawn`
+//! makes the bodies, `resources` holds what the phases share, `settings` the stepping rules.
 
-pub mod contacts;
-pub mod phases;
-pub mod plugin;
-pub mod resources;
+mod contacts;
+mod phases;
+mod plugin;
+mod resources;
 mod settings;
-pub mod spawn;
+mod spawn;
 
 use bevy::prelude::*;
 
 use crate::model::{Checks, Meter, Model, ModelError, OverBudget, RunOptions, Setting, Simulator};
 use crate::run::{EnergyAccount, Record, Run};
 use crate::scene::Scene;
-pub use plugin::{DamperSet, DamperStep, LpcDamperPlugins};
+pub use phases::plan::{APPROACH_RATIO, APPROACH_STEP, MIN_STEP, TOUCHING};
+pub use plugin::{integration_parameters, ContactPhysicsPlugin, DamperSchedulePlugin, DamperSet, DamperStep, FramePlugin, LpcDamperPlugins, RecordPlugin, SceneSpawnPlugin};
 pub use resources::{Bodies, DamperScene, FrameState, Recording, StepClock, StepPlan, StepSettings};
 pub use crate::scene::Stepping;
 pub use settings::*;

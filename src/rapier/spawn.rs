@@ -9,7 +9,7 @@ use crate::scene::Scene;
 
 /// How much smaller Rapier's balls are than the scene's, m: four f32 steps of the largest
 /// coordinate. Balls that touch in the scene then do not overlap in f32, where Rapier would push
-/// them apart and make energy from round-off (a packed column at rest started moving). Impacts
+/// them apart and make energy from round-off (a packed column at rest would start moving). Impacts
 /// are found and resolved on the scene's radii (`super::phases::plan`, `super::contacts`); only
 /// Rapier's resting contacts sit this much deeper.
 pub fn collider_skin(scene: &Scene) -> f64 {

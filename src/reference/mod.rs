@@ -1,28 +1,15 @@
-//! The reference model: an exact event-driven impulse-momentum solver (docs/MODEL.md §1-4), f64,
-//! no engine. It is the ground truth every other model is measured against.
+//! The reference model: the exact event-driven impulse-momentum solver of docs/MODEL.md §1-4,
+//! f64 and no engine, the ground truth every other model is measured against. Between events
+//! the frame moves in closed form and free balls fly straight, so the state at any time is a
+//! formula; events are contacts (ball-frame contacts found by the sound root isolation of
+//! docs/MODEL.md §10), releases of held balls and the horizon; persistent contact is a state
+//! (§4), so chattering and inelastic collapse end in a bounded number of events.
 //!
-//! Between events the frame moves in closed form ([`crate::oscillator`]) and free balls fly in straight
-//! lines, so the state at any time is exact up to round-off. Events are
-//! - ball-ball contacts, whose times are exact (linear gaps);
-//! - contacts between a ball and the frame (a wall, or a ball stuck to it), found by
-//!   [`Solver::search_frame_pair`], which splits time at the sign changes of the frame's
-//!   acceleration: on each piece the gap is convex or concave, and the first root is bracketed
-//!   by Newton iteration from the safe side, so a graze is never stepped over;
-//! - the reversal of the force that holds a stuck group of balls against a wall (release).
-//!
-//! Impacts follow [`impact_law`]. Persistent contact is a state, not a stream of impacts: when
-//! two touching bodies approach slower than `v_stick`, or a ball would bounce off an
-//! accelerating wall and return within `t_stick`, the touching run of bodies is merged
-//! (perfectly inelastic, momentum kept, the energy lost booked as an impact). A run that reaches
-//! a wall moves with the frame (its mass joins the frame's oscillator) until the wall would pull
-//! it, and is then released. Chattering, inelastic collapse and resting balls therefore end in
-//! a bounded number of events with the energy balance intact.
-//!
-//! One `impl Solver` split by phase, as rapier splits its physics pipeline: `segment` (the
-//! frame's closed-form motion and its sign changes), `geometry` (gaps, tolerances and the
-//! contact invariant), `search` (when each pair next touches), `events` (impacts, merges,
-//! releases, one instant's resolution), `output` (samples and the finished run); this file
-//! holds the solver's state, its limits and the event loop.
+//! The solver is composed of parts that own their state: `balls`, `frame` (the current segment
+//! of closed-form motion, whose mathematics is `segment`), `search` (each pair's next event),
+//! `geometry` (gaps, tolerances, the postcondition), `events` (impacts, merges, releases and
+//! the ledger) and `output` (samples, the exact metrics of `exact`, the finished run). This
+//! file holds the limits and the event loop that composes them.
 
 mod balls;
 mod events;

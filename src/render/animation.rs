@@ -15,7 +15,7 @@ const QUANTISER_SPEED: i32 = 10;
 
 /// Shortest frame delay in hundredths of a second: browsers and viewers slow anything
 /// shorter down to 10 cs, so faster animations play at 50 frames per second.
-const MIN_DELAY_CS: u16 = 2;
+pub const MIN_DELAY_CS: u16 = 2;
 
 /// The delay between frames of an animation at `fps` frames per simulated second, in the
 /// GIF's hundredths of a second, so that one simulated second plays in one second of real

@@ -226,13 +226,21 @@ pub fn spawn_stage(
     commands.insert_resource(GlobalAmbientLight { brightness: 900.0, ..default() });
 }
 
+/// The balls' meshes, posed by [`pose`].
+type BallParts<'w, 's> = Query<'w, 's, (&'static BallMesh, &'static mut Transform, &'static MeshMaterial3d<StandardMaterial>), (Without<FramePart>, Without<Column>)>;
+/// The frame's parts (walls, floor), posed by [`pose`].
+type FrameParts<'w, 's> =
+    Query<'w, 's, (&'static FramePart, &'static mut Transform, Option<&'static WallMesh>, &'static MeshMaterial3d<StandardMaterial>), (Without<BallMesh>, Without<Column>)>;
+/// The columns the frame stands on, posed by [`pose`].
+type Columns<'w, 's> = Query<'w, 's, (&'static Column, &'static mut Transform), (Without<BallMesh>, Without<FramePart>)>;
+
 /// Poses every part at the playback's sample and lights the flashes.
 pub fn pose(
     playback: Res<Playback>,
     layout: Res<Layout>,
-    mut balls: Query<(&BallMesh, &mut Transform, &MeshMaterial3d<StandardMaterial>), (Without<FramePart>, Without<Column>)>,
-    mut parts: Query<(&FramePart, &mut Transform, Option<&WallMesh>, &MeshMaterial3d<StandardMaterial>), (Without<BallMesh>, Without<Column>)>,
-    mut columns: Query<(&Column, &mut Transform), (Without<BallMesh>, Without<FramePart>)>,
+    mut balls: BallParts,
+    mut parts: FrameParts,
+    mut columns: Columns,
     mut materials: ResMut<Assets<StandardMaterial>>,
 ) {
     let (xs, x) = super::state_at_sample(&playback.run, playback.sample);

@@ -108,7 +108,7 @@ impl Recorder {
         let a = scene.frame_acceleration(t, xs, vs);
         let wants_energy = self.tally.as_ref().is_some_and(|t| t.wants_energy());
         let mut kinetic = 0.0;
-        let kept = self.series.as_mut().filter(|s| self.taken % s.every.max(1) == 0);
+        let kept = self.series.as_mut().filter(|s| self.taken.is_multiple_of(s.every.max(1)));
         self.taken += 1;
         if let Some(s) = kept {
             s.t.push(t);

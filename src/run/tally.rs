@@ -9,7 +9,8 @@ use crate::scene::Scene;
 pub const SETTLING_FRACTION: f64 = 0.05;
 
 /// The metrics read from the motion itself: peaks of `|xs|` and `|a|` from one bare period on,
-/// RMS of `xs`, the settling time and the dissipation times (see [`Metrics`]). Every model
+/// RMS of `xs`, the settling time and the dissipation times (see
+/// [`crate::metrics::Metrics`]). Every model
 /// reads them at its samples ([`SampleTally`]); the reference computes them exactly from its
 /// closed-form motion in free vibration.
 #[derive(Debug, Clone, Copy, PartialEq, Default)]

@@ -7,7 +7,7 @@ use super::format::ForcingKind;
 
 /// Harmonic excitation of the frame. Either way the frame obeys
 /// `ms xs'' + cs xs' + ks xs = P sin(w t) + Q cos(w t)` ([`Forcing::harmonic_load`]), and its
-/// smooth force is [`Scene::frame_force`].
+/// smooth force is [`super::Scene::frame_force`].
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Forcing {
     /// Force on the frame, or motion of the ground.

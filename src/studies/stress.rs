@@ -229,9 +229,9 @@ pub fn judge(model: Model, scene: &Scene, run: &Run) -> Result<(), Failure> {
     let fail = |check, detail: String| Err(Failure { check, detail });
     let s = &run.series;
     let finite = |v: &[f64]| v.iter().all(|x| x.is_finite());
-    if !(finite(&s.xs) && finite(&s.vs) && finite(&s.a) && s.x.iter().all(|v| finite(v)) && s.v.iter().all(|v| finite(v)))
-        || ![run.energy.final_, run.energy.damping_loss, run.energy.impact_loss].iter().all(|x| x.is_finite())
-    {
+    let series_finite = finite(&s.xs) && finite(&s.vs) && finite(&s.a) && s.x.iter().all(|v| finite(v)) && s.v.iter().all(|v| finite(v));
+    let account_finite = [run.energy.final_, run.energy.damping_loss, run.energy.impact_loss].iter().all(|x| x.is_finite());
+    if !(series_finite && account_finite) {
         return fail("non-finite", "a series or the energy account holds NaN or infinity".into());
     }
     // Energy scale: the initial energy, or for a scene at rest the work its impacts could do

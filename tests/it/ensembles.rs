@@ -361,7 +361,7 @@ fn shards_merge_into_the_unsharded_table() {
     let dir = |name: &str| tmp.path().join(name);
     let run = |args: &[&str], out: &std::path::Path| {
         let mut all: Vec<&std::ffi::OsStr> = vec!["run".as_ref(), path.as_os_str(), "--ensemble".as_ref(), "23".as_ref(), "--seed".as_ref(), "5".as_ref()];
-        all.extend(args.iter().map(|a| std::ffi::OsStr::new(a)));
+        all.extend(args.iter().map(std::ffi::OsStr::new));
         all.extend(["--out".as_ref(), out.as_os_str()]);
         let o = lpc(all);
         assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));

@@ -44,7 +44,7 @@ fn assert_figure(dir: &Path, name: &str, (w, h): (u32, u32), curves: usize) {
 #[test]
 fn scene_gives_figs_8_to_12_with_and_without_the_damper() {
     let out = tempfile::tempdir().unwrap();
-    let o = lpc(&["plot", "scenes/lpc-lsl.toml", "--out", out.path().to_str().unwrap(), "--size", "640x400"]);
+    let o = lpc(["plot", "scenes/lpc-lsl.toml", "--out", out.path().to_str().unwrap(), "--size", "640x400"]);
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     for (name, curves) in [("displacement", 2), ("acceleration", 2), ("positions", 5)] {
         assert_figure(out.path(), name, (640, 400), curves);
@@ -56,7 +56,7 @@ fn scene_gives_figs_8_to_12_with_and_without_the_damper() {
 #[test]
 fn chain_scene_gives_the_ker_chart() {
     let out = tempfile::tempdir().unwrap();
-    let o = lpc(&["plot", "scenes/chain-ker.toml", "--out", out.path().to_str().unwrap(), "--size", "500x300"]);
+    let o = lpc(["plot", "scenes/chain-ker.toml", "--out", out.path().to_str().unwrap(), "--size", "500x300"]);
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     assert_figure(out.path(), "ker", (500, 300), 2);
 }
@@ -64,7 +64,7 @@ fn chain_scene_gives_the_ker_chart() {
 #[test]
 fn sweep_scene_gives_one_curve_per_value() {
     let out = tempfile::tempdir().unwrap();
-    let o = lpc(&["plot", "scenes/sweep-cor.toml", "--out", out.path().to_str().unwrap()]);
+    let o = lpc(["plot", "scenes/sweep-cor.toml", "--out", out.path().to_str().unwrap()]);
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     assert_figure(out.path(), "sweep", (1000, 640), 3);
     let svg = std::fs::read_to_string(out.path().join("sweep.svg")).unwrap();
@@ -77,16 +77,16 @@ fn sweep_scene_gives_one_curve_per_value() {
 fn compare_and_run_directories_are_plotted() {
     let dir = tempfile::tempdir().unwrap();
     let cmp = dir.path().join("cmp");
-    let o = lpc(&["compare", "scenes/conventional.toml", "--out", cmp.to_str().unwrap()]);
+    let o = lpc(["compare", "scenes/conventional.toml", "--out", cmp.to_str().unwrap()]);
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     let figs = dir.path().join("figs");
-    let o = lpc(&["plot", cmp.to_str().unwrap(), "--out", figs.to_str().unwrap(), "--size", "320x200"]);
+    let o = lpc(["plot", cmp.to_str().unwrap(), "--out", figs.to_str().unwrap(), "--size", "320x200"]);
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     assert_figure(&figs, "overlay", (320, 200), 2);
     let svg = std::fs::read_to_string(figs.join("overlay.svg")).unwrap();
     assert!(svg.contains("reference") && svg.contains("rapier"), "one curve per model");
 
-    let o = lpc(&["plot", cmp.join("rapier").to_str().unwrap(), "--out", figs.to_str().unwrap(), "--size", "320x200"]);
+    let o = lpc(["plot", cmp.join("rapier").to_str().unwrap(), "--out", figs.to_str().unwrap(), "--size", "320x200"]);
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     assert_figure(&figs, "displacement", (320, 200), 1);
 }
@@ -95,10 +95,10 @@ fn compare_and_run_directories_are_plotted() {
 fn bad_input_is_named() {
     let dir = tempfile::tempdir().unwrap();
     let out = dir.path().join("figs");
-    let o = lpc(&["plot", dir.path().to_str().unwrap(), "--out", out.to_str().unwrap()]);
+    let o = lpc(["plot", dir.path().to_str().unwrap(), "--out", out.to_str().unwrap()]);
     assert_eq!(o.status.code(), Some(2));
     assert!(String::from_utf8_lossy(&o.stderr).contains("series.csv"), "{}", String::from_utf8_lossy(&o.stderr));
-    let o = lpc(&["plot", "scenes/lpc-lsl.toml", "--out", out.to_str().unwrap(), "--size", "10x10"]);
+    let o = lpc(["plot", "scenes/lpc-lsl.toml", "--out", out.to_str().unwrap(), "--size", "10x10"]);
     assert_eq!(o.status.code(), Some(2));
     assert!(String::from_utf8_lossy(&o.stderr).contains("WIDTHxHEIGHT"));
     assert!(!out.exists(), "nothing written on bad input");

@@ -1,4 +1,4 @@
-//! The integration tests, one binary (as cargo's `tests/testsuite/main.rs`): one link against
+//! The integration tests, one binary: one link against
 //! the library and Bevy instead of one per file. Each module is a property of the product;
 //! `regressions/` holds one test per fixed bug, on the scene that showed it; `common/` holds
 //! the known-solution problems and the one way to run the `lpc` binary.

@@ -41,8 +41,11 @@ fn the_closed_form_matches_published_values_and_balances_energy() {
     assert!((b.amplitude - 7.58311e-3).abs() < 0.5e-8, "{}", b.amplitude);
 }
 
+/// The series `(t, xs, x1)` and the impacts `(bodies, t, approach speed)` of a run.
+type SeriesAndImpacts = (Vec<[f64; 3]>, Vec<(String, f64, f64)>);
+
 /// `lpc run` on a one-ball forced scene over `periods` forcing periods.
-fn run(d: &ImpactDamper, xs0: f64, periods: f64, dir: &std::path::Path) -> (Vec<[f64; 3]>, Vec<(String, f64, f64)>) {
+fn run(d: &ImpactDamper, xs0: f64, periods: f64, dir: &std::path::Path) -> SeriesAndImpacts {
     let scene = format!(
         "name = \"masri\"\n[frame]\nmass = {}\nstiffness = {}\ndamping = {}\ninitial_displacement = {xs0}\n\
          [balls]\narrangement = \"L\"\nlarge_mass = {}\ndensity = 8000.0\nrestitution = {}\ngap = {}\nclearance = {}\n\

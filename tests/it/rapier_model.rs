@@ -51,7 +51,7 @@ fn one_ball_ball_impact_follows_eq_9_10() {
     assert_relative_eq!(run.impacts[0].energy_lost, lost, max_relative = 1e-4);
     // Aligned stepping ends a step as the gap closes to within the touching distance: the
     // impact's time is the exact one to within the shortest step.
-    assert!((run.impacts[0].t - 0.001 / 0.5).abs() <= lpc_damper::rapier::phases::plan::MIN_STEP, "{:?}", run.impacts);
+    assert!((run.impacts[0].t - 0.001 / 0.5).abs() <= lpc_damper::rapier::MIN_STEP, "{:?}", run.impacts);
 }
 
 #[test]

@@ -35,7 +35,7 @@ const SIZE: (u32, u32) = (480, 270);
 fn balls_are_drawn_where_the_physics_puts_them() {
     let out = tempfile::tempdir().unwrap();
     let dir = out.path().to_str().unwrap();
-    let o = lpc(&["render", "scenes/lpc-lsl.toml", "--out", dir, "--horizon", "0.4", "--fps", "20", "--size", "480x270"]);
+    let o = lpc(["render", "scenes/lpc-lsl.toml", "--out", dir, "--horizon", "0.4", "--fps", "20", "--size", "480x270"]);
     assert!(o.status.success(), "{}\n{}", String::from_utf8_lossy(&o.stdout), String::from_utf8_lossy(&o.stderr));
     // Off-screen on a machine without a Wayland session, nothing but the summary is printed.
     assert!(String::from_utf8_lossy(&o.stderr).trim().is_empty(), "{}", String::from_utf8_lossy(&o.stderr));
@@ -113,13 +113,13 @@ fn rendering_never_changes_the_physics() {
     for model in ["reference", "rapier"] {
         let out = tempfile::tempdir().unwrap();
         let (rendered, headless) = (out.path().join("rendered"), out.path().join("headless"));
-        let o = lpc(&[
+        let o = lpc([
             "render", "scenes/lpc-lsl.toml", "--model", model, "--out", rendered.to_str().unwrap(),
             "--horizon", "0.3", "--fps", "20", "--size", "160x100",
         ]);
         assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
         let (sample_dt, _) = lpc_damper::run::frame_sampling(FPS, 0.001);
-        let o = lpc(&[
+        let o = lpc([
             "run", "scenes/lpc-lsl.toml", "--model", model, "--out", headless.to_str().unwrap(),
             "--horizon", "0.3", "--sample-dt", &format!("{sample_dt}"),
         ]);

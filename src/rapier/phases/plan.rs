@@ -52,7 +52,7 @@ pub fn plan_step(
     }
     // bevy_rapier creates the bodies during the first update, after the frame is driven: the
     // walls stay where they start for that step. Keep it too short for the frame to move
-    // (a ball that fits its container exactly was struck by the walls' jump a step later).
+    // (a ball that fits its container exactly would be struck by the walls' jump a step later).
     if clock.steps == 0 {
         h = MIN_STEP;
     }

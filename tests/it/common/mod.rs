@@ -1,6 +1,8 @@
-//! Known-solution problems shared by the integration tests (in the spirit of diffsol's
-//! problem collection): scenes built in code whose answers are known by hand.
+//! Known-solution problems shared by the integration tests: scenes built in code whose answers
+//! are known by hand, and the one way to run the `lpc` binary.
 #![allow(dead_code)]
+// The known solutions solve small linear systems by index, as their derivations write them.
+#![allow(clippy::needless_range_loop)]
 
 pub mod masri_caughey;
 
