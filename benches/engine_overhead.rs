@@ -40,17 +40,12 @@ fn bare(scene: &Scene) -> Bare {
     let mut bodies = RigidBodySet::new();
     let mut colliders = ColliderSet::new();
     let frame = bodies.insert(
-        RigidBodyBuilder::kinematic_position_based()
-            .translation(Vector::new(scene.initial_displacement as f32, 0.0, 0.0))
-            .can_sleep(false),
+        RigidBodyBuilder::kinematic_position_based().translation(Vector::new(scene.initial_displacement as f32, 0.0, 0.0)).can_sleep(false),
     );
     let half = (0.5 * c.length as f32).max(0.06);
     for centre in [-half, c.length as f32 + half] {
         colliders.insert_with_parent(
-            ColliderBuilder::cuboid(half, 0.03, 0.03)
-                .translation(Vector::new(centre, 0.0, 0.0))
-                .friction(0.0)
-                .user_data(0),
+            ColliderBuilder::cuboid(half, 0.03, 0.03).translation(Vector::new(centre, 0.0, 0.0)).friction(0.0).user_data(0),
             frame,
             &mut bodies,
         );
@@ -64,10 +59,7 @@ fn bare(scene: &Scene) -> Bare {
                 .can_sleep(false),
         );
         colliders.insert_with_parent(
-            ColliderBuilder::ball(b.radius as f32)
-                .mass(b.mass as f32)
-                .friction(0.0)
-                .user_data(i as u128 + 1),
+            ColliderBuilder::ball(b.radius as f32).mass(b.mass as f32).friction(0.0).user_data(i as u128 + 1),
             h,
             &mut bodies,
         );

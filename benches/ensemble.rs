@@ -9,9 +9,9 @@
 //! `cargo bench --bench ensemble`.
 
 use criterion::{criterion_group, criterion_main, Criterion};
+use lpc_damper::model::{Model, RunOptions};
 use lpc_damper::scene::{load, scenes_dir};
 use lpc_damper::studies::ensemble::{draw, run_members, Ensemble};
-use lpc_damper::model::{Model, RunOptions};
 
 fn lsl_with_tolerance() -> (lpc_damper::scene::Scene, Ensemble, Ensemble) {
     // The scene's own [tolerances]: gap 0.02 Rr.

@@ -31,10 +31,10 @@ pub mod model;
 pub mod oscillator;
 pub mod output;
 pub mod rapier;
-#[cfg(feature = "render")]
-pub mod render;
 pub mod reference;
 mod registry;
+#[cfg(feature = "render")]
+pub mod render;
 pub mod run;
 pub mod scene;
 pub mod studies;

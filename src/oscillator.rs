@@ -174,9 +174,7 @@ impl Oscillator {
     /// per solution, which [`Oscillator::next_sign_change`] would otherwise repeat per call.
     pub fn zero_phase(&self, y0: f64, y1: f64) -> Option<f64> {
         match self.regime {
-            Regime::Under { w } if y0 != 0.0 || y1 + self.sigma * y0 != 0.0 => {
-                Some(((y1 + self.sigma * y0) / w).atan2(y0) + 0.5 * PI)
-            }
+            Regime::Under { w } if y0 != 0.0 || y1 + self.sigma * y0 != 0.0 => Some(((y1 + self.sigma * y0) / w).atan2(y0) + 0.5 * PI),
             _ => None,
         }
     }

@@ -24,7 +24,9 @@ impl Model {
             return Err(ModelError::Refused(format!("{}: {rule}", budget.flag())));
         }
         let model = simulator(self);
-        model.supports(scene).map_err(|reason| ModelError::Refused(format!("scene `{}`: {} cannot run it: {reason}", scene.name, self.title())))?;
+        model
+            .supports(scene)
+            .map_err(|reason| ModelError::Refused(format!("scene `{}`: {} cannot run it: {reason}", scene.name, self.title())))?;
         if options.record == Record::Series {
             check_memory(scene).map_err(ModelError::Refused)?;
         }

@@ -18,9 +18,9 @@ use pyo3::prelude::*;
 use pyo3::sync::MutexExt;
 use pyo3::types::PyDict;
 
-use lpc_damper::model::{ModelError as RustModelError, RunOptions};
 use lpc_damper::files::write_atomic;
 use lpc_damper::metrics::{Headline, Metric, RunSummary};
+use lpc_damper::model::{ModelError as RustModelError, RunOptions};
 use lpc_damper::output::parquet::{provenance, table_parquet, Constant, TOOL_VERSION};
 use lpc_damper::scene::{self, Loaded, Overrides, SceneError as RustSceneError, SceneFile, Stepping};
 use lpc_damper::studies::{chain as chains, ensemble as ensembles, frf as frfs, sweep as sweeps};
@@ -73,7 +73,8 @@ fn to_toml(value: &Bound<'_, PyAny>, at: &str) -> PyResult<toml::Value> {
     if let Ok(d) = value.cast::<PyDict>() {
         let mut table = toml::Table::new();
         for (k, v) in d.iter() {
-            let key: String = k.extract().map_err(|_| SceneError::new_err(format!("<dict>: `{at}` has a key that is not a string: {k}")))?;
+            let key: String =
+                k.extract().map_err(|_| SceneError::new_err(format!("<dict>: `{at}` has a key that is not a string: {k}")))?;
             let v = to_toml(&v, &field(&key))?;
             table.insert(key, v);
         }
@@ -151,9 +152,9 @@ impl Scene {
     fn from_dict(d: &Bound<'_, PyAny>, name: Option<String>) -> PyResult<Scene> {
         let file = "<dict>";
         let value = to_toml(d, "")?;
-        let parsed: SceneFile = value
-            .try_into()
-            .map_err(|e: toml::de::Error| scene_error(RustSceneError::Parse { file: file.into(), message: e.to_string().trim_end().to_string() }))?;
+        let parsed: SceneFile = value.try_into().map_err(|e: toml::de::Error| {
+            scene_error(RustSceneError::Parse { file: file.into(), message: e.to_string().trim_end().to_string() })
+        })?;
         let name = name.unwrap_or_else(|| "scene".into());
         Ok(Scene { loaded: scene::from_file(parsed, file, &name).map_err(scene_error)? })
     }
@@ -262,7 +263,12 @@ struct Run {
 
 impl Run {
     /// `name`, made by `make` (from the run) on first reading and kept.
-    fn cached(&self, py: Python<'_>, name: &'static str, make: impl FnOnce(Python<'_>, &mut lpc_damper::run::Run) -> PyResult<Py<PyAny>>) -> PyResult<Py<PyAny>> {
+    fn cached(
+        &self,
+        py: Python<'_>,
+        name: &'static str,
+        make: impl FnOnce(Python<'_>, &mut lpc_damper::run::Run) -> PyResult<Py<PyAny>>,
+    ) -> PyResult<Py<PyAny>> {
         // Locked without holding up the interpreter: another thread reading the same run waits
         // detached.
         if let Some(v) = self.made.lock_py_attached(py).expect("not poisoned").get(name) {
@@ -331,9 +337,7 @@ impl Run {
             let impacts = PyDict::new(py);
             let column = |f: &dyn Fn(&lpc_damper::run::Impact) -> f64| floats(py, run.impacts.iter().map(f).collect());
             impacts.set_item("t", column(&|i| i.t))?;
-            let names = |left: bool| -> Vec<String> {
-                run.impacts.iter().map(|i| if left { i.a } else { i.b }.name()).collect()
-            };
+            let names = |left: bool| -> Vec<String> { run.impacts.iter().map(|i| if left { i.a } else { i.b }.name()).collect() };
             let numpy = py.import("numpy")?;
             impacts.set_item("body_a", numpy.call_method1("asarray", (names(true),))?)?;
             impacts.set_item("body_b", numpy.call_method1("asarray", (names(false),))?)?;
@@ -447,7 +451,11 @@ fn columns<'py>(py: Python<'py>, header: &[String], rows: &[Vec<Option<f64>>], i
 
 /// Runs `work` over `0..n` in batches on rayon without the GIL, looking for Ctrl-C between
 /// batches.
-fn batched<T: Send>(py: Python<'_>, n: usize, work: impl Fn(std::ops::Range<usize>) -> Result<Vec<T>, PyErr> + Send + Sync) -> PyResult<Vec<T>> {
+fn batched<T: Send>(
+    py: Python<'_>,
+    n: usize,
+    work: impl Fn(std::ops::Range<usize>) -> Result<Vec<T>, PyErr> + Send + Sync,
+) -> PyResult<Vec<T>> {
     let mut out = Vec::with_capacity(n);
     let mut at = 0;
     while at < n {
@@ -461,9 +469,18 @@ fn batched<T: Send>(py: Python<'_>, n: usize, work: impl Fn(std::ops::Range<usiz
 }
 
 /// Writes `table` as Parquet into `dir` under `name`.
-fn write_part(dir: &PathBuf, name: &str, header: &[String], rows: &[Vec<Option<f64>>], integers: &[&str], constants: &[(&str, Constant)]) -> PyResult<()> {
+fn write_part(
+    dir: &PathBuf,
+    name: &str,
+    header: &[String],
+    rows: &[Vec<Option<f64>>],
+    integers: &[&str],
+    constants: &[(&str, Constant)],
+) -> PyResult<()> {
     let bytes = table_parquet(header, rows, integers, constants).map_err(|e| PyRuntimeError::new_err(e.to_string()))?;
-    std::fs::create_dir_all(dir).and_then(|_| write_atomic(&dir.join(name), &bytes)).map_err(|e| PyRuntimeError::new_err(format!("writing {}: {e}", dir.display())))
+    std::fs::create_dir_all(dir)
+        .and_then(|_| write_atomic(&dir.join(name), &bytes))
+        .map_err(|e| PyRuntimeError::new_err(format!("writing {}: {e}", dir.display())))
 }
 
 /// Members `start..stop` (default all) of an ensemble of `members` drawn under the scene's
@@ -519,7 +536,9 @@ fn grid(scene: &Scene, axes: Option<Vec<String>>, settings: &Settings) -> PyResu
     let axes = match axes {
         None => sweeps::file_axes(l).map_err(scene_error)?,
         Some(a) if a.is_empty() || a.len() > 2 => return Err(SceneError::new_err("axes: give one or two axes")),
-        Some(a) => a.iter().map(|x| sweeps::parse_axis(x).map_err(|rule| SceneError::new_err(format!("axes: {rule}")))).collect::<PyResult<_>>()?,
+        Some(a) => {
+            a.iter().map(|x| sweeps::parse_axis(x).map_err(|rule| SceneError::new_err(format!("axes: {rule}")))).collect::<PyResult<_>>()?
+        }
     };
     l.damper().map_err(scene_error)?;
     let mut grid = sweeps::grid_scenes(l, &axes).map_err(scene_error)?;
@@ -558,7 +577,8 @@ fn sweep<'py>(
     tolerance: Option<f64>,
 ) -> PyResult<Bound<'py, PyDict>> {
     let model = parse_model(model)?;
-    let (parameters, grid) = grid(scene, axes, &Settings { horizon, stepping, dt, solver_iterations, ccd, tolerance, ..Settings::default() })?;
+    let (parameters, grid) =
+        grid(scene, axes, &Settings { horizon, stepping, dt, solver_iterations, ccd, tolerance, ..Settings::default() })?;
     let stop = stop.unwrap_or(grid.len()).min(grid.len());
     if start >= stop {
         return Err(SceneError::new_err(format!("start: cells {start}..{stop} are not a part of 0..{}", grid.len())));
@@ -616,11 +636,10 @@ fn frf<'py>(py: Python<'py>, scene: &Scene, frequencies: Vec<f64>, model: &str) 
 #[pyo3(signature = (scene, *, model = "reference"))]
 fn chain<'py>(py: Python<'py>, scene: &Scene, model: &str) -> PyResult<Bound<'py, PyDict>> {
     let model = parse_model(model)?;
-    let cases = scene
-        .loaded
-        .chain
-        .as_ref()
-        .ok_or_else(|| SceneError::new_err(format!("{}: `chain` is missing: the KER experiment needs a chain scene", scene.loaded.path)))?;
+    let cases =
+        scene.loaded.chain.as_ref().ok_or_else(|| {
+            SceneError::new_err(format!("{}: `chain` is missing: the KER experiment needs a chain scene", scene.loaded.path))
+        })?;
     let rows = py.detach(|| chains::run_chain(cases, model)).map_err(model_error)?;
     let d = PyDict::new(py);
     d.set_item("large", rows.iter().map(|r| r.large as i64).collect::<Vec<_>>().into_pyarray(py))?;

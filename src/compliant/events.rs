@@ -87,7 +87,12 @@ impl Driver<'_, '_> {
                         prev
                     } else {
                         // Sign of g follows "crossed": the root returned lies on the crossed side.
-                        bracketed_root(|x| if crossed(overlap(x)) { 1.0 } else { -1.0 } * overlap(x).abs().max(f64::MIN_POSITIVE), prev, th, 1e-15)
+                        bracketed_root(
+                            |x| if crossed(overlap(x)) { 1.0 } else { -1.0 } * overlap(x).abs().max(f64::MIN_POSITIVE),
+                            prev,
+                            th,
+                            1e-15,
+                        )
                     };
                     if earliest.is_none_or(|e| root < e.0) {
                         earliest = Some((root, q));

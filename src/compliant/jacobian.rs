@@ -310,7 +310,13 @@ mod tests {
         let mut ju = vec![0.0; y.len()];
         let (mut ahead, mut behind) = (vec![0.0; y.len()], vec![0.0; y.len()]);
         for k in 0..y.len() {
-            let delta = if k >= 2 + 2 * n { 1.0 } else if position(k) { 1e-9 } else { 1e-7 };
+            let delta = if k >= 2 + 2 * n {
+                1.0
+            } else if position(k) {
+                1e-9
+            } else {
+                1e-7
+            };
             let mut yp = y.clone();
             yp[k] += delta;
             sys.rhs(t, &yp, &mut ahead, &v_max);
@@ -324,7 +330,13 @@ mod tests {
         sys.solve(&mut stage, &mut r);
         let scale = u.iter().fold(0.0f64, |m, v| m.max(v.abs()));
         for k in 0..y.len() {
-            let of = if k >= 2 + 2 * n { scale } else if position(k) { hg * 1e-6 } else { 1e-6 };
+            let of = if k >= 2 + 2 * n {
+                scale
+            } else if position(k) {
+                hg * 1e-6
+            } else {
+                1e-6
+            };
             assert!((r[k] - u[k]).abs() <= 1e-6 * of, "component {k}: {} vs {}", r[k], u[k]);
         }
     }

@@ -110,4 +110,3 @@ fn overlap_bound(scene: &Scene, run: &Run) -> f64 {
     1e-9 * scene.container.map_or(1e-3, |c| c.length.max(1e-3))
         + 2.0 * (contact::max_overlap(m_max, u_max, k) + (m_all * a_max / k).powf(2.0 / 3.0))
 }
-

@@ -97,11 +97,7 @@ impl<'a> System<'a> {
                 rest_band: contact::max_overlap(m_star, FLOOR_SPEED_FRACTION * v_scale, k),
             });
         }
-        let length_scale = pairs
-            .iter()
-            .map(|p| p.length)
-            .reduce(f64::min)
-            .unwrap_or_else(|| scene.length_scale() * 1e-3);
+        let length_scale = pairs.iter().map(|p| p.length).reduce(f64::min).unwrap_or_else(|| scene.length_scale() * 1e-3);
         let h_floor = pairs.iter().map(|p| 0.1 * p.length / v_scale).reduce(f64::min).unwrap_or(scene.horizon);
         let mut h_max = scene.horizon;
         if w0 > 0.0 {
@@ -230,4 +226,3 @@ impl<'a> System<'a> {
         crate::scene::pair_bodies(pair.p, self.n)
     }
 }
-

@@ -69,9 +69,11 @@ impl std::fmt::Display for Metric {
 impl std::str::FromStr for Metric {
     type Err = String;
     fn from_str(s: &str) -> Result<Self, String> {
-        Metric::ALL.iter().copied().find(|m| m.name() == s).ok_or_else(|| {
-            format!("`{s}` is not one of {}", Metric::ALL.iter().map(|m| m.name()).collect::<Vec<_>>().join(", "))
-        })
+        Metric::ALL
+            .iter()
+            .copied()
+            .find(|m| m.name() == s)
+            .ok_or_else(|| format!("`{s}` is not one of {}", Metric::ALL.iter().map(|m| m.name()).collect::<Vec<_>>().join(", ")))
     }
 }
 

@@ -105,7 +105,13 @@ pub struct Meter<'a> {
 impl<'a> Meter<'a> {
     /// A meter started now for a run under `options`, looking every `every` steps.
     pub fn new(options: &RunOptions<'a>, every: u64) -> Self {
-        Meter { start: Instant::now(), every: every.max(1), max_steps: options.max_steps, max_wall_s: options.max_wall_s, progress: options.progress }
+        Meter {
+            start: Instant::now(),
+            every: every.max(1),
+            max_steps: options.max_steps,
+            max_wall_s: options.max_wall_s,
+            progress: options.progress,
+        }
     }
     /// Seconds of computing since the run started.
     pub fn elapsed(&self) -> f64 {

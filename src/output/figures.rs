@@ -9,8 +9,8 @@ use std::sync::Once;
 use plotters::coord::Shift;
 use plotters::prelude::*;
 
-use crate::studies::chain::KerRow;
 use crate::run::{Run, Series};
+use crate::studies::chain::KerRow;
 
 /// The font every bitmap figure is drawn with (DejaVu Sans, bundled so that figures look the
 /// same on every machine and need no system font library). SVG files name `sans-serif`.
@@ -85,8 +85,7 @@ fn write_both(
     svg: impl FnOnce(Svg) -> Result<(), String>,
 ) -> Result<Vec<PathBuf>, FigureError> {
     register_font();
-    std::fs::create_dir_all(dir)
-        .map_err(|e| FigureError { path: dir.display().to_string(), reason: e.to_string() })?;
+    std::fs::create_dir_all(dir).map_err(|e| FigureError { path: dir.display().to_string(), reason: e.to_string() })?;
     let mut written = vec![];
     let (mut png, mut svg) = (Some(png), Some(svg));
     for ext in ["png", "svg"] {

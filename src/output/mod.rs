@@ -2,9 +2,9 @@
 //! of `--out DIR` (`series.csv`, `impacts.csv`, `summary.json`), each written atomically.
 
 pub mod figures;
-mod run_dir;
 pub mod parquet;
 pub mod plot;
+mod run_dir;
 
 use crate::metrics::{Noise, RunSummary};
 
@@ -12,10 +12,8 @@ pub use run_dir::{impacts_csv, series_csv, table_csv, write_run_dir};
 
 fn noise_line(n: &Noise) -> String {
     let Some(e) = n.energy_lost else { return "no impacts".into() };
-    let mut line = format!(
-        "{:.1} impacts/s; energy lost per impact mean {:.3e} J, p95 {:.3e} J, max {:.3e} J",
-        n.impact_rate, e.mean, e.p95, e.max
-    );
+    let mut line =
+        format!("{:.1} impacts/s; energy lost per impact mean {:.3e} J, p95 {:.3e} J, max {:.3e} J", n.impact_rate, e.mean, e.p95, e.max);
     if let Some(f) = n.peak_force {
         line += &format!("; peak force mean {:.1} N, p95 {:.1} N, max {:.1} N", f.mean, f.p95, f.max);
     }

@@ -86,23 +86,12 @@ impl Instant<'_> {
 
 /// Resolves the impacts of the touching pairs of `now` that approach faster than
 /// `threshold(pair)`, fastest first, each with Eq. 9-10; returns them in the order resolved.
-pub fn resolve_touching(
-    scene: &Scene,
-    now: &mut Instant<'_>,
-    threshold: impl Fn(usize) -> f64,
-    out: &mut Vec<PairImpact>,
-) {
+pub fn resolve_touching(scene: &Scene, now: &mut Instant<'_>, threshold: impl Fn(usize) -> f64, out: &mut Vec<PairImpact>) {
     resolve_touching_with(scene, scene.restitution, now, threshold, out)
 }
 
 /// [`resolve_touching`] with restitution `e` (0 holds the pairs together).
-pub fn resolve_touching_with(
-    scene: &Scene,
-    e: f64,
-    now: &mut Instant<'_>,
-    threshold: impl Fn(usize) -> f64,
-    out: &mut Vec<PairImpact>,
-) {
+pub fn resolve_touching_with(scene: &Scene, e: f64, now: &mut Instant<'_>, threshold: impl Fn(usize) -> f64, out: &mut Vec<PairImpact>) {
     out.clear();
     let n = now.n();
     let touching = |p: &usize| now.gap(scene, *p).is_some_and(|g| g <= TOUCHING);
@@ -198,9 +187,9 @@ pub fn write_velocities(
         lin.x = v_new[i] as f32;
         body.set_linvel(lin, true);
         v_new[i] = lin.x as f64; // what Rapier will carry on with
-        // bevy_rapier wrote the step's velocity into the ball's `Velocity` before this system
-        // ran, and in an app driven by `app.update()` it copies a changed `Velocity` back into
-        // the body at the next step: it must hold the corrected one.
+                                 // bevy_rapier wrote the step's velocity into the ball's `Velocity` before this system
+                                 // ran, and in an app driven by `app.update()` it copies a changed `Velocity` back into
+                                 // the body at the next step: it must hold the corrected one.
         if let Ok(mut velocity) = velocities.get_mut(balls[i]) {
             if velocity.linear != lin {
                 velocity.linear = lin;
@@ -217,10 +206,8 @@ mod tests {
 
     /// Three steel balls of `mass`, touching, in a container on a frame of `frame_mass`.
     fn touching_balls(masses: &[f64], e: f64, frame_mass: f64) -> Scene {
-        let balls: Vec<Ball> = masses
-            .iter()
-            .map(|&m| Ball { mass: m, radius: crate::scene::ball_radius(m, 8000.0), kind: BallKind::Custom })
-            .collect();
+        let balls: Vec<Ball> =
+            masses.iter().map(|&m| Ball { mass: m, radius: crate::scene::ball_radius(m, 8000.0), kind: BallKind::Custom }).collect();
         let mut x = 0.0;
         let positions = balls
             .iter()

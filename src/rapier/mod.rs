@@ -20,10 +20,13 @@ use bevy::prelude::*;
 use crate::model::{Checks, Meter, Model, ModelError, OverBudget, RunOptions, Setting, Simulator};
 use crate::run::{EnergyAccount, Record, Run};
 use crate::scene::Scene;
-pub use phases::plan::{APPROACH_RATIO, APPROACH_STEP, MIN_STEP, TOUCHING};
-pub use plugin::{integration_parameters, ContactPhysicsPlugin, DamperSchedulePlugin, DamperSet, DamperStep, FramePlugin, LpcDamperPlugins, RecordPlugin, SceneSpawnPlugin};
-pub use resources::{Bodies, DamperScene, FrameState, Recording, StepClock, StepPlan, StepSettings};
 pub use crate::scene::Stepping;
+pub use phases::plan::{APPROACH_RATIO, APPROACH_STEP, MIN_STEP, TOUCHING};
+pub use plugin::{
+    integration_parameters, ContactPhysicsPlugin, DamperSchedulePlugin, DamperSet, DamperStep, FramePlugin, LpcDamperPlugins, RecordPlugin,
+    SceneSpawnPlugin,
+};
+pub use resources::{Bodies, DamperScene, FrameState, Recording, StepClock, StepPlan, StepSettings};
 pub use settings::*;
 
 /// A headless app (no window, renderer or audio) simulating `scene`: one Rapier step per
@@ -103,7 +106,11 @@ pub fn simulate_with(scene: &Scene, settings: StepSettings, options: &RunOptions
         }
         if let Some(budget) = meter.look(clock.t, clock.steps) {
             let wall_s = meter.elapsed();
-            let cost = format!("{} impacts so far; the last step was {} s", world.resource::<Recording>().impacts.len(), crate::scene::human(world.resource::<StepPlan>().h));
+            let cost = format!(
+                "{} impacts so far; the last step was {} s",
+                world.resource::<Recording>().impacts.len(),
+                crate::scene::human(world.resource::<StepPlan>().h)
+            );
             let mut partial = collect(world, scene, clock.t, clock.steps);
             partial.wall_time_s = wall_s;
             return Err(ModelError::OverBudget(Box::new(OverBudget {
@@ -143,8 +150,7 @@ pub fn collect(world: &mut World, scene: &Scene, t: f64, steps: u64) -> Run {
     let frame = world.get_resource::<FrameState>().copied();
     let (xs, vs) = frame.map_or((0.0, 0.0), |f| f.now);
     let f = scene.frame;
-    let final_ = scene.frame_energy(t, xs, vs)
-        + scene.balls.iter().zip(&rec.v).map(|(b, v)| 0.5 * b.mass * v * v).sum::<f64>();
+    let final_ = scene.frame_energy(t, xs, vs) + scene.balls.iter().zip(&rec.v).map(|(b, v)| 0.5 * b.mass * v * v).sum::<f64>();
     let energy = EnergyAccount::forced(
         scene.initial_energy(),
         final_,

@@ -104,10 +104,7 @@ impl Plugin for ContactPhysicsPlugin {
             .add_systems(Update, plan_step.in_set(DamperSet::Plan))
             .add_systems(
                 DamperStep,
-                (
-                    plan_step.in_set(DamperSet::Plan),
-                    bevy_rapier3d::plugin::systems::step_simulation::<()>.in_set(DamperSet::Step),
-                ),
+                (plan_step.in_set(DamperSet::Plan), bevy_rapier3d::plugin::systems::step_simulation::<()>.in_set(DamperSet::Step)),
             );
     }
 }
@@ -169,10 +166,9 @@ impl Plugin for RecordPlugin {
         app.add_systems(Startup, move |commands: Commands, scene: Res<DamperScene>, settings: Res<StepSettings>| {
             init_recording(commands, scene, settings, record)
         })
-            .add_systems(PostUpdate, (feedback.in_set(DamperSet::Feedback), record_samples.in_set(DamperSet::Record)))
-            .add_systems(DamperStep, (feedback.in_set(DamperSet::Feedback), record_samples.in_set(DamperSet::Record)))
-            .add_systems(Update, resolve_impacts.in_set(DamperSet::Impacts))
-            .add_systems(DamperStep, resolve_impacts.in_set(DamperSet::Impacts));
+        .add_systems(PostUpdate, (feedback.in_set(DamperSet::Feedback), record_samples.in_set(DamperSet::Record)))
+        .add_systems(DamperStep, (feedback.in_set(DamperSet::Feedback), record_samples.in_set(DamperSet::Record)))
+        .add_systems(Update, resolve_impacts.in_set(DamperSet::Impacts))
+        .add_systems(DamperStep, resolve_impacts.in_set(DamperSet::Impacts));
     }
 }
-

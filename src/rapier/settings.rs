@@ -78,4 +78,3 @@ pub fn default_iterations(scene: &Scene) -> usize {
 pub fn neighbour_mass_ratio(scene: &Scene) -> f64 {
     scene.balls.windows(2).map(|w| (w[0].mass / w[1].mass).max(w[1].mass / w[0].mass)).fold(1.0, f64::max)
 }
-

@@ -78,4 +78,3 @@ pub fn spawn_scene(mut commands: Commands, scene: Res<DamperScene>, settings: Re
     }
     commands.insert_resource(bodies);
 }
-

@@ -73,7 +73,16 @@ impl Solver<'_> {
             }
         }
         self.ledger.last_impact[p] = Some(self.ledger.impacts.len());
-        self.ledger.impacts.push(Impact { t: self.t, a, b, approach_speed, energy_lost, impulses, peak_force: None, contact_duration: None });
+        self.ledger.impacts.push(Impact {
+            t: self.t,
+            a,
+            b,
+            approach_speed,
+            energy_lost,
+            impulses,
+            peak_force: None,
+            contact_duration: None,
+        });
     }
 
     /// An impact with restitution `e` across pair `p`.
@@ -122,8 +131,7 @@ impl Solver<'_> {
         let reaches_left = lo == 0 || self.balls.hold[lo - 1] != Hold::Free;
         let reaches_right = hi == self.balls.n || self.balls.hold[hi] != Hold::Free;
         let with_frame = self.has_frame() && self.balls.walls && (reaches_left || reaches_right);
-        let balls: Vec<usize> =
-            (lo.saturating_sub(1)..(hi + 1).min(self.balls.n)).filter(|&i| self.balls.hold[i] == Hold::Free).collect();
+        let balls: Vec<usize> = (lo.saturating_sub(1)..(hi + 1).min(self.balls.n)).filter(|&i| self.balls.hold[i] == Hold::Free).collect();
         let (_, vs, _) = self.frame.now(self.t);
         let group = self.frame.mass + self.frame.held_mass;
         let (mut pm, mut m) = (0.0, 0.0);

@@ -49,9 +49,6 @@ pub(super) struct Scratch {
 }
 
 impl Solver<'_> {
-
-
-
     /// Gap and its rate for a ball-frame pair at time `t` (the ball flies from `self.t`).
     #[inline(always)]
     pub(super) fn frame_gap_at(&self, ball: usize, s: f64, k: f64, t: f64) -> (f64, f64) {
@@ -165,6 +162,4 @@ impl Solver<'_> {
     pub(super) fn pair_bodies(&self, p: usize) -> (Body, Body) {
         crate::scene::pair_bodies(p, self.balls.n)
     }
-
-
 }

@@ -29,12 +29,12 @@ use output::Sampler;
 use search::Search;
 use segment::{Segment, Zeros};
 
-use crate::model::{Budget, Checks, Meter, Model, ModelError, OverBudget, RunOptions, Setting, Simulator};
-use crate::run::{EnergyAccount, Impact, Record, Recorder, Run};
-use crate::scene::{Body, Scene};
 pub use crate::impact_law::impact_law;
+use crate::model::{Budget, Checks, Meter, Model, ModelError, OverBudget, RunOptions, Setting, Simulator};
 pub use crate::oscillator::Oscillator;
 use crate::oscillator::{gauss_legendre, Harmonic, ROUNDOFF_ULPS};
+use crate::run::{EnergyAccount, Impact, Record, Recorder, Run};
+use crate::scene::{Body, Scene};
 
 /// Most events one run may process before it is declared stalled.
 pub const MAX_EVENTS: u64 = 20_000_000;

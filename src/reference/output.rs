@@ -80,7 +80,10 @@ impl Solver<'_> {
         let ends = [(xs, vs), self.frame.state(until)];
         let Some(exact) = &mut self.sampler.exact else { return };
         let free_energy = if exact.wants_energy() {
-            (0..self.balls.n).filter(|&i| self.balls.hold[i] == Hold::Free).map(|i| 0.5 * self.balls.mass[i] * self.balls.v[i] * self.balls.v[i]).sum()
+            (0..self.balls.n)
+                .filter(|&i| self.balls.hold[i] == Hold::Free)
+                .map(|i| 0.5 * self.balls.mass[i] * self.balls.v[i] * self.balls.v[i])
+                .sum()
         } else {
             0.0
         };
@@ -140,8 +143,7 @@ impl Solver<'_> {
             self.book_segment_energy();
         }
         let (_, vs) = if self.has_frame() { self.frame.seg.state(self.t) } else { (0.0, 0.0) };
-        let final_velocities =
-            (0..self.balls.n).map(|i| if self.balls.hold[i] == Hold::Free { self.balls.v[i] } else { vs }).collect();
+        let final_velocities = (0..self.balls.n).map(|i| if self.balls.hold[i] == Hold::Free { self.balls.v[i] } else { vs }).collect();
         let energy = EnergyAccount::forced(
             self.scene.initial_energy(),
             self.mechanical_energy(),

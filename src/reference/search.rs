@@ -76,11 +76,7 @@ impl Solver<'_> {
             // The sign just after `a` holds over the whole piece; judged as `resolve` judges it,
             // so that the two agree even where the acceleration is round-off (a frame at rest).
             let curvature = -s * self.frame.accel_ahead(a);
-            let root = if curvature >= 0.0 {
-                self.convex_root(ball, s, k, a, b)
-            } else {
-                self.concave_root(ball, s, k, a, b)
-            };
+            let root = if curvature >= 0.0 { self.convex_root(ball, s, k, a, b) } else { self.concave_root(ball, s, k, a, b) };
             if let Some(t) = root {
                 return Candidate { t, exact: true };
             }

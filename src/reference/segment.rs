@@ -91,7 +91,8 @@ impl Segment {
         let reach = if forced.is_none() { osc.envelope(x0, v0) } else { None };
         let mut seg = Segment { t0, x0, v0, a0, j0, osc, forced, phases: [None; 3], reach };
         if osc.damped_omega().is_some() {
-            let which: &[Zeros] = if forced.is_none() { &[Zeros::Acceleration, Zeros::Velocity, Zeros::Jerk] } else { &[Zeros::Acceleration] };
+            let which: &[Zeros] =
+                if forced.is_none() { &[Zeros::Acceleration, Zeros::Velocity, Zeros::Jerk] } else { &[Zeros::Acceleration] };
             for &z in which {
                 let (y0, y1) = seg.initial(z);
                 seg.phases[z as usize] = osc.zero_phase(y0, y1);
@@ -231,7 +232,9 @@ impl Segment {
         let snap0 = next(self.a0, self.j0);
         let mut err = [o.roundoff(self.a0, self.j0, tau), o.roundoff(self.j0, snap0, tau), 0.0, 0.0, 0.0];
         for k in 2..5 {
-            err[k] = 2.0 * o.sigma * err[k - 1] + o.w0sq * err[k - 2] + 4.0 * eps * (2.0 * o.sigma * free[k - 1].abs() + o.w0sq * free[k - 2].abs());
+            err[k] = 2.0 * o.sigma * err[k - 1]
+                + o.w0sq * err[k - 2]
+                + 4.0 * eps * (2.0 * o.sigma * free[k - 1].abs() + o.w0sq * free[k - 2].abs());
         }
         // The values' own round-off at each end.
         let (y0, y1) = if order == 0 { (self.a0, self.j0) } else { (self.j0, snap0) };

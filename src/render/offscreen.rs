@@ -101,10 +101,7 @@ fn app_for(scene: &Scene, run: Run, size: (u32, u32)) -> Result<(App, Handle<Ima
                 Camera3d::default(),
                 // An analytic tone mapper: the default one needs lookup-table features.
                 Tonemapping::AcesFitted,
-                Camera {
-                    clear_color: ClearColorConfig::Custom(Color::srgb_u8(BACKGROUND[0], BACKGROUND[1], BACKGROUND[2])),
-                    ..default()
-                },
+                Camera { clear_color: ClearColorConfig::Custom(Color::srgb_u8(BACKGROUND[0], BACKGROUND[1], BACKGROUND[2])), ..default() },
                 RenderTarget::Image(target.clone().into()),
                 layout.camera(),
             ));

@@ -46,7 +46,11 @@ impl Layout {
             || {
                 let (lo, hi) = scene.initial_positions.iter().fold((f64::MAX, f64::MIN), |(a, b), &x| (a.min(x), b.max(x)));
                 // No balls at all: an empty stretch of a few radii, not `MIN - MAX`.
-                if lo <= hi { (hi - lo) as f32 + 4.0 * radius } else { 4.0 * radius }
+                if lo <= hi {
+                    (hi - lo) as f32 + 4.0 * radius
+                } else {
+                    4.0 * radius
+                }
             },
             |c| c.length as f32,
         );
@@ -164,7 +168,12 @@ pub fn spawn_stage(
     layout: &Layout,
 ) {
     let l = *layout;
-    let steel = materials.add(StandardMaterial { base_color: Color::srgb(0.42, 0.44, 0.48), metallic: 0.3, perceptual_roughness: 0.5, ..default() });
+    let steel = materials.add(StandardMaterial {
+        base_color: Color::srgb(0.42, 0.44, 0.48),
+        metallic: 0.3,
+        perceptual_roughness: 0.5,
+        ..default()
+    });
     let ground = materials.add(StandardMaterial { base_color: Color::srgb(0.62, 0.6, 0.56), perceptual_roughness: 0.95, ..default() });
     let glass = materials.add(StandardMaterial {
         base_color: Color::srgba(0.75, 0.88, 1.0, 0.16),
@@ -195,7 +204,12 @@ pub fn spawn_stage(
     let platform_y = l.column_height + 0.5 * l.platform;
     frame_part(commands, meshes.add(Cuboid::new(span, l.platform, depth * 1.4)), steel.clone(), Vec3::new(0.5 * l.length, platform_y, 0.0));
     let floor_y = l.column_height + l.platform + 0.5 * l.wall;
-    frame_part(commands, meshes.add(Cuboid::new(l.length + 2.0 * l.wall, l.wall, depth)), steel.clone(), Vec3::new(0.5 * l.length, floor_y, 0.0));
+    frame_part(
+        commands,
+        meshes.add(Cuboid::new(l.length + 2.0 * l.wall, l.wall, depth)),
+        steel.clone(),
+        Vec3::new(0.5 * l.length, floor_y, 0.0),
+    );
     let height = 2.4 * l.radius;
     let wall_y = l.column_height + l.platform + l.wall + 0.5 * height;
     for (body, x) in [(Body::LeftWall, -0.5 * l.wall), (Body::RightWall, l.length + 0.5 * l.wall)] {
@@ -204,9 +218,24 @@ pub fn spawn_stage(
         commands.entity(id).insert(WallMesh(body));
     }
     // The see-through box: front, back and lid (the end walls are drawn opaque).
-    frame_part(commands, meshes.add(Cuboid::new(l.length, height, 0.02 * l.radius)), glass.clone(), Vec3::new(0.5 * l.length, wall_y, 0.5 * depth));
-    frame_part(commands, meshes.add(Cuboid::new(l.length, height, 0.02 * l.radius)), glass.clone(), Vec3::new(0.5 * l.length, wall_y, -0.5 * depth));
-    frame_part(commands, meshes.add(Cuboid::new(l.length, 0.02 * l.radius, depth)), glass, Vec3::new(0.5 * l.length, wall_y + 0.5 * height, 0.0));
+    frame_part(
+        commands,
+        meshes.add(Cuboid::new(l.length, height, 0.02 * l.radius)),
+        glass.clone(),
+        Vec3::new(0.5 * l.length, wall_y, 0.5 * depth),
+    );
+    frame_part(
+        commands,
+        meshes.add(Cuboid::new(l.length, height, 0.02 * l.radius)),
+        glass.clone(),
+        Vec3::new(0.5 * l.length, wall_y, -0.5 * depth),
+    );
+    frame_part(
+        commands,
+        meshes.add(Cuboid::new(l.length, 0.02 * l.radius, depth)),
+        glass,
+        Vec3::new(0.5 * l.length, wall_y + 0.5 * height, 0.0),
+    );
 
     let sphere = meshes.add(Sphere::new(1.0).mesh().uv(48, 24));
     for (i, b) in scene.balls.iter().enumerate() {
@@ -227,10 +256,19 @@ pub fn spawn_stage(
 }
 
 /// The balls' meshes, posed by [`pose`].
-type BallParts<'w, 's> = Query<'w, 's, (&'static BallMesh, &'static mut Transform, &'static MeshMaterial3d<StandardMaterial>), (Without<FramePart>, Without<Column>)>;
+type BallParts<'w, 's> = Query<
+    'w,
+    's,
+    (&'static BallMesh, &'static mut Transform, &'static MeshMaterial3d<StandardMaterial>),
+    (Without<FramePart>, Without<Column>),
+>;
 /// The frame's parts (walls, floor), posed by [`pose`].
-type FrameParts<'w, 's> =
-    Query<'w, 's, (&'static FramePart, &'static mut Transform, Option<&'static WallMesh>, &'static MeshMaterial3d<StandardMaterial>), (Without<BallMesh>, Without<Column>)>;
+type FrameParts<'w, 's> = Query<
+    'w,
+    's,
+    (&'static FramePart, &'static mut Transform, Option<&'static WallMesh>, &'static MeshMaterial3d<StandardMaterial>),
+    (Without<BallMesh>, Without<Column>),
+>;
 /// The columns the frame stands on, posed by [`pose`].
 type Columns<'w, 's> = Query<'w, 's, (&'static Column, &'static mut Transform), (Without<BallMesh>, Without<FramePart>)>;
 

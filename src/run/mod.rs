@@ -72,11 +72,9 @@ impl std::fmt::Display for Model {
 impl std::str::FromStr for Model {
     type Err = String;
     fn from_str(s: &str) -> Result<Self, String> {
-        Model::ALL
-            .iter()
-            .copied()
-            .find(|m| m.name() == s)
-            .ok_or_else(|| format!("unknown model `{s}`; choose one of {}", Model::ALL.iter().map(|m| m.name()).collect::<Vec<_>>().join(", ")))
+        Model::ALL.iter().copied().find(|m| m.name() == s).ok_or_else(|| {
+            format!("unknown model `{s}`; choose one of {}", Model::ALL.iter().map(|m| m.name()).collect::<Vec<_>>().join(", "))
+        })
     }
 }
 
@@ -206,4 +204,3 @@ impl Run {
         }
     }
 }
-

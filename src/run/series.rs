@@ -85,12 +85,7 @@ impl Recorder {
     fn thinned(scene: &Scene, record: Record, every: usize) -> Self {
         let series = (record == Record::Series)
             .then(|| Series { every, ..Series::with_capacity(scene.balls.len(), scene.sample_count().div_ceil(every)) });
-        Recorder {
-            series,
-            taken: 0,
-            tally: Some(SampleTally::new(scene)),
-            masses: scene.balls.iter().map(|b| b.mass).collect(),
-        }
+        Recorder { series, taken: 0, tally: Some(SampleTally::new(scene)), masses: scene.balls.iter().map(|b| b.mass).collect() }
     }
     /// This recorder keeping the series only: for a model that computes the metrics itself
     /// (the reference, exactly, in free vibration).

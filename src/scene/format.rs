@@ -269,8 +269,7 @@ impl TryFrom<LengthRepr> for Length {
         match r {
             LengthRepr::Number(x) => Ok(Length::Metres(x)),
             LengthRepr::Int(i) => Ok(Length::Metres(i as f64)),
-            LengthRepr::Text(s) => parse_rr(&s)
-                .ok_or_else(|| format!("`{s}` is not a length: write metres as a number or `<k> Rr`")),
+            LengthRepr::Text(s) => parse_rr(&s).ok_or_else(|| format!("`{s}` is not a length: write metres as a number or `<k> Rr`")),
         }
     }
 }

@@ -105,13 +105,7 @@ impl Scene {
     /// Initial mechanical energy: spring energy plus balls' kinetic energy.
     pub fn initial_energy(&self) -> f64 {
         let spring = self.frame.map_or(0.0, |f| f.energy(self.initial_displacement, 0.0));
-        spring
-            + self
-                .balls
-                .iter()
-                .zip(&self.initial_velocities)
-                .map(|(b, v)| 0.5 * b.mass * v * v)
-                .sum::<f64>()
+        spring + self.balls.iter().zip(&self.initial_velocities).map(|(b, v)| 0.5 * b.mass * v * v).sum::<f64>()
     }
 
     /// The fastest motion the scene sets going, m/s: the frame's free swing from its initial
@@ -254,16 +248,15 @@ pub struct ChainCase {
 pub fn load(path: impl AsRef<Path>) -> Result<Loaded, SceneError> {
     let path = path.as_ref();
     let file_name = path.display().to_string();
-    let text = std::fs::read_to_string(path)
-        .map_err(|e| SceneError::Io { file: file_name.clone(), message: e.to_string() })?;
+    let text = std::fs::read_to_string(path).map_err(|e| SceneError::Io { file: file_name.clone(), message: e.to_string() })?;
     let stem = path.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_default();
     parse(&text, &file_name, &stem)
 }
 
 /// Parses and validates scene text; `file` names it in errors, `default_name` names the scene.
 pub fn parse(text: &str, file: &str, default_name: &str) -> Result<Loaded, SceneError> {
-    let parsed: SceneFile = toml::from_str(text)
-        .map_err(|e| SceneError::Parse { file: file.into(), message: e.to_string().trim_end().to_string() })?;
+    let parsed: SceneFile =
+        toml::from_str(text).map_err(|e| SceneError::Parse { file: file.into(), message: e.to_string().trim_end().to_string() })?;
     from_file(parsed, file, default_name)
 }
 

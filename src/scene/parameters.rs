@@ -120,7 +120,12 @@ impl Parameter {
                     g.frequency = x;
                 }
             }
-            Parameter::Clearance | Parameter::Gap | Parameter::MassRatio | Parameter::Restitution | Parameter::LargeMass | Parameter::Density => {
+            Parameter::Clearance
+            | Parameter::Gap
+            | Parameter::MassRatio
+            | Parameter::Restitution
+            | Parameter::LargeMass
+            | Parameter::Density => {
                 let balls = f.balls.as_mut().ok_or("needs a [balls] table")?;
                 match self {
                     Parameter::Clearance => {

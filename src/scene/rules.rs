@@ -42,16 +42,12 @@ pub fn from_file(parsed: SceneFile, file: &str, default_name: &str) -> Result<Lo
             .chain(second.map(|(p, values)| ("sweep.parameter_y", "sweep.values_y", p, values)));
         for (parameter_field, values_field, parameter, values) in axes {
             for (i, value) in values.iter().enumerate() {
-                let varied = parameter
-                    .parse::<Parameter>()
-                    .and_then(|p| p.apply(&parsed, *value))
-                    .map_err(|rule| v.err(parameter_field, &rule))?;
+                let varied =
+                    parameter.parse::<Parameter>().and_then(|p| p.apply(&parsed, *value)).map_err(|rule| v.err(parameter_field, &rule))?;
                 build_damper(&varied, &name, &v).map_err(|e| match e {
-                    SceneError::Invalid { file, field, rule } => SceneError::Invalid {
-                        file,
-                        field: format!("{values_field}[{i}] (as {field})"),
-                        rule,
-                    },
+                    SceneError::Invalid { file, field, rule } => {
+                        SceneError::Invalid { file, field: format!("{values_field}[{i}] (as {field})"), rule }
+                    }
                     other => other,
                 })?;
             }
@@ -125,11 +121,7 @@ pub fn validate_sample_dt(horizon: f64, dt: f64) -> Result<(), String> {
         return Err(format!("must be a positive finite step (got {})", human(dt)));
     }
     if dt > horizon {
-        return Err(format!(
-            "({} s) is longer than the horizon ({} s): no sample would be written",
-            human(dt),
-            human(horizon)
-        ));
+        return Err(format!("({} s) is longer than the horizon ({} s): no sample would be written", human(dt), human(horizon)));
     }
     if horizon / dt > MAX_SAMPLES {
         return Err(format!(
@@ -207,17 +199,16 @@ pub(super) fn build_damper(f: &SceneFile, name: &str, v: &Validator) -> Result<S
             if lc < 0.0 {
                 return Err(v.err(
                     "balls.container_length",
-                    &format!(
-                        "is {le} m but the balls and gaps need {} m: the balls cannot fit",
-                        n * gap + sum_d
-                    ),
+                    &format!("is {le} m but the balls and gaps need {} m: the balls cannot fit", n * gap + sum_d),
                 ));
             }
             (le, lc)
         }
     };
     if !length.is_finite() {
-        return Err(v.err("balls.gap", &format!("and the clearance make the container {} m long, more than a number can hold", human(length))));
+        return Err(
+            v.err("balls.gap", &format!("and the clearance make the container {} m long, more than a number can hold", human(length)))
+        );
     }
     let mut positions = Vec::with_capacity(balls.len());
     let mut x = xs0 + gap;
@@ -326,7 +317,11 @@ pub(super) fn arrangement_balls(
     if let Some(b) = balls.iter().find(|b| !(b.mass.is_normal() && b.radius.is_normal())) {
         return Err(v.err(
             field,
-            &format!("has a ball of mass {} kg and radius {} m (from its density): not a size a number can hold", human(b.mass), human(b.radius)),
+            &format!(
+                "has a ball of mass {} kg and radius {} m (from its density): not a size a number can hold",
+                human(b.mass),
+                human(b.radius)
+            ),
         ));
     }
     Ok(balls)
@@ -431,4 +426,3 @@ pub(super) fn tolerances(t: &format::TolerancesFile, parsed: &SceneFile, scene: 
     }
     Ok(Tolerances { spreads, distribution: t.distribution, seed: t.seed.unwrap_or(1) })
 }
-

@@ -71,7 +71,9 @@ impl Plan {
                     match setting {
                         Setting::Stepping => self.steppings.iter().map(|&x| Overrides { stepping: Some(x), ..v }).collect(),
                         Setting::Dt => self.dts.iter().map(|&x| Overrides { dt: Some(x), ..v }).collect(),
-                        Setting::SolverIterations => self.solver_iterations.iter().map(|&x| Overrides { solver_iterations: Some(x), ..v }).collect(),
+                        Setting::SolverIterations => {
+                            self.solver_iterations.iter().map(|&x| Overrides { solver_iterations: Some(x), ..v }).collect()
+                        }
                         Setting::Tolerance => self.tolerances.iter().map(|&x| Overrides { tolerance: Some(x), ..v }).collect(),
                     }
                 })
@@ -138,9 +140,7 @@ pub fn mark_pareto(rows: &mut [BenchRow]) {
         .iter()
         .enumerate()
         .map(|(i, &(s, m, c, e))| {
-            !key.iter().enumerate().any(|(j, &(sj, mj, cj, ej))| {
-                j != i && sj == s && mj == m && cj <= c && ej <= e && (cj < c || ej < e)
-            })
+            !key.iter().enumerate().any(|(j, &(sj, mj, cj, ej))| j != i && sj == s && mj == m && cj <= c && ej <= e && (cj < c || ej < e))
         })
         .collect();
     for (row, f) in rows.iter_mut().zip(front) {

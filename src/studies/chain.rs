@@ -4,7 +4,7 @@
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
-use crate::model::{RunOptions, Model, ModelError};
+use crate::model::{Model, ModelError, RunOptions};
 use crate::run::Run;
 use crate::scene::{ChainCase, Scene};
 

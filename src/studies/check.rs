@@ -20,10 +20,10 @@ use std::path::{Path, PathBuf};
 use serde::{Deserialize, Serialize};
 
 use super::StudyError;
-use crate::studies::chain::{run_chain, KerRow};
 use crate::metrics::{metrics, Headline, Metric, Metrics};
 use crate::model::{Model, RunOptions};
 use crate::scene;
+use crate::studies::chain::{run_chain, KerRow};
 use crate::studies::sweep::sweep_scenes;
 
 /// What is kept of one run.
@@ -59,7 +59,6 @@ pub struct Row {
     /// Within tolerance.
     pub ok: bool,
 }
-
 
 /// Runs every case of every scene file in `dir` with every model.
 pub fn current(dir: &Path, models: &[Model]) -> Result<Vec<Golden>, StudyError> {

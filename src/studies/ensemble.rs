@@ -11,8 +11,8 @@ use rand_pcg::Pcg64;
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
-use crate::model::{RunOptions, Model, ModelError};
 use crate::metrics::{Headline, Metric};
+use crate::model::{Model, ModelError, RunOptions};
 use crate::run::{refuse_beyond_memory, Record};
 use crate::scene::{self, Distribution, Length, Parameter, Scene, SceneError, SceneFile, Tolerances};
 
@@ -115,8 +115,7 @@ pub fn draw_range(
     base.sweep = None;
     base.tolerances = None;
     let drawer = Drawer { base, path, nominal, spreads, normal };
-    let drawn: Vec<(Member, Vec<Failure>)> =
-        range.into_par_iter().map(|k| drawer.member(seed, k)).collect::<Result<_, _>>()?;
+    let drawn: Vec<(Member, Vec<Failure>)> = range.into_par_iter().map(|k| drawer.member(seed, k)).collect::<Result<_, _>>()?;
     let redraws: u64 = drawn.iter().map(|d| d.1.len() as u64).sum();
     if redraws > count as u64 {
         let mut blame: BTreeMap<Parameter, (usize, &str)> = BTreeMap::new();
@@ -309,7 +308,10 @@ fn shift_gaps(scene: &mut Scene, deviation: &[f64]) -> Result<Vec<f64>, Failure>
     let gaps: Vec<f64> = deviation.iter().map(|d| container.gap + d).collect();
     let clearance = container.clearance - deviation.iter().sum::<f64>();
     if let Some((i, g)) = gaps.iter().enumerate().find(|(_, g)| **g < 0.0) {
-        return Err(Failure { parameter: Parameter::Gap, rule: format!("gap {} of {} m overlaps its neighbours", i + 1, scene::human(*g)) });
+        return Err(Failure {
+            parameter: Parameter::Gap,
+            rule: format!("gap {} of {} m overlaps its neighbours", i + 1, scene::human(*g)),
+        });
     }
     if clearance < 0.0 {
         return Err(Failure {
@@ -356,12 +358,7 @@ pub struct EnsembleRuns {
 
 /// Runs every member with `model`. Members build no series unless `keep_xs`, which keeps each
 /// member's frame displacement (the ensemble's band) and drops the rest.
-pub fn run_members(
-    ensemble: &Ensemble,
-    model: Model,
-    keep_xs: bool,
-    progress: &(dyn Fn() + Sync),
-) -> Result<EnsembleRuns, ModelError> {
+pub fn run_members(ensemble: &Ensemble, model: Model, keep_xs: bool, progress: &(dyn Fn() + Sync)) -> Result<EnsembleRuns, ModelError> {
     let record = if keep_xs { Record::Series } else { Record::MetricsOnly };
     if keep_xs {
         if let Some(first) = ensemble.members.first() {
@@ -522,11 +519,7 @@ impl EnsembleSummary {
 
 /// Each metric's distribution over `metrics` (`[member][metric]`, [`Metric::ALL`] order).
 pub fn metric_stats(metrics: &[Vec<Option<f64>>]) -> BTreeMap<String, Stats> {
-    Metric::ALL
-        .iter()
-        .enumerate()
-        .map(|(j, metric)| (metric.name().to_string(), Stats::of(metrics.iter().map(|m| m[j]))))
-        .collect()
+    Metric::ALL.iter().enumerate().map(|(j, metric)| (metric.name().to_string(), Stats::of(metrics.iter().map(|m| m[j])))).collect()
 }
 
 /// Each metric's `q` quantile over the members that define it (`None` when none does).

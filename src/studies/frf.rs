@@ -18,10 +18,10 @@
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
-use crate::model::{RunOptions, Model, ModelError};
-use crate::studies::ensemble::{Member, Stats};
+use crate::model::{Model, ModelError, RunOptions};
 use crate::run::Run;
 use crate::scene::Scene;
+use crate::studies::ensemble::{Member, Stats};
 
 /// Forcing periods per block of peaks.
 pub const BLOCK_PERIODS: usize = 10;
@@ -193,9 +193,8 @@ pub fn check_ensemble_memory(members: usize, frequencies: usize) -> Result<(), S
 /// as [`frf`] runs the nominal scene (the horizon doubling until steady, or to its limit),
 /// every run in parallel.
 pub fn frf_ensemble(members: &[Member], frequencies: &[f64], model: Model, progress: &(dyn Fn() + Sync)) -> Vec<FrfBand> {
-    let jobs: Vec<(usize, usize, bool)> = (0..frequencies.len())
-        .flat_map(|k| (0..members.len()).flat_map(move |m| [(k, m, true), (k, m, false)]))
-        .collect();
+    let jobs: Vec<(usize, usize, bool)> =
+        (0..frequencies.len()).flat_map(|k| (0..members.len()).flat_map(move |m| [(k, m, true), (k, m, false)])).collect();
     let results: Vec<Result<(Vec<f64>, SteadyState), ModelError>> = jobs
         .par_iter()
         .map(|&(k, m, damper)| {
@@ -271,10 +270,7 @@ pub fn frf(scene: &Scene, frequencies: &[f64], model: Model, progress: &(dyn Fn(
         .enumerate()
         .map(|(k, &frequency)| {
             let (with, without) = (&results[2 * k], &results[2 * k + 1]);
-            let error = [with, without]
-                .iter()
-                .find_map(|r| r.as_ref().err())
-                .map(|e| e.to_string());
+            let error = [with, without].iter().find_map(|r| r.as_ref().err()).map(|e| e.to_string());
             FrfPoint {
                 frequency,
                 amplitude: with.as_ref().ok().map(|(r, _)| r.amplitude),

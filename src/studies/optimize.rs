@@ -11,10 +11,10 @@ use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
 use super::StudyError;
-use crate::studies::frf;
 use crate::model::{Model, RunOptions};
 use crate::scene::{self, Arrangement, Length, Loaded, Parameter, Scene, SceneError};
 use crate::studies::ensemble;
+use crate::studies::frf;
 use crate::studies::sweep::Axis;
 
 /// Points per axis in each refinement.
@@ -83,7 +83,6 @@ pub struct Robust {
     /// The quantile ranked by.
     pub quantile: f64,
 }
-
 
 /// How designs are judged.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -166,9 +165,9 @@ pub fn optimize(
             && a.values.iter().zip(&b.values).all(|((_, x), (_, y))| (x - y).abs() <= 1e-9 * x.abs().max(y.abs()))
     };
     all.sort_by(|a, b| {
-        cmp(a, b).then_with(|| a.arrangement.cmp(&b.arrangement)).then_with(|| {
-            a.values.iter().map(|v| v.1).partial_cmp(b.values.iter().map(|v| v.1)).unwrap_or(std::cmp::Ordering::Equal)
-        })
+        cmp(a, b)
+            .then_with(|| a.arrangement.cmp(&b.arrangement))
+            .then_with(|| a.values.iter().map(|v| v.1).partial_cmp(b.values.iter().map(|v| v.1)).unwrap_or(std::cmp::Ordering::Equal))
     });
     all.dedup_by(|a, b| same(a, b));
     let mut distinguishable = None;
@@ -212,10 +211,11 @@ fn evaluate(
         .map(|point| {
             let mut f = file.clone();
             for (axis, value) in axes.iter().zip(point) {
-                f = axis
-                    .parameter
-                    .apply(&f, *value)
-                    .map_err(|rule| SceneError::Invalid { file: loaded.path.clone(), field: axis.parameter.to_string(), rule })?;
+                f = axis.parameter.apply(&f, *value).map_err(|rule| SceneError::Invalid {
+                    file: loaded.path.clone(),
+                    field: axis.parameter.to_string(),
+                    rule,
+                })?;
             }
             // A design whose balls do not fit is infeasible, not an error.
             let Ok(valid) = scene::from_file(f.clone(), &loaded.path, &name) else {
@@ -228,9 +228,7 @@ fn evaluate(
             };
             let objective_of = |scene: &Scene| -> Result<Option<f64>, StudyError> {
                 Ok(match objective {
-                    Objective::SettlingTime => {
-                        crate::metrics::metrics(&model.simulate(scene, &RunOptions::metrics_only())?).settling_time
-                    }
+                    Objective::SettlingTime => crate::metrics::metrics(&model.simulate(scene, &RunOptions::metrics_only())?).settling_time,
                     Objective::ResonantAmplitude { from, to, steps } => {
                         let mut worst: f64 = 0.0;
                         for f in frf::frequencies(from, to, steps) {

@@ -136,15 +136,7 @@ pub fn cell(case: Case, config: Config, dt: f64, speed: f64) -> Cell {
             }
         }
     };
-    Cell {
-        case,
-        config: config.name,
-        dt,
-        speed,
-        travel_per_step: speed * dt / scene.balls[0].radius,
-        outcome,
-        energy_error,
-    }
+    Cell { case, config: config.name, dt, speed, travel_per_step: speed * dt / scene.balls[0].radius, outcome, energy_error }
 }
 
 /// The whole map: every case, configuration, step and speed (in parallel).

@@ -134,14 +134,16 @@ pub fn random_scene_file(seed: u64, max_horizon: f64, forced: bool) -> SceneFile
     let xs0 = rng.random_range(0.0..=10.0) * clearance.max(0.1) * if rng.random_bool(0.5) { 1.0 } else { -1.0 };
     let horizon = log_uniform(&mut rng, 0.05, max_horizon.max(0.06));
     let mass_ratio = log_uniform(&mut rng, 1.0, 1000.0);
-    let restitution = if rng.random_bool(0.1) { 0.0 } else if rng.random_bool(0.1) { 1.0 } else { rng.random_range(0.0..=1.0) };
+    let restitution = if rng.random_bool(0.1) {
+        0.0
+    } else if rng.random_bool(0.1) {
+        1.0
+    } else {
+        rng.random_range(0.0..=1.0)
+    };
     let forcing = forced.then(|| {
         let kind = if free || rng.random_bool(0.5) { ForcingKind::Force } else { ForcingKind::Base };
-        let frequency = if free {
-            log_uniform(&mut rng, 1.0, 100.0) / horizon
-        } else {
-            log_uniform(&mut rng, 0.1, 10.0) / period
-        };
+        let frequency = if free { log_uniform(&mut rng, 1.0, 100.0) / horizon } else { log_uniform(&mut rng, 0.1, 10.0) / period };
         // The bare frame's steady amplitude X as a multiple of the free travel (in metres:
         // the large ball's radius is what Rr stands for).
         let rr = crate::scene::ball_radius(0.11, 8000.0);
@@ -198,11 +200,8 @@ pub fn judge_run(model: Model, scene: &Scene, max_wall_s: Option<f64>) -> Result
     let outcome = catch_unwind(AssertUnwindSafe(|| model.simulate(scene, &options)));
     let run = match outcome {
         Err(panic) => {
-            let msg = panic
-                .downcast_ref::<String>()
-                .cloned()
-                .or_else(|| panic.downcast_ref::<&str>().map(|s| s.to_string()))
-                .unwrap_or_default();
+            let msg =
+                panic.downcast_ref::<String>().cloned().or_else(|| panic.downcast_ref::<&str>().map(|s| s.to_string())).unwrap_or_default();
             return Err(Failure { check: "panic", detail: msg });
         }
         Ok(Ok(run)) => run,
@@ -222,7 +221,6 @@ pub fn judge_run(model: Model, scene: &Scene, max_wall_s: Option<f64>) -> Result
     judge(model, scene, &run)?;
     Ok(Passed::Run(Box::new(run)))
 }
-
 
 /// The checks of a run of `model` on `scene` (see the module docs).
 pub fn judge(model: Model, scene: &Scene, run: &Run) -> Result<(), Failure> {
@@ -324,10 +322,7 @@ fn forced_energy_scale(scene: &Scene) -> f64 {
 
 /// The damper scene of `file`, or why the scene's rules reject it.
 fn validate(file: &SceneFile) -> Result<Scene, String> {
-    scene::from_file(file.clone(), "stress", "stress")
-        .map_err(|e| e.to_string())?
-        .scene
-        .ok_or_else(|| "no damper scene".to_string())
+    scene::from_file(file.clone(), "stress", "stress").map_err(|e| e.to_string())?.scene.ok_or_else(|| "no damper scene".to_string())
 }
 
 /// Smaller and simpler variants of a scene file, for shrinking.
@@ -423,9 +418,8 @@ pub fn stress(model: Model, seed: u64, count: u64, draws: Draws, progress: &(dyn
                 Err(f) => (Some(f), None, false, None),
             };
             let wall_s = start.elapsed().as_secs_f64();
-            let minimal_scene = failure
-                .as_ref()
-                .map(|f| toml::to_string(&shrink(model, &file, f.check, draws.max_wall_s)).unwrap_or_default());
+            let minimal_scene =
+                failure.as_ref().map(|f| toml::to_string(&shrink(model, &file, f.check, draws.max_wall_s)).unwrap_or_default());
             progress();
             outcome(failure, minimal_scene, refused, refused_during_run, stopped, wall_s)
         })

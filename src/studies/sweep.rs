@@ -5,8 +5,8 @@
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
-use crate::model::{RunOptions, Model, ModelError};
 use crate::metrics::{Headline, Metric, RunSummary};
+use crate::model::{Model, ModelError, RunOptions};
 use crate::scene::{self, Length, Loaded, Parameter, Scene, SceneError};
 
 /// Where a point of a sweep lies (the first fields of `lpc sweep`'s JSON).
@@ -108,8 +108,7 @@ pub fn tidy(x: f64) -> f64 {
 /// Parses `PARAM=V1,V2,...` or `PARAM=A..B:N` (N values evenly spaced; lengths may carry
 /// `Rr`, as `0.5Rr..3Rr:6`).
 pub fn parse_axis(text: &str) -> Result<Axis, String> {
-    let (parameter, values) =
-        text.split_once('=').ok_or_else(|| format!("`{text}`: write `PARAM=V1,V2,...` or `PARAM=A..B:N`"))?;
+    let (parameter, values) = text.split_once('=').ok_or_else(|| format!("`{text}`: write `PARAM=V1,V2,...` or `PARAM=A..B:N`"))?;
     let parameter: Parameter = parameter.trim().parse()?;
     let value = |s: &str| -> Result<Length, String> {
         let s = s.trim();
@@ -167,10 +166,11 @@ pub fn grid_scenes(loaded: &Loaded, axes: &[Axis]) -> Result<Vec<GridScene>, Sce
         for (coords, file) in &points {
             for (i, value) in axis.values.iter().enumerate() {
                 let field = if a == 0 { format!("sweep.values[{i}]") } else { format!("sweep.values_y[{i}]") };
-                let varied = axis
-                    .parameter
-                    .apply(file, *value)
-                    .map_err(|rule| SceneError::Invalid { file: loaded.path.clone(), field: field.clone(), rule })?;
+                let varied = axis.parameter.apply(file, *value).map_err(|rule| SceneError::Invalid {
+                    file: loaded.path.clone(),
+                    field: field.clone(),
+                    rule,
+                })?;
                 let mut c = coords.clone();
                 c.push((i, *value));
                 next.push((c, varied));
@@ -257,4 +257,3 @@ pub fn cells_table(parameters: &[String], cells: &[(usize, SweepPoint)]) -> (Vec
 
 /// Columns of [`cells_table`] that hold integers.
 pub const INTEGER_COLUMNS: &[&str] = &["cell", "impact_count"];
-

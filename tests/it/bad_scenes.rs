@@ -1,8 +1,8 @@
 //! Bad input: every impossible scene gets an error naming the file, the field and the rule,
 //! with exit status 2, no panic and nothing written.
 
-use std::path::Path;
 use crate::common::lpc_command;
+use std::path::Path;
 
 const GOOD: &str = crate::common::LSL_TOML;
 
@@ -12,14 +12,7 @@ fn run_lpc(text: &str, extra: &[&str]) -> (i32, String, bool) {
     let file = dir.path().join("scene.toml");
     std::fs::write(&file, text).unwrap();
     let out = dir.path().join("out");
-    let o = lpc_command()
-        .arg("run")
-        .arg(&file)
-        .arg("--out")
-        .arg(&out)
-        .args(extra)
-        .output()
-        .unwrap();
+    let o = lpc_command().arg("run").arg(&file).arg("--out").arg(&out).args(extra).output().unwrap();
     (o.status.code().unwrap_or(-1), String::from_utf8_lossy(&o.stderr).into_owned(), out.exists())
 }
 

@@ -1,10 +1,10 @@
 //! `lpc bench` reports, for each setting, exactly the errors `lpc compare` reports for it.
 
 use lpc_damper::model::RunOptions;
-use lpc_damper::studies::bench::{bench_scene, Plan};
-use lpc_damper::studies::compare::errors;
 use lpc_damper::rapier::Stepping;
 use lpc_damper::scene::{load_scene, scenes_dir};
+use lpc_damper::studies::bench::{bench_scene, Plan};
+use lpc_damper::studies::compare::errors;
 use lpc_damper::Model;
 
 #[test]

@@ -3,11 +3,7 @@
 use crate::common::lpc_command;
 
 fn lpc_check(golden: &std::path::Path) -> (Option<i32>, String) {
-    let o = lpc_command()
-        .args(["check", "scenes", "--golden"])
-        .arg(golden)
-        .output()
-        .unwrap();
+    let o = lpc_command().args(["check", "scenes", "--golden"]).arg(golden).output().unwrap();
     (o.status.code(), String::from_utf8_lossy(&o.stdout).into_owned())
 }
 

@@ -3,9 +3,9 @@
 
 use crate::common;
 
+use crate::common::reference;
 use approx::assert_relative_eq;
 use common::*;
-use crate::common::reference;
 use lpc_damper::scene::{Body, Frame};
 
 /// Round-off bound for quantities built from a few dozen floating operations on O(1) data.

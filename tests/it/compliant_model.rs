@@ -13,18 +13,18 @@
 //! Issue 18: packed and pressed contacts cost what their motion needs (the packed column and a
 //! plastic light ball between heavy ones, each once stopped by millions of explicit steps).
 
-use lpc_damper::model::{ModelError, OverBudget, RunOptions};
 use crate::common;
-use lpc_damper::studies::compare::errors;
 use crate::common::compliant;
 use lpc_damper::compliant::contact;
-use lpc_damper::scene::DEFAULT_COMPLIANT_TOLERANCE as DEFAULT_TOLERANCE;
 use lpc_damper::impact_law::impact_law;
+use lpc_damper::model::{ModelError, OverBudget, RunOptions};
 use lpc_damper::run::Run;
+use lpc_damper::scene::DEFAULT_COMPLIANT_TOLERANCE as DEFAULT_TOLERANCE;
 use lpc_damper::scene::{
-    ball_radius, load_scene, parse, scenes_dir, Ball, BallKind, CompliantSettings, Container, Forcing, ForcingKind, Frame,
-    RapierSettings, Scene,
+    ball_radius, load_scene, parse, scenes_dir, Ball, BallKind, CompliantSettings, Container, Forcing, ForcingKind, Frame, RapierSettings,
+    Scene,
 };
+use lpc_damper::studies::compare::errors;
 use lpc_damper::Model;
 
 const STEEL: f64 = 8000.0;
@@ -164,7 +164,10 @@ fn wall_of_a_free_frame_bounces_a_ball_as_eq_9_10() {
             let true_peak = r.peak_true_acceleration.unwrap();
             let force_peak = imp.peak_force.unwrap() / frame.mass;
             assert!(true_peak <= force_peak * (1.0 + 1e-9), "v {v} e {e}: {true_peak} > {force_peak}");
-            assert!(true_peak >= force_peak * (1.0 - 0.5 * (std::f64::consts::PI / 40.0).powi(2)), "v {v} e {e}: {true_peak} vs {force_peak}");
+            assert!(
+                true_peak >= force_peak * (1.0 - 0.5 * (std::f64::consts::PI / 40.0).powi(2)),
+                "v {v} e {e}: {true_peak} vs {force_peak}"
+            );
         }
     }
 }
@@ -330,7 +333,16 @@ fn lpc_run_writes_the_run_a_budget_stopped() {
     let tmp = tempfile::tempdir().unwrap();
     let out = tmp.path().join("out");
     let scene = scenes_dir().join("lpc-lsl.toml");
-    let o = crate::common::lpc(["run".as_ref(), scene.as_os_str(), "--model".as_ref(), "compliant".as_ref(), "--max-steps".as_ref(), "5000".as_ref(), "--out".as_ref(), out.as_os_str()]);
+    let o = crate::common::lpc([
+        "run".as_ref(),
+        scene.as_os_str(),
+        "--model".as_ref(),
+        "compliant".as_ref(),
+        "--max-steps".as_ref(),
+        "5000".as_ref(),
+        "--out".as_ref(),
+        out.as_os_str(),
+    ]);
     assert_eq!(o.status.code(), Some(1), "{}", String::from_utf8_lossy(&o.stderr));
     let err = String::from_utf8_lossy(&o.stderr);
     assert!(err.contains("wrote the run up to t = ") && err.contains("--max-steps"), "{err}");
@@ -364,7 +376,13 @@ fn converges(scene: &Scene, tol: f64, max_steps: u64) -> (Run, Run) {
     let coarse = Model::Compliant.simulate(&with_tolerance(scene, tol), &options).unwrap();
     let fine = Model::Compliant.simulate(&with_tolerance(scene, tol / 10.0), &options).unwrap();
     for r in [&coarse, &fine] {
-        assert!(r.energy.balance_error.abs() <= r.events as f64 * tol, "{}: balance {:e} after {} steps", scene.name, r.energy.balance_error, r.events);
+        assert!(
+            r.energy.balance_error.abs() <= r.events as f64 * tol,
+            "{}: balance {:e} after {} steps",
+            scene.name,
+            r.energy.balance_error,
+            r.events
+        );
     }
     (coarse, fine)
 }

@@ -4,8 +4,8 @@
 use crate::common::{self, reference};
 
 use lpc_damper::metrics::{metrics, noise};
-use lpc_damper::studies::optimize::{optimize, Judging, Objective};
 use lpc_damper::scene::{self, Length};
+use lpc_damper::studies::optimize::{optimize, Judging, Objective};
 use lpc_damper::studies::sweep::{grid_scenes, parse_axis};
 
 fn paper(name: &str) -> scene::Loaded {
@@ -95,9 +95,15 @@ fn optimize_finds_the_best_of_an_exhaustive_evaluation() {
     let length = loaded.scene.as_ref().unwrap().container.unwrap().length;
     let axes = [parse_axis("gap=0.1Rr,0.25Rr,0.5Rr,0.75Rr").unwrap()];
     let arrangements = ["LSL".to_string(), "LLLLLLLL".to_string()];
-    let search =
-        optimize(&loaded, &axes, &arrangements, Length::Metres(length), Judging { objective: Objective::SettlingTime, model: lpc_damper::Model::Reference, refinements: 0, robust: None }, &|| {})
-            .unwrap();
+    let search = optimize(
+        &loaded,
+        &axes,
+        &arrangements,
+        Length::Metres(length),
+        Judging { objective: Objective::SettlingTime, model: lpc_damper::Model::Reference, refinements: 0, robust: None },
+        &|| {},
+    )
+    .unwrap();
     // Eight large balls (8 x 29.7 mm) do not fit a 114 mm container.
     assert_eq!(search.infeasible, 4);
     // Exhaustive evaluation, built independently from scene text.

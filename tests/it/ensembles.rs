@@ -150,7 +150,11 @@ fn members_draw_uniform_numbers_across_indices() {
     for seed in [0, 1, 7] {
         let mut u: Vec<f64> = (0..n).map(|k| ensemble::member_rng(seed, k).random::<f64>()).collect();
         u.sort_by(f64::total_cmp);
-        let ks = u.iter().enumerate().map(|(i, &x)| (x - i as f64 / n as f64).abs().max(((i + 1) as f64 / n as f64 - x).abs())).fold(0.0, f64::max);
+        let ks = u
+            .iter()
+            .enumerate()
+            .map(|(i, &x)| (x - i as f64 / n as f64).abs().max(((i + 1) as f64 / n as f64 - x).abs()))
+            .fold(0.0, f64::max);
         assert!(ks < 1.628 / (n as f64).sqrt(), "seed {seed}: KS statistic {ks}");
     }
 }
@@ -360,7 +364,8 @@ fn shards_merge_into_the_unsharded_table() {
     std::fs::write(&path, format!("{LSL}[tolerances]\ngap = \"0.02 Rr\"\nrestitution = 0.05\n")).unwrap();
     let dir = |name: &str| tmp.path().join(name);
     let run = |args: &[&str], out: &std::path::Path| {
-        let mut all: Vec<&std::ffi::OsStr> = vec!["run".as_ref(), path.as_os_str(), "--ensemble".as_ref(), "23".as_ref(), "--seed".as_ref(), "5".as_ref()];
+        let mut all: Vec<&std::ffi::OsStr> =
+            vec!["run".as_ref(), path.as_os_str(), "--ensemble".as_ref(), "23".as_ref(), "--seed".as_ref(), "5".as_ref()];
         all.extend(args.iter().map(std::ffi::OsStr::new));
         all.extend(["--out".as_ref(), out.as_os_str()]);
         let o = lpc(all);
@@ -370,7 +375,15 @@ fn shards_merge_into_the_unsharded_table() {
     for i in 0..4 {
         run(&["--shard", &format!("{i}/4")], &dir(&format!("shard{i}")));
     }
-    let o = lpc(["merge".as_ref(), dir("shard3").as_os_str(), dir("shard1").as_os_str(), dir("shard0").as_os_str(), dir("shard2").as_os_str(), "--out".as_ref(), dir("merged").as_os_str()]);
+    let o = lpc([
+        "merge".as_ref(),
+        dir("shard3").as_os_str(),
+        dir("shard1").as_os_str(),
+        dir("shard0").as_os_str(),
+        dir("shard2").as_os_str(),
+        "--out".as_ref(),
+        dir("merged").as_os_str(),
+    ]);
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     for file in ["members.csv", "members.parquet"] {
         assert_eq!(std::fs::read(dir("whole").join(file)).unwrap(), std::fs::read(dir("merged").join(file)).unwrap(), "{file}");

@@ -2,8 +2,8 @@
 //! (curves, axes and text, not a blank canvas), from a scene, a run directory, a chain scene and
 //! a compare directory; bad input gets an error naming what is wrong.
 
-use std::path::Path;
 use crate::common::lpc;
+use std::path::Path;
 
 /// Width, height and RGBA pixels of a PNG.
 fn decode(path: &Path) -> (u32, u32, Vec<[u8; 4]>) {

@@ -2,12 +2,12 @@
 //! `m x'' + c x' + k x = P sin wt + Q cos wt`, for a force and for base motion, in both models;
 //! the energy balance with the excitation's work; the frequency response against `|H(w)|`.
 
-use lpc_damper::model::RunOptions;
 use crate::common;
+use lpc_damper::model::RunOptions;
 
-use lpc_damper::studies::frf;
-use lpc_damper::scene::{Forcing, ForcingKind, Scene};
 use crate::common::reference;
+use lpc_damper::scene::{Forcing, ForcingKind, Scene};
+use lpc_damper::studies::frf;
 use lpc_damper::Model;
 
 const FRAME: lpc_damper::scene::Frame = common::PAPER_FRAME;
@@ -51,13 +51,8 @@ fn bare_forced_frame_follows_the_textbook_solution_in_both_models() {
             let scale = 0.01 + textbook(kind, amp, f, 0.0, 100.0).abs().max(amp / FRAME.stiffness);
             for model in [Model::Reference, Model::Rapier] {
                 let run = model.simulate(&scene, &RunOptions::default()).unwrap();
-                let worst = run
-                    .series
-                    .t
-                    .iter()
-                    .zip(&run.series.xs)
-                    .map(|(t, x)| (x - textbook(kind, amp, f, 0.01, *t)).abs())
-                    .fold(0.0, f64::max);
+                let worst =
+                    run.series.t.iter().zip(&run.series.xs).map(|(t, x)| (x - textbook(kind, amp, f, 0.01, *t)).abs()).fold(0.0, f64::max);
                 // Both models move the frame in closed form: agreement to round-off, which
                 // grows with the ~3000 samples' phase arguments (w t up to 170 rad).
                 assert!(worst <= 1e-12 * scale * 1e3, "{kind:?} {f} Hz {}: {worst:e} m", model.name());

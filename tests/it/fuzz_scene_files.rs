@@ -20,7 +20,17 @@ fn check(text: &str) {
 /// TOML values, including the awkward ones (NaN, infinities, huge and negative numbers).
 fn value() -> impl Strategy<Value = String> {
     prop_oneof![
-        any::<f64>().prop_map(|x| if x.is_nan() { "nan".into() } else if x.is_infinite() { if x > 0.0 { "inf".into() } else { "-inf".into() } } else { format!("{x:e}") }),
+        any::<f64>().prop_map(|x| if x.is_nan() {
+            "nan".into()
+        } else if x.is_infinite() {
+            if x > 0.0 {
+                "inf".into()
+            } else {
+                "-inf".into()
+            }
+        } else {
+            format!("{x:e}")
+        }),
         any::<i64>().prop_map(|i| i.to_string()),
         "[LS]{0,60}".prop_map(|s| format!("\"{s}\"")),
         "[-0-9.]{1,8} ?Rr".prop_map(|s| format!("\"{s}\"")),

@@ -5,8 +5,8 @@
 
 use crate::common;
 
-use std::f64::consts::PI;
 use crate::common::lpc_command;
+use std::f64::consts::PI;
 
 use common::masri_caughey::{ImpactDamper, Periodic};
 
@@ -122,7 +122,12 @@ fn the_reference_settles_on_the_periodic_motion() {
             let off = i.1 * w - wall_phase;
             let off = off - (off / (2.0 * PI)).round() * 2.0 * PI;
             assert!(off.abs() < 1e-6, "case {k}: impact {} at t = {} is {off:e} rad off the periodic phase", i.0, i.1);
-            assert!((i.2 - branch.approach_speed).abs() < 1e-6 * branch.approach_speed, "case {k}: approach {} vs {}", i.2, branch.approach_speed);
+            assert!(
+                (i.2 - branch.approach_speed).abs() < 1e-6 * branch.approach_speed,
+                "case {k}: approach {} vs {}",
+                i.2,
+                branch.approach_speed
+            );
         }
         let tail: Vec<_> = samples.iter().filter(|s| s[0] > horizon - 2.0 / d.frequency).copied().collect();
         let amplitude = sampled_amplitude(&tail);
@@ -149,7 +154,15 @@ fn frf_reads_the_periodic_motion() {
         "[frame]\nmass = {}\nstiffness = {}\ndamping = {}\ninitial_displacement = 0.0\n\
          [balls]\narrangement = \"L\"\nlarge_mass = {}\ndensity = 8000.0\nrestitution = {}\ngap = {}\nclearance = {}\n\
          [forcing]\nkind = \"force\"\namplitude = {}\nfrequency = {}\n",
-        d.frame_mass, d.stiffness, d.damping, d.ball_mass, d.restitution, 0.5 * d.travel, 0.5 * d.travel, d.force, d.frequency
+        d.frame_mass,
+        d.stiffness,
+        d.damping,
+        d.ball_mass,
+        d.restitution,
+        0.5 * d.travel,
+        0.5 * d.travel,
+        d.force,
+        d.frequency
     );
     let scene = lpc_damper::scene::parse(&text, "masri.toml", "masri").unwrap().scene.unwrap();
     let point = lpc_damper::studies::frf::frf(&scene, &[d.frequency], lpc_damper::Model::Reference, &|| {}).remove(0);

@@ -1,15 +1,15 @@
 //! The Rapier/Bevy contact model against closed forms, Eq. 9-10 and the reference.
 
-use lpc_damper::model::RunOptions;
 use crate::common;
+use lpc_damper::model::RunOptions;
 
 use approx::assert_relative_eq;
 use common::*;
-use lpc_damper::studies::compare::errors;
-use lpc_damper::output::{impacts_csv, series_csv};
-use lpc_damper::metrics::RunSummary;
 use lpc_damper::impact_law::impact_law;
+use lpc_damper::metrics::RunSummary;
+use lpc_damper::output::{impacts_csv, series_csv};
 use lpc_damper::scene::{ball_radius, load_scene, scenes_dir, Ball, BallKind, Frame, Scene};
+use lpc_damper::studies::compare::errors;
 use lpc_damper::Model;
 
 /// Ball velocities live in f32 inside Rapier: a few roundings of 6e-8 each, plus the solver's
@@ -128,7 +128,10 @@ fn compare_on_the_paper_scenes_is_within_the_measured_bounds() {
 #[test]
 fn lsl_meets_the_rms_target() {
     let scene = paper("lpc-lsl");
-    let e = errors(&Model::Rapier.simulate(&scene, &RunOptions::default()).unwrap(), &Model::Reference.simulate(&scene, &RunOptions::default()).unwrap());
+    let e = errors(
+        &Model::Rapier.simulate(&scene, &RunOptions::default()).unwrap(),
+        &Model::Reference.simulate(&scene, &RunOptions::default()).unwrap(),
+    );
     assert!(e.rms_xs <= 0.5e-3, "rms {:e} m", e.rms_xs);
 }
 

@@ -4,8 +4,8 @@
 //! the byte.
 #![cfg(feature = "render")]
 
-use std::path::Path;
 use crate::common::{lpc, lpc_command};
+use std::path::Path;
 
 use lpc_damper::output::figures::read_series_csv;
 use lpc_damper::render::stage::{Layout, BACKGROUND};
@@ -114,14 +114,32 @@ fn rendering_never_changes_the_physics() {
         let out = tempfile::tempdir().unwrap();
         let (rendered, headless) = (out.path().join("rendered"), out.path().join("headless"));
         let o = lpc([
-            "render", "scenes/lpc-lsl.toml", "--model", model, "--out", rendered.to_str().unwrap(),
-            "--horizon", "0.3", "--fps", "20", "--size", "160x100",
+            "render",
+            "scenes/lpc-lsl.toml",
+            "--model",
+            model,
+            "--out",
+            rendered.to_str().unwrap(),
+            "--horizon",
+            "0.3",
+            "--fps",
+            "20",
+            "--size",
+            "160x100",
         ]);
         assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
         let (sample_dt, _) = lpc_damper::run::frame_sampling(FPS, 0.001);
         let o = lpc([
-            "run", "scenes/lpc-lsl.toml", "--model", model, "--out", headless.to_str().unwrap(),
-            "--horizon", "0.3", "--sample-dt", &format!("{sample_dt}"),
+            "run",
+            "scenes/lpc-lsl.toml",
+            "--model",
+            model,
+            "--out",
+            headless.to_str().unwrap(),
+            "--horizon",
+            "0.3",
+            "--sample-dt",
+            &format!("{sample_dt}"),
         ]);
         assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
         for file in ["series.csv", "impacts.csv"] {

@@ -4,8 +4,8 @@
 
 use crate::common;
 
-use common::*;
 use crate::common::reference;
+use common::*;
 use lpc_damper::run::Run;
 use lpc_damper::scene::Scene;
 

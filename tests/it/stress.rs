@@ -62,7 +62,12 @@ fn extreme_scenes_pass_refuse_or_stop_never_panic() {
     assert_all_pass(&stress(Model::Reference, 1, 24, draws(1.0), &|| {}));
     for model in [Model::Rapier, Model::Compliant] {
         for o in stress(model, 1, 6, draws(0.5), &|| {}) {
-            assert!(o.failure.as_ref().is_none_or(|f| f.check != "panic" && f.check != "non-finite"), "{model} seed {}: {:?}", o.seed, o.failure);
+            assert!(
+                o.failure.as_ref().is_none_or(|f| f.check != "panic" && f.check != "non-finite"),
+                "{model} seed {}: {:?}",
+                o.seed,
+                o.failure
+            );
         }
     }
 }

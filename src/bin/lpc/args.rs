@@ -127,7 +127,8 @@ impl Nominal {
         if k == 0 || i >= k || k > n {
             return Err(invalid(Path::new(&self.path), "--shard", format!("must be I/K with 0 <= I < K <= N = {n} (got {i}/{k})")));
         }
-        ensemble::draw_range(&self.file, &self.path, &self.scene, self.tolerances.as_ref(), n, ensemble::shard_range(n, i, k), e.seed).map(Some)
+        ensemble::draw_range(&self.file, &self.path, &self.scene, self.tolerances.as_ref(), n, ensemble::shard_range(n, i, k), e.seed)
+            .map(Some)
     }
 }
 

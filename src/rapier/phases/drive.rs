@@ -70,4 +70,3 @@ pub fn drive_frame(
         set.bodies[h].set_next_kinematic_translation(Vec3::new(frame.before_impulses.0 as f32, 0.0, 0.0));
     }
 }
-

@@ -174,14 +174,7 @@ fn read_balls(set: &RapierRigidBodySet, handles: &[RigidBodyHandle], x: &mut Vec
 
 /// Phase 1b: Rapier's contacts are soft, so a ball pressed by an accelerating wall or a loaded
 /// chain sinks past the allowed error. Project it back (positions only: no energy changes).
-fn project_sunk_balls(
-    set: &mut RapierRigidBodySet,
-    handles: &[RigidBodyHandle],
-    x: &mut [f64],
-    scene: &Scene,
-    frame_x: f64,
-    length: f64,
-) {
+fn project_sunk_balls(set: &mut RapierRigidBodySet, handles: &[RigidBodyHandle], x: &mut [f64], scene: &Scene, frame_x: f64, length: f64) {
     if !project_inside(x, &scene.balls, frame_x, length) {
         return;
     }
@@ -219,8 +212,7 @@ fn mark_pairs_in_contact(
         let (Some(a), Some(b)) = (collider(p as isize - 1), collider(p as isize)) else {
             return false;
         };
-        sim.contact_pair(colliders, set, a, b)
-            .is_some_and(|pair| pair.manifolds().any(|m| m.points().any(|pt| pt.impulse() > 0.0)))
+        sim.contact_pair(colliders, set, a, b).is_some_and(|pair| pair.manifolds().any(|m| m.points().any(|pt| pt.impulse() > 0.0)))
     }));
 }
 
@@ -309,9 +301,8 @@ fn held_runs(scene: &Scene, x: &[f64], v: &[f64], ((xs, vs), t, h): ((f64, f64),
     let force = scene.frame_force(t, xs, vs);
     let stick = contacts::sticking_speed(scene, force / f.mass, h);
     let walls = Some((xs, c.length));
-    let holds = |ball: usize, pair: usize| {
-        pair_gap(&scene.balls, x, walls, pair).is_some_and(|g| g <= TOUCHING) && (v[ball] - vs).abs() <= stick
-    };
+    let holds =
+        |ball: usize, pair: usize| pair_gap(&scene.balls, x, walls, pair).is_some_and(|g| g <= TOUCHING) && (v[ball] - vs).abs() <= stick;
     let mut held = [0, 0];
     if force > 0.0 {
         held[0] = (0..n).take_while(|&b| holds(b, b)).count();
@@ -459,9 +450,8 @@ impl StepVelocities<'_> {
     /// Kinetic energy the step's contacts took, J.
     fn kinetic_energy_lost(&self, scene: &Scene) -> f64 {
         let frame_mass = scene.frame.map_or(0.0, |f| f.mass);
-        let ke = |v: &[f64], vf: f64| {
-            0.5 * frame_mass * vf * vf + scene.balls.iter().zip(v).map(|(b, v)| 0.5 * b.mass * v * v).sum::<f64>()
-        };
+        let ke =
+            |v: &[f64], vf: f64| 0.5 * frame_mass * vf * vf + scene.balls.iter().zip(v).map(|(b, v)| 0.5 * b.mass * v * v).sum::<f64>();
         ke(self.before, self.frame_before) - ke(self.after, self.frame_after)
     }
 
@@ -554,16 +544,7 @@ fn attribute_impacts(
 /// than Rapier's allowed overlap (pushed through: projection only lifts shallow overlaps), an
 /// impact that gained energy, or more energy in the system than was put in. Returns the reason.
 #[allow(clippy::too_many_arguments)]
-fn self_check(
-    scene: &Scene,
-    rec: &Recording,
-    x: &[f64],
-    v: &[f64],
-    xs: f64,
-    vs: f64,
-    forcing_work: f64,
-    t: f64,
-) -> Option<String> {
+fn self_check(scene: &Scene, rec: &Recording, x: &[f64], v: &[f64], xs: f64, vs: f64, forcing_work: f64, t: f64) -> Option<String> {
     if let Some(c) = scene.container {
         for (i, b) in scene.balls.iter().enumerate() {
             let (left, right) = (x[i] - b.radius - xs, xs + c.length - x[i] - b.radius);
@@ -641,4 +622,3 @@ pub fn project_inside(x: &mut [f64], balls: &[crate::scene::Ball], left: f64, le
     }
     moved
 }
-

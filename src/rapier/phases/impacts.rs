@@ -36,8 +36,7 @@ pub fn resolve_impacts(
     let floor = approach_floor(scene);
     // What the frame's acceleration now builds over the last step: a slower approach of a
     // loaded pair is the wall or the chain pressing on, not a new impact.
-    let acceleration =
-        frame.as_deref().zip(scene.frame).map_or(0.0, |(f, sf)| scene.frame_force(clock.t, f.now.0, f.now.1) / sf.mass);
+    let acceleration = frame.as_deref().zip(scene.frame).map_or(0.0, |(f, sf)| scene.frame_force(clock.t, f.now.0, f.now.1) / sf.mass);
     let stick = sticking_speed(scene, acceleration, plan.h);
     let Recording { x, v, last_impulse, impulse_floor, impacts, last_impact, struck_at, impact_loss, .. } = &mut *rec;
     // Pairs within a run the walls hold ride the frame: persistent too.
@@ -59,9 +58,8 @@ pub fn resolve_impacts(
     let mut merged = false;
     if let (Some(f), Some(sf)) = (frame.as_deref_mut(), scene.frame) {
         let carried = held_balls(f.held, n);
-        let (mass, momentum) = carried.clone().fold((sf.mass, sf.mass * f.now.1), |(m, p), i| {
-            (m + scene.balls[i].mass, p + scene.balls[i].mass * v[i])
-        });
+        let (mass, momentum) =
+            carried.clone().fold((sf.mass, sf.mass * f.now.1), |(m, p), i| (m + scene.balls[i].mass, p + scene.balls[i].mass * v[i]));
         if mass > sf.mass {
             let common = momentum / mass;
             let ke = |m: f64, u: f64| 0.5 * m * u * u;
@@ -105,4 +103,3 @@ pub fn resolve_impacts(
         }
     }
 }
-

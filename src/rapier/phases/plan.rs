@@ -84,15 +84,7 @@ fn aligned_step(scene: &crate::scene::Scene, x: &[f64], v: &[f64], frame: Option
         if (p2.x - p1.x) - (r1 + r2) <= TOUCHING {
             continue;
         }
-        let hit = cast_shapes(
-            &Pose::from_translation(p1),
-            v1,
-            &Ball::new(r1),
-            &Pose::from_translation(p2),
-            v2,
-            &Ball::new(r2),
-            options,
-        );
+        let hit = cast_shapes(&Pose::from_translation(p1), v1, &Ball::new(r1), &Pose::from_translation(p2), v2, &Ball::new(r2), options);
         if let Ok(Some(hit)) = hit {
             ball_toi = ball_toi.min(hit.time_of_impact as f64);
         }
@@ -125,13 +117,8 @@ fn aligned_step(scene: &crate::scene::Scene, x: &[f64], v: &[f64], frame: Option
         }
     }
     let (toi, limit) = if wall_toi < ball_toi { (wall_toi, APPROACH_STEP.min(longest)) } else { (ball_toi, longest) };
-    let h = if toi <= limit {
-        toi
-    } else {
-        (toi / APPROACH_RATIO).min(longest)
-    };
+    let h = if toi <= limit { toi } else { (toi / APPROACH_RATIO).min(longest) };
     // On a frame stiffer than about 1e10 N/m per kg^(1/2) the longest stable step (a 40th of
     // the period) is itself shorter than MIN_STEP: the period's bound wins.
     h.max(MIN_STEP).min(longest)
 }
-

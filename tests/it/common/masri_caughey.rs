@@ -114,11 +114,8 @@ impl ImpactDamper {
         let p = [a, b];
         let pd = [-w * b, w * a];
         // Rows over (X0, v-, v+, u) = rhs over (1, s, c).
-        let mut rows: Vec<([f64; 4], [f64; 3])> = vec![
-            ([0.0, -mm, mm, 2.0 * m], [0.0; 3]),
-            ([0.0, -e, -1.0, 1.0 - e], [0.0; 3]),
-            ([2.0, 0.0, 0.0, half], [-d, 0.0, 0.0]),
-        ];
+        let mut rows: Vec<([f64; 4], [f64; 3])> =
+            vec![([0.0, -mm, mm, 2.0 * m], [0.0; 3]), ([0.0, -e, -1.0, 1.0 - e], [0.0; 3]), ([2.0, 0.0, 0.0, half], [-d, 0.0, 0.0])];
         for i in 0..2 {
             // phi_i0 (X0 - p) + phi_i1 (v+ - p') + (X0 - p if i = 0 else v- - p') = 0.
             let cp = phi[i][0] + if i == 0 { 1.0 } else { 0.0 };

@@ -68,10 +68,7 @@ pub const PAPER_FRAME: Frame = Frame { mass: 1.35, stiffness: 865.0, damping: 1.
 /// A damper scene from explicit parts: balls (mass, kind) left to right with gap `gap`,
 /// clearance `clearance`, density 8000.
 pub fn damper(frame: Frame, xs0: f64, masses: &[f64], e: f64, gap: f64, clearance: f64, horizon: f64) -> Scene {
-    let balls: Vec<Ball> = masses
-        .iter()
-        .map(|&m| Ball { mass: m, radius: ball_radius(m, 8000.0), kind: BallKind::Custom })
-        .collect();
+    let balls: Vec<Ball> = masses.iter().map(|&m| Ball { mass: m, radius: ball_radius(m, 8000.0), kind: BallKind::Custom }).collect();
     let mut positions = Vec::new();
     let mut x = xs0 + gap;
     for b in &balls {

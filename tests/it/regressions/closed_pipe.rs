@@ -9,12 +9,8 @@ use crate::common::lpc_command;
 
 #[test]
 fn a_closed_pipe_ends_the_tool_without_a_panic() {
-    let mut child = lpc_command()
-        .args(["check", "--models", "reference", "--verbose"])
-        .stdout(Stdio::piped())
-        .stderr(Stdio::piped())
-        .spawn()
-        .unwrap();
+    let mut child =
+        lpc_command().args(["check", "--models", "reference", "--verbose"]).stdout(Stdio::piped()).stderr(Stdio::piped()).spawn().unwrap();
     // Close the pipe at once: the tool spends a good fraction of a second running the scenes
     // before its first line, which then meets a closed pipe.
     drop(child.stdout.take());

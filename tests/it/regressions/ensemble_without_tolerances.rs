@@ -1,8 +1,8 @@
 //! An ensemble of a scene without `[tolerances]` panicked (the draw blamed its failures on
 //! the first toleranced parameter, of which there was none). Every member is the nominal scene.
 
-use lpc_damper::model::RunOptions;
 use lpc_damper::metrics::Headline;
+use lpc_damper::model::RunOptions;
 use lpc_damper::studies::ensemble;
 use lpc_damper::Model;
 

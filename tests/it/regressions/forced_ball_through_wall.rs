@@ -2,8 +2,8 @@
 //! scenes written to find such misses found three more ways for it to go wrong. One test per
 //! bug, each on the scene that showed it.
 
-use lpc_damper::model::RunOptions;
 use crate::common::{lpc_command, min_gap, scene_from_toml as scene};
+use lpc_damper::model::RunOptions;
 
 use crate::common::reference;
 use lpc_damper::Model;

@@ -6,8 +6,8 @@
 //! balls of forced-lsl became one lump after 6 s. The plug-in now resolves the impacts of
 //! touching pairs itself, one pair at a time as Eq. 9-10 and the reference say.
 
-use lpc_damper::model::RunOptions;
 use approx::assert_relative_eq;
+use lpc_damper::model::RunOptions;
 use lpc_damper::scene::{ball_radius, Ball, BallKind, Frame};
 use lpc_damper::Model;
 
@@ -34,9 +34,7 @@ fn a_touching_chain_passes_the_momentum_along() {
 /// moved as one body, all three at one velocity, for the last 2 s).
 #[test]
 fn forced_balls_do_not_glue() {
-    let mut scene = common::scene_from_toml(
-        &std::fs::read_to_string(lpc_damper::scene::scenes_dir().join("forced-lsl.toml")).unwrap(),
-    );
+    let mut scene = common::scene_from_toml(&std::fs::read_to_string(lpc_damper::scene::scenes_dir().join("forced-lsl.toml")).unwrap());
     scene.forcing.as_mut().unwrap().frequency = 3.0;
     scene.horizon = 8.0;
     let run = Model::Rapier.simulate(&scene, &RunOptions::default()).unwrap();

@@ -3,8 +3,8 @@
 //! the stress run reported as a ball outside the container. The plug-in now projects sunk balls
 //! back (positions only) and bounds the step by the walls' chord error.
 
-use lpc_damper::model::RunOptions;
 use crate::common;
+use lpc_damper::model::RunOptions;
 use lpc_damper::Model;
 
 const SCENE: &str = r#"

@@ -17,7 +17,11 @@ fn the_plugin_in_a_users_app_runs_the_headless_model() {
     let scene = Overrides { horizon: Some(0.5), ..Overrides::default() }.apply(scene, "lpc-lsl").unwrap();
     let headless = Model::Rapier.simulate(&scene, &RunOptions::default()).unwrap();
     let mut app = App::new();
-    app.init_resource::<Time>().add_plugins(LpcDamperPlugins { scene: scene.clone(), settings: settings(&scene), record: lpc_damper::run::Record::Series });
+    app.init_resource::<Time>().add_plugins(LpcDamperPlugins {
+        scene: scene.clone(),
+        settings: settings(&scene),
+        record: lpc_damper::run::Record::Series,
+    });
     app.finish();
     app.cleanup();
     while app.world().get_resource::<StepClock>().is_none_or(|c| c.t < scene.horizon * (1.0 - 1e-12)) {

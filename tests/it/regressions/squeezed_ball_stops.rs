@@ -5,9 +5,9 @@
 //! frame at 38 m/s striking a light ball still beats Rapier's solver (`FAST_FRAME`, stress
 //! seed 91211), and the check still stops that run.
 
-use lpc_damper::model::RunOptions;
-use lpc_damper::model::ModelError;
 use crate::common;
+use lpc_damper::model::ModelError;
+use lpc_damper::model::RunOptions;
 use lpc_damper::Model;
 
 const SCENE: &str = r#"

@@ -4,8 +4,8 @@
 //! now applies the bounce Rapier skipped; the chain experiment must match the reference.
 
 use lpc_damper::model::RunOptions;
-use lpc_damper::studies::chain::{ker, run_chain};
 use lpc_damper::scene::{load, scenes_dir};
+use lpc_damper::studies::chain::{ker, run_chain};
 use lpc_damper::Model;
 
 #[test]

@@ -4,9 +4,9 @@
 //!
 //! `cargo run --release -p lpc-tools --bin compliant_convergence`
 
-use lpc_damper::studies::compare::errors;
 use lpc_damper::model::{Model, RunOptions};
 use lpc_damper::scene::{load_scene, scenes_dir};
+use lpc_damper::studies::compare::errors;
 
 fn main() {
     println!("early xs error (max |xs - xs_ref| over 0.5 s), mm");

@@ -22,7 +22,8 @@ fn main() {
         let done = std::sync::atomic::AtomicBool::new(false);
         let mut said = Vec::new();
         let start = std::time::Instant::now();
-        let options = RunOptions { record: Record::MetricsOnly, max_wall_s: Some(60.0), progress: Some(&progress), ..RunOptions::default() };
+        let options =
+            RunOptions { record: Record::MetricsOnly, max_wall_s: Some(60.0), progress: Some(&progress), ..RunOptions::default() };
         let run = std::thread::scope(|s| {
             let watcher = s.spawn(|| {
                 let mut said = Vec::new();

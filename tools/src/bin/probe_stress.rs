@@ -18,5 +18,7 @@ fn main() {
             match &r { Ok(lpc_damper::studies::stress::Passed::Refused { .. }) => "refused", Ok(_) => "ok", Err(f) => f.check },
             match &r { Err(f) => f.detail.replace('"', "'"), _ => String::new() })
     }).collect();
-    for r in rows { println!("{r}"); }
+    for r in rows {
+        println!("{r}");
+    }
 }

@@ -3,9 +3,9 @@
 
 use std::time::Instant;
 
+use lpc_damper::model::{Model, RunOptions};
 use lpc_damper::scene::{load, load_scene, scenes_dir, Arrangement, Length};
 use lpc_damper::studies::sweep::{run_sweep, sweep_scenes};
-use lpc_damper::model::{Model, RunOptions};
 
 fn main() {
     let lsl = scenes_dir().join("lpc-lsl.toml");
@@ -48,10 +48,11 @@ fn main() {
     println!("\n## Sweep size (gap of lpc-lsl from 0.1 to 1 Rr, 5 s each, rayon on {} threads)\n", rayon::current_num_threads());
     println!("| values | model | wall s | scene-runs per second |");
     println!("|---|---|---|---|");
-    for (values, models) in [(4usize, &[Model::Reference, Model::Rapier][..]), (16, &[Model::Reference, Model::Rapier]), (256, &[Model::Reference])] {
+    for (values, models) in
+        [(4usize, &[Model::Reference, Model::Rapier][..]), (16, &[Model::Reference, Model::Rapier]), (256, &[Model::Reference])]
+    {
         let mut loaded = load(scenes_dir().join("sweep-gap.toml")).unwrap();
-        loaded.file.sweep.as_mut().unwrap().values =
-            (0..values).map(|k| Length::Rr(0.1 + 0.9 * k as f64 / (values - 1) as f64)).collect();
+        loaded.file.sweep.as_mut().unwrap().values = (0..values).map(|k| Length::Rr(0.1 + 0.9 * k as f64 / (values - 1) as f64)).collect();
         let scenes = sweep_scenes(&loaded).unwrap();
         for &model in models {
             let start = Instant::now();

@@ -8,7 +8,12 @@ fn main() {
     if args[1].ends_with(".toml") {
         let scene = lpc_damper::scene::load_scene(&args[1]).unwrap();
         let run = Model::Reference.simulate(&scene, &RunOptions::default()).unwrap();
-        println!("events {} impacts {} events per simulated second {:.0}", run.events, run.impacts.len(), run.events as f64 / scene.horizon);
+        println!(
+            "events {} impacts {} events per simulated second {:.0}",
+            run.events,
+            run.impacts.len(),
+            run.events as f64 / scene.horizon
+        );
         return;
     }
     let seed: u64 = args[1].parse().unwrap();
@@ -22,6 +27,18 @@ fn main() {
     let scene = lpc_damper::scene::from_file(file, "s", "s").unwrap().scene.unwrap();
     let t = std::time::Instant::now();
     let r = lpc_damper::studies::stress::judge_run(model, &scene, None);
-    if let Err(f) = &r { println!("{}", f.detail); }
-    println!("seed {seed}: {:.3} s balls {} horizon {:.2} -> {:?}", t.elapsed().as_secs_f64(), scene.balls.len(), scene.horizon, r.map(|p| match p { lpc_damper::studies::stress::Passed::Run(r) => Some((r.events, r.impacts.len())), lpc_damper::studies::stress::Passed::Refused { .. } | lpc_damper::studies::stress::Passed::Stopped(_) => None }).map_err(|f| f.check));
+    if let Err(f) = &r {
+        println!("{}", f.detail);
+    }
+    println!(
+        "seed {seed}: {:.3} s balls {} horizon {:.2} -> {:?}",
+        t.elapsed().as_secs_f64(),
+        scene.balls.len(),
+        scene.horizon,
+        r.map(|p| match p {
+            lpc_damper::studies::stress::Passed::Run(r) => Some((r.events, r.impacts.len())),
+            lpc_damper::studies::stress::Passed::Refused { .. } | lpc_damper::studies::stress::Passed::Stopped(_) => None,
+        })
+        .map_err(|f| f.check)
+    );
 }

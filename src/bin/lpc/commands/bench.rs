@@ -7,8 +7,8 @@ use lpc_damper::scene::Overrides;
 use lpc_damper::Model;
 
 use crate::args::{load_scene, print_json, progress_bar, TableFormat};
-use crate::table::{right, Table};
 use crate::exit::{CommandError, ExitStatus, Result};
+use crate::table::{right, Table};
 
 /// Most runs per setting: the median of a thousand is as steady as timing gets.
 const MAX_REPEAT: usize = 1000;
@@ -86,7 +86,8 @@ pub fn run(a: Args) -> Result<ExitStatus> {
         write_atomic(&dir.join("bench.csv"), &csv_bytes)?;
         write_atomic(&dir.join("bench.json"), &serde_json::to_vec_pretty(&rows)?)?;
         let svg = dir.join("error_vs_cost.svg");
-        lpc_damper::output::plot::error_vs_cost(&rows, &svg).map_err(|e| CommandError::failure(anyhow::anyhow!("drawing {}: {e}", svg.display())))?;
+        lpc_damper::output::plot::error_vs_cost(&rows, &svg)
+            .map_err(|e| CommandError::failure(anyhow::anyhow!("drawing {}: {e}", svg.display())))?;
     }
     match a.format {
         TableFormat::Json => print_json(&rows)?,
@@ -136,8 +137,20 @@ pub fn run(a: Args) -> Result<ExitStatus> {
 fn bench_csv(rows: &[lpc_damper::studies::bench::BenchRow]) -> Result<Vec<u8>> {
     let mut w = csv::Writer::from_writer(Vec::new());
     w.write_record([
-        "scene", "model", "stepping", "dt", "solver_iterations", "wall_s_per_sim_s", "steps_per_sim_s", "rms_xs",
-        "max_xs_early", "settling_time_diff", "impact_loss_diff", "impact_count_diff", "pareto", "tolerance",
+        "scene",
+        "model",
+        "stepping",
+        "dt",
+        "solver_iterations",
+        "wall_s_per_sim_s",
+        "steps_per_sim_s",
+        "rms_xs",
+        "max_xs_early",
+        "settling_time_diff",
+        "impact_loss_diff",
+        "impact_count_diff",
+        "pareto",
+        "tolerance",
     ])?;
     let opt = |x: Option<f64>| x.map_or(String::new(), |v| v.to_string());
     for r in rows {

@@ -2,13 +2,13 @@
 
 use std::path::PathBuf;
 
-use lpc_damper::studies::chain::{run_chain, KerRow};
 use lpc_damper::scene;
+use lpc_damper::studies::chain::{run_chain, KerRow};
 use lpc_damper::Model;
 
 use crate::args::{invalid, override_scene, print_json, Format, ModelArgs};
-use crate::table::{right, Table};
 use crate::exit::{ExitStatus, Result};
+use crate::table::{right, Table};
 
 #[derive(clap::Args)]
 pub struct Args {

@@ -5,8 +5,8 @@ use std::path::PathBuf;
 use lpc_damper::studies::check;
 use lpc_damper::Model;
 
-use crate::table::{left, right, Table};
 use crate::exit::{ExitStatus, Result};
+use crate::table::{left, right, Table};
 
 #[derive(clap::Args)]
 pub struct Args {

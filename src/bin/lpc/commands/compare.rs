@@ -5,18 +5,18 @@ use std::path::PathBuf;
 
 use anyhow::Context;
 
-use lpc_damper::model::RunOptions;
-use lpc_damper::studies::compare::{errors, Errors};
 use lpc_damper::metrics::RunSummary;
+use lpc_damper::model::RunOptions;
 use lpc_damper::output::write_run_dir;
+use lpc_damper::studies::compare::{errors, Errors};
 use lpc_damper::Model;
 
 use lpc_damper::metrics::Metric;
 use lpc_damper::studies::ensemble::{self, Agreement, Ensemble, Stats};
 
 use crate::args::{load_nominal, print_json, progress_bar, EnsembleArgs, Format, ModelArgs};
-use crate::table::{left, right, statistic, Table};
 use crate::exit::{ExitStatus, Result};
+use crate::table::{left, right, statistic, Table};
 
 #[derive(clap::Args)]
 pub struct Args {

@@ -10,8 +10,8 @@ use lpc_damper::scene::{self, Overrides};
 use lpc_damper::Model;
 
 use crate::args::{invalid, load_nominal, parse_range, print_json, progress_bar, EnsembleArgs, Format, ModelArgs};
-use crate::table::{right, Table};
 use crate::exit::{CommandError, ExitStatus, Result};
+use crate::table::{right, Table};
 
 #[derive(clap::Args)]
 pub struct Args {
@@ -95,8 +95,7 @@ pub fn run(a: Args) -> Result<ExitStatus> {
     bar.finish_and_clear();
     let elapsed = start.elapsed().as_secs_f64();
     if let Some(dir) = &a.out {
-        write_atomic(&dir.join("frf.json"), &serde_json::to_vec_pretty(&points)?)
-            .with_context(|| format!("writing {}", dir.display()))?;
+        write_atomic(&dir.join("frf.json"), &serde_json::to_vec_pretty(&points)?).with_context(|| format!("writing {}", dir.display()))?;
         let mut w = csv::Writer::from_writer(Vec::new());
         for p in &points {
             w.serialize(p)?;

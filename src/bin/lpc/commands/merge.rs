@@ -7,9 +7,9 @@ use std::path::{Path, PathBuf};
 use anyhow::Context;
 
 use lpc_damper::files::write_atomic;
+use lpc_damper::metrics::Metric;
 use lpc_damper::scene::SceneError;
 use lpc_damper::studies::ensemble::{self, EnsembleSummary, ShardInfo};
-use lpc_damper::metrics::Metric;
 
 use crate::args::Format;
 use crate::commands::run::{print_ensemble, write_table};
@@ -42,22 +42,16 @@ fn bad(dir: &Path, field: &str, rule: impl Into<String>) -> SceneError {
 
 fn read_shard(dir: &Path) -> std::result::Result<Shard, SceneError> {
     let read = |name: &str| {
-        std::fs::read(dir.join(name))
-            .map_err(|e| SceneError::Io { file: dir.join(name).display().to_string(), message: e.to_string() })
+        std::fs::read(dir.join(name)).map_err(|e| SceneError::Io { file: dir.join(name).display().to_string(), message: e.to_string() })
     };
-    let info: ShardInfo = serde_json::from_slice(&read("shard.json")?)
-        .map_err(|e| bad(dir, "shard.json", format!("is not a shard's description: {e}")))?;
+    let info: ShardInfo =
+        serde_json::from_slice(&read("shard.json")?).map_err(|e| bad(dir, "shard.json", format!("is not a shard's description: {e}")))?;
     if info.stop < info.start {
         return Err(bad(dir, "shard.json", format!("ends (member {}) before it starts ({})", info.stop, info.start)));
     }
     let bytes = read("members.csv")?;
     let mut reader = csv::Reader::from_reader(bytes.as_slice());
-    let header: Vec<String> = reader
-        .headers()
-        .map_err(|e| bad(dir, "members.csv", e.to_string()))?
-        .iter()
-        .map(String::from)
-        .collect();
+    let header: Vec<String> = reader.headers().map_err(|e| bad(dir, "members.csv", e.to_string()))?.iter().map(String::from).collect();
     // The table ends with the summary's metrics, in order: the merged summary reads them there.
     let tail = header.len().checked_sub(Metric::ALL.len()).map(|k| &header[k..]);
     if tail.is_none_or(|t| t.iter().zip(Metric::ALL).any(|(h, m)| h.as_str() != m.name())) {
@@ -94,7 +88,15 @@ pub fn run(a: Args) -> Result<ExitStatus> {
                 "shard.json",
                 format!(
                     "is a shard of another ensemble ({} / {} / seed {} / {} members) than {} ({} / {} / seed {} / {} members)",
-                    i.scene, i.model, i.seed, i.members, first.dir.display(), f.scene, f.model, f.seed, f.members
+                    i.scene,
+                    i.model,
+                    i.seed,
+                    i.members,
+                    first.dir.display(),
+                    f.scene,
+                    f.model,
+                    f.seed,
+                    f.members
                 ),
             )
             .into());
@@ -106,7 +108,12 @@ pub fn run(a: Args) -> Result<ExitStatus> {
         next = i.stop;
     }
     if next != first.info.members {
-        return Err(bad(&shards[shards.len() - 1].dir, "shard.json", format!("the shards end at member {next} of {}: some are missing", first.info.members)).into());
+        return Err(bad(
+            &shards[shards.len() - 1].dir,
+            "shard.json",
+            format!("the shards end at member {next} of {}: some are missing", first.info.members),
+        )
+        .into());
     }
     let header = first.header.clone();
     let rows: Vec<Vec<Option<f64>>> = shards.iter().flat_map(|s| s.rows.iter().cloned()).collect();

@@ -10,8 +10,8 @@ use lpc_damper::scene;
 use lpc_damper::Model;
 
 use crate::args::{invalid, parse_range, print_json, progress_bar, quantile_arg, EnsembleArgs, Format};
-use crate::table::{left, right, Table};
 use crate::exit::{ExitStatus, Result};
+use crate::table::{left, right, Table};
 
 #[derive(clap::Args)]
 pub struct Args {
@@ -101,17 +101,22 @@ pub fn run(a: Args) -> Result<ExitStatus> {
         }
     };
     let robust = match a.ensemble.ensemble {
-        Some(members) => Some(lpc_damper::studies::optimize::Robust {
-            members,
-            seed: a.ensemble.seed,
-            quantile: quantile_arg(a.quantile, &a.scene)?,
-        }),
+        Some(members) => {
+            Some(lpc_damper::studies::optimize::Robust { members, seed: a.ensemble.seed, quantile: quantile_arg(a.quantile, &a.scene)? })
+        }
         None => None,
     };
     let bar = progress_bar(usize::MAX >> 1, "designs");
     bar.set_style(ProgressStyle::with_template("{msg} {pos} ({elapsed})").expect("valid template"));
     let start = std::time::Instant::now();
-    let search = optimize(&loaded, &axes, &arrangements, length, Judging { objective, model: a.model, refinements: a.refinements, robust }, &|| bar.inc(1))?;
+    let search = optimize(
+        &loaded,
+        &axes,
+        &arrangements,
+        length,
+        Judging { objective, model: a.model, refinements: a.refinements, robust },
+        &|| bar.inc(1),
+    )?;
     bar.finish_and_clear();
     match a.format {
         Format::Json => print_json(&search)?,
@@ -151,7 +156,11 @@ pub fn run(a: Args) -> Result<ExitStatus> {
                 ]);
             }
             match &search.best {
-                Some(b) => println!("best: {} with {}", b.arrangement, b.values.iter().map(|(p, v)| format!("{p}={v}")).collect::<Vec<_>>().join(" ")),
+                Some(b) => println!(
+                    "best: {} with {}",
+                    b.arrangement,
+                    b.values.iter().map(|(p, v)| format!("{p}={v}")).collect::<Vec<_>>().join(" ")
+                ),
                 None => println!("no feasible design settled"),
             }
             match search.distinguishable {

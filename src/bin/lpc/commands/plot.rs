@@ -3,8 +3,8 @@
 use std::path::{Path, PathBuf};
 
 use lpc_damper::model::RunOptions;
-use lpc_damper::studies::chain::run_chain;
 use lpc_damper::scene;
+use lpc_damper::studies::chain::run_chain;
 use lpc_damper::Model;
 
 use crate::args::{invalid, override_scene, parse_size, ModelArgs};

@@ -175,7 +175,11 @@ fn run_ensemble(a: &Args, nominal: &lpc_damper::scene::Scene, members: &Ensemble
         write_ensemble_dir(dir, a.model, nominal, members, &runs, &summary)
             .with_context(|| format!("writing outputs to {}", dir.display()))?;
     }
-    print_ensemble(&summary, a.format, a.out.as_deref().map(|d| (d, "members.csv, members.parquet, ensemble.json, band.csv and the nominal run")))
+    print_ensemble(
+        &summary,
+        a.format,
+        a.out.as_deref().map(|d| (d, "members.csv, members.parquet, ensemble.json, band.csv and the nominal run")),
+    )
 }
 
 /// One shard of an ensemble: its members' table and `shard.json` for `lpc merge`.
@@ -212,7 +216,14 @@ fn run_shard(a: &Args, nominal: &lpc_damper::scene::Scene, members: &Ensemble, (
 }
 
 /// `members.csv` and `members.parquet` of an ensemble's (or a shard's) members.
-pub fn write_members(dir: &Path, model: Model, seed: u64, columns: &[String], members: &Ensemble, metrics: &[Vec<Option<f64>>]) -> anyhow::Result<()> {
+pub fn write_members(
+    dir: &Path,
+    model: Model,
+    seed: u64,
+    columns: &[String],
+    members: &Ensemble,
+    metrics: &[Vec<Option<f64>>],
+) -> anyhow::Result<()> {
     let (header, rows) = ensemble::members_table(columns, &members.members, metrics);
     write_table(dir, "members", &header, &rows, model, seed)
 }

@@ -1,8 +1,8 @@
 //! `lpc stability`: the contact model's stability map (step size x impact speed).
 
 use crate::args::{print_json, Format};
-use crate::table::{right, Table};
 use crate::exit::{ExitStatus, Result};
+use crate::table::{right, Table};
 
 #[derive(clap::Args)]
 pub struct Args {

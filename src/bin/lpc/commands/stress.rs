@@ -50,11 +50,8 @@ pub fn run(a: Args) -> Result<ExitStatus> {
         field: "--max-wall-time".into(),
         rule,
     })?;
-    let command_line = |field: &str, rule: String| lpc_damper::scene::SceneError::Invalid {
-        file: "(command line)".into(),
-        field: field.into(),
-        rule,
-    };
+    let command_line =
+        |field: &str, rule: String| lpc_damper::scene::SceneError::Invalid { file: "(command line)".into(), field: field.into(), rule };
     if !(a.max_horizon > 0.0 && a.max_horizon.is_finite()) {
         return Err(command_line("--max-horizon", format!("must be a positive number of seconds (got {})", a.max_horizon)).into());
     }

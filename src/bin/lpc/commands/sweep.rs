@@ -13,9 +13,9 @@ use lpc_damper::Model;
 use lpc_damper::studies::ensemble;
 use lpc_damper::studies::sweep::{Axis, Coordinates, EnsemblePoint, GridScene, SweepPoint};
 
-use crate::args::{invalid, override_scene, print_json, progress_bar, quantile_arg, EnsembleArgs, Format, Nominal, ModelArgs};
-use crate::table::{right, statistic, Table};
+use crate::args::{invalid, override_scene, print_json, progress_bar, quantile_arg, EnsembleArgs, Format, ModelArgs, Nominal};
 use crate::exit::{ExitStatus, Result};
+use crate::table::{right, statistic, Table};
 
 #[derive(clap::Args)]
 pub struct Args {
@@ -248,7 +248,13 @@ fn sweep_ensembles(a: &Args, nominal: &Nominal, axes: &[Axis], parameters: &[Str
                 let s = &p.metrics[a.metric.name()];
                 let mut cells = vec![p.at.value.to_string()];
                 cells.extend(p.at.value_y.map(|v| v.to_string()));
-                cells.extend([statistic(s.median), statistic(s.p05), statistic(s.p95), statistic(p.at_quantile[a.metric.name()]), s.undefined.to_string()]);
+                cells.extend([
+                    statistic(s.median),
+                    statistic(s.p05),
+                    statistic(s.p95),
+                    statistic(p.at_quantile[a.metric.name()]),
+                    s.undefined.to_string(),
+                ]);
                 table.print_row(&cells);
             }
         }

@@ -24,11 +24,15 @@ pub struct Args {
 
 pub fn run(a: Args) -> Result<ExitStatus> {
     if !cfg!(feature = "render") {
-        return Err(CommandError::failure(anyhow::anyhow!("this lpc was built without a renderer: build it with `cargo run --release --features render -- view ...`")));
+        return Err(CommandError::failure(anyhow::anyhow!(
+            "this lpc was built without a renderer: build it with `cargo run --release --features render -- view ...`"
+        )));
     }
     // The window is an X11 one; without a display winit cannot start (and would panic).
     if std::env::var_os("DISPLAY").is_none_or(|d| d.is_empty()) {
-        return Err(CommandError::failure(anyhow::anyhow!("no display: `lpc view` needs an X11 display (DISPLAY is not set); `lpc render` draws frames off-screen")));
+        return Err(CommandError::failure(anyhow::anyhow!(
+            "no display: `lpc view` needs an X11 display (DISPLAY is not set); `lpc render` draws frames off-screen"
+        )));
     }
     let s = load_scene(&a.scene, a.settings.overrides(a.horizon, None))?;
     let run = a.model.simulate(&s, &RunOptions::default())?;
