@@ -68,6 +68,7 @@ def run(
     dt: float | None = None,
     solver_iterations: int | None = None,
     ccd: bool = False,
+    tolerance: float | None = None,
     max_steps: int | None = None,
     max_wall_time: float | None = None,
 ) -> Run: ...
@@ -86,6 +87,7 @@ def ensemble(
     dt: float | None = None,
     solver_iterations: int | None = None,
     ccd: bool = False,
+    tolerance: float | None = None,
 ) -> Columns: ...
 def sweep_cells(scene: Scene, axes: Sequence[str] | None = None) -> int: ...
 def sweep(
@@ -101,6 +103,7 @@ def sweep(
     dt: float | None = None,
     solver_iterations: int | None = None,
     ccd: bool = False,
+    tolerance: float | None = None,
 ) -> Columns: ...
 def frf(scene: Scene, frequencies: Sequence[float], *, model: ModelName = "reference") -> Columns: ...
 def chain(scene: Scene, *, model: ModelName = "reference") -> Columns: ...
