@@ -72,8 +72,7 @@ impl<'a> System<'a> {
         let v_scale = scene.speed_scale();
         let mut pairs = Vec::new();
         let walls = scene.container.map(|c| c.length);
-        let range = if walls.is_some() { 0..n + 1 } else { 1..n.max(1) };
-        for p in range {
+        for p in crate::scene::pair_range(n, walls.is_some()) {
             let left = if p == 0 { Side::Wall(0.0) } else { Side::Ball(p - 1) };
             let right = if p == n { Side::Wall(walls.unwrap_or(0.0)) } else { Side::Ball(p) };
             let (r_star, m_star) = match (left, right) {

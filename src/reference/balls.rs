@@ -66,11 +66,7 @@ impl Balls {
     /// Pairs that can touch: `p` lies between body `p - 1` and body `p` (body `-1` is the left
     /// wall, body `n` the right wall).
     pub(super) fn pair_range(&self) -> std::ops::Range<usize> {
-        if self.walls {
-            0..self.n + 1
-        } else {
-            1..self.n.max(1)
-        }
+        crate::scene::pair_range(self.n, self.walls)
     }
 
     /// Moves the free balls on by `dt`, counting the rounding each step adds to their positions.

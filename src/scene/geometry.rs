@@ -63,6 +63,17 @@ impl Body {
     }
 }
 
+/// The pairs of neighbours of a line of `n` balls that can touch: pair `p` between body `p - 1`
+/// and body `p`, the walls included when the balls are in a container (pair 0 the left wall
+/// and ball 1, pair `n` ball `n` and the right wall), only ball-ball pairs otherwise.
+pub fn pair_range(n: usize, walls: bool) -> std::ops::Range<usize> {
+    if walls {
+        0..n + 1
+    } else {
+        1..n.max(1)
+    }
+}
+
 /// The bodies either side of pair `p` of a line of `n` balls: pair `p` lies between body
 /// `p - 1` and body `p`, the left wall being body `-1` and the right wall body `n`.
 pub fn pair_bodies(p: usize, n: usize) -> (Body, Body) {

@@ -14,7 +14,7 @@ use std::path::{Path, PathBuf};
 
 pub use excitation::Forcing;
 pub use format::{Arrangement, Distribution, ForcingKind, Length, SceneFile, Stepping};
-pub use geometry::{ball_radius, pair_bodies, pair_gap, Ball, BallKind, Body, Container};
+pub use geometry::{ball_radius, pair_bodies, pair_gap, pair_range, Ball, BallKind, Body, Container};
 pub use overrides::{with_settings_of, Overrides};
 pub use parameters::{Parameter, Tolerances};
 pub use rules::{from_file, validate_sample_dt};
