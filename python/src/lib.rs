@@ -640,7 +640,7 @@ fn chain<'py>(py: Python<'py>, scene: &Scene, model: &str) -> PyResult<Bound<'py
         scene.loaded.chain.as_ref().ok_or_else(|| {
             SceneError::new_err(format!("{}: `chain` is missing: the KER experiment needs a chain scene", scene.loaded.path))
         })?;
-    let rows = py.detach(|| chains::run_chain(cases, model)).map_err(model_error)?;
+    let rows = py.detach(|| chains::run_chain(cases, model, &|| {})).map_err(model_error)?;
     let d = PyDict::new(py);
     d.set_item("large", rows.iter().map(|r| r.large as i64).collect::<Vec<_>>().into_pyarray(py))?;
     d.set_item("small", rows.iter().map(|r| r.small as i64).collect::<Vec<_>>().into_pyarray(py))?;

@@ -88,7 +88,10 @@ impl Simulator for Reference {
     }
 
     fn simulate(&self, scene: &Scene, options: &RunOptions) -> Result<Run, ModelError> {
-        let meter = Meter::new(options, BUDGET_EVENTS);
+        // Every event reads every pair: with many balls the meter looks more often, so that a
+        // long run reports about once per a few hundred thousand pair readings.
+        let every = (BUDGET_EVENTS * 16 / (scene.balls.len() as u64 + 1)).clamp(1, BUDGET_EVENTS);
+        let meter = Meter::new(options, every);
         let mut solver = Solver::new(scene, options.record);
         let stop = solver.run(&meter)?;
         let (t, events) = (solver.t, solver.events);

@@ -25,12 +25,14 @@ pub fn ker(scene: &Scene, run: &Run) -> f64 {
     after / scene.initial_energy()
 }
 
-/// Runs every case with `model`, in parallel.
-pub fn run_chain(cases: &[ChainCase], model: Model) -> Result<Vec<KerRow>, ModelError> {
+/// Runs every case with `model`, in parallel; `progress` is called after each.
+pub fn run_chain(cases: &[ChainCase], model: Model, progress: &(dyn Fn() + Sync)) -> Result<Vec<KerRow>, ModelError> {
     cases
         .par_iter()
         .map(|c| {
-            let run = model.simulate(&c.scene, &RunOptions::default())?;
+            let run = model.simulate(&c.scene, &RunOptions::default());
+            progress();
+            let run = run?;
             Ok(KerRow { large: c.large, small: if c.small { c.large - 1 } else { 0 }, ker: ker(&c.scene, &run) })
         })
         .collect()

@@ -60,8 +60,9 @@ pub struct Row {
     pub ok: bool,
 }
 
-/// Runs every case of every scene file in `dir` with every model.
-pub fn current(dir: &Path, models: &[Model]) -> Result<Vec<Golden>, StudyError> {
+/// Runs every case of every scene file in `dir` with every model; `progress` is called after
+/// each run.
+pub fn current(dir: &Path, models: &[Model], progress: &(dyn Fn() + Sync)) -> Result<Vec<Golden>, StudyError> {
     let mut paths: Vec<PathBuf> = std::fs::read_dir(dir)
         .map_err(|e| StudyError::Io { path: dir.display().to_string(), message: e.to_string() })?
         .filter_map(|e| e.ok().map(|e| e.path()))
@@ -80,6 +81,7 @@ pub fn current(dir: &Path, models: &[Model]) -> Result<Vec<Golden>, StudyError> 
         for &model in models {
             for s in &cases {
                 let run = model.simulate(s, &RunOptions::default())?;
+                progress();
                 out.push(Golden {
                     case: s.name.clone(),
                     model,
@@ -90,7 +92,7 @@ pub fn current(dir: &Path, models: &[Model]) -> Result<Vec<Golden>, StudyError> 
             }
             if let Some(chain) = &loaded.chain {
                 let name = loaded.file.name.clone().unwrap_or_else(|| "chain".into());
-                out.push(Golden { case: name, model, impact_count: 0, metrics: None, ker: run_chain(chain, model)? });
+                out.push(Golden { case: name, model, impact_count: 0, metrics: None, ker: run_chain(chain, model, progress)? });
             }
         }
     }

@@ -139,8 +139,9 @@ pub fn cell(case: Case, config: Config, dt: f64, speed: f64) -> Cell {
     Cell { case, config: config.name, dt, speed, travel_per_step: speed * dt / scene.balls[0].radius, outcome, energy_error }
 }
 
-/// The whole map: every case, configuration, step and speed (in parallel).
-pub fn map() -> Vec<Cell> {
+/// The whole map: every case, configuration, step and speed (in parallel); `progress` is
+/// called after each cell.
+pub fn map(progress: &(dyn Fn() + Sync)) -> Vec<Cell> {
     use rayon::prelude::*;
     let mut jobs = vec![];
     for case in Case::ALL {
@@ -152,5 +153,11 @@ pub fn map() -> Vec<Cell> {
             }
         }
     }
-    jobs.into_par_iter().map(|(case, config, dt, speed)| cell(case, config, dt, speed)).collect()
+    jobs.into_par_iter()
+        .map(|(case, config, dt, speed)| {
+            let c = cell(case, config, dt, speed);
+            progress();
+            c
+        })
+        .collect()
 }

@@ -4,7 +4,6 @@
 use std::path::Path;
 
 use clap::ValueEnum;
-use indicatif::{ProgressBar, ProgressStyle};
 
 use lpc_damper::scene::{self, Loaded, Overrides, Scene, SceneError, SceneFile, Stepping, Tolerances};
 use lpc_damper::studies::ensemble::{self, Ensemble};
@@ -184,12 +183,4 @@ pub fn parse_range(text: &str, path: &Path, field: &str) -> std::result::Result<
 pub fn print_json<T: serde::Serialize>(value: &T) -> Result<()> {
     println!("{}", serde_json::to_string_pretty(value)?);
     Ok(())
-}
-
-/// A progress bar on a terminal when there is enough work to wait for; hidden otherwise.
-pub fn progress_bar(len: usize, label: &str) -> ProgressBar {
-    let bar = if len > 4 { ProgressBar::new(len as u64) } else { ProgressBar::hidden() };
-    bar.set_style(ProgressStyle::with_template("{msg} [{bar:30}] {pos}/{len} ({elapsed})").expect("valid template"));
-    bar.set_message(label.to_string());
-    bar
 }

@@ -14,6 +14,7 @@ mod args;
 mod commands;
 mod exit;
 mod table;
+mod watch;
 
 use std::process::ExitCode;
 

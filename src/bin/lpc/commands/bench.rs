@@ -6,7 +6,7 @@ use lpc_damper::files::write_atomic;
 use lpc_damper::scene::Overrides;
 use lpc_damper::Model;
 
-use crate::args::{load_scene, print_json, progress_bar, TableFormat};
+use crate::args::{load_scene, print_json, TableFormat};
 use crate::exit::{CommandError, ExitStatus, Result};
 use crate::table::{right, Table};
 
@@ -74,13 +74,13 @@ pub fn run(a: Args) -> Result<ExitStatus> {
         repeat: a.repeat,
     };
     let per_scene = a.models.iter().map(|&m| plan.variants(m).len()).sum::<usize>();
-    let bar = progress_bar(per_scene * paths.len(), "bench");
+    let work = crate::watch::Work::new(Some(per_scene * paths.len()), "bench");
     let mut rows = Vec::new();
     for p in &paths {
         let scene = load_scene(p, Overrides { horizon: a.horizon, ..Overrides::default() })?;
-        rows.extend(lpc_damper::studies::bench::bench_scene(&scene, &plan, &|| bar.inc(1))?);
+        rows.extend(lpc_damper::studies::bench::bench_scene(&scene, &plan, &|| work.inc())?);
     }
-    bar.finish_and_clear();
+    work.finish();
     let csv_bytes = bench_csv(&rows)?;
     if let Some(dir) = &a.out {
         write_atomic(&dir.join("bench.csv"), &csv_bytes)?;

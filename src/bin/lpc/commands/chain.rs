@@ -32,7 +32,9 @@ pub fn run(a: Args) -> Result<ExitStatus> {
     for c in &mut cases {
         override_scene(&mut c.scene, a.settings.overrides(None, None), &path)?;
     }
-    let rows: Vec<KerRow> = run_chain(&cases, a.model)?;
+    let work = crate::watch::Work::new(Some(cases.len()), "chain");
+    let rows: Vec<KerRow> = run_chain(&cases, a.model, &|| work.inc())?;
+    work.finish();
     match a.format {
         Format::Json => print_json(&rows)?,
         Format::Text => {

@@ -28,7 +28,9 @@ pub struct Args {
 }
 
 pub fn run(a: Args) -> Result<ExitStatus> {
-    let now = check::current(&a.dir, &a.models)?;
+    let work = crate::watch::Work::new(None, "check");
+    let now = check::current(&a.dir, &a.models, &|| work.inc())?;
+    work.finish();
     let mut rows = Vec::new();
     for g in &now {
         if a.update {

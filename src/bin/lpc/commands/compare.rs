@@ -14,7 +14,7 @@ use lpc_damper::Model;
 use lpc_damper::metrics::Metric;
 use lpc_damper::studies::ensemble::{self, Agreement, Ensemble, Stats};
 
-use crate::args::{load_nominal, print_json, progress_bar, EnsembleArgs, Format, ModelArgs};
+use crate::args::{load_nominal, print_json, EnsembleArgs, Format, ModelArgs};
 use crate::exit::{ExitStatus, Result};
 use crate::table::{left, right, statistic, Table};
 
@@ -61,11 +61,11 @@ pub fn run(a: Args) -> Result<ExitStatus> {
         return compare_ensembles(&a, &nominal.scene.name, &members);
     }
     let scene = nominal.scene;
-    let reference = Model::Reference.simulate(&scene, &RunOptions::default())?;
+    let reference = crate::watch::watched(Model::Reference, &scene, RunOptions::default(), None)?;
     let mut models = std::collections::BTreeMap::new();
     let mut runs = vec![];
     for &m in a.models.iter().filter(|m| **m != Model::Reference) {
-        let run = m.simulate(&scene, &RunOptions::default())?;
+        let run = crate::watch::watched(m, &scene, RunOptions::default(), None)?;
         models.insert(m.name().to_string(), ModelComparison { summary: RunSummary::of(&run), errors: errors(&run, &reference) });
         runs.push(run);
     }
@@ -150,10 +150,10 @@ struct EnsembleComparison {
 fn compare_ensembles(a: &Args, scene: &str, members: &Ensemble) -> Result<ExitStatus> {
     let mut runs = BTreeMap::new();
     for &m in std::iter::once(&Model::Reference).chain(a.models.iter().filter(|m| **m != Model::Reference)) {
-        let bar = progress_bar(members.members.len(), m.name());
+        let work = crate::watch::Work::new(Some(members.members.len()), m.name());
         let start = std::time::Instant::now();
-        let r = ensemble::run_members(members, m, false, &|| bar.inc(1))?;
-        bar.finish_and_clear();
+        let r = ensemble::run_members(members, m, false, &|| work.inc())?;
+        work.finish();
         runs.insert(m, (r.metrics, start.elapsed().as_secs_f64()));
     }
     let reference = &runs[&Model::Reference].0;

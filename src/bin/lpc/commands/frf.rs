@@ -9,7 +9,7 @@ use lpc_damper::files::write_atomic;
 use lpc_damper::scene::{self, Overrides};
 use lpc_damper::Model;
 
-use crate::args::{invalid, load_nominal, parse_range, print_json, progress_bar, EnsembleArgs, Format, ModelArgs};
+use crate::args::{invalid, load_nominal, parse_range, print_json, EnsembleArgs, Format, ModelArgs};
 use crate::exit::{CommandError, ExitStatus, Result};
 use crate::table::{right, Table};
 
@@ -89,10 +89,10 @@ pub fn run(a: Args) -> Result<ExitStatus> {
     if let Some(members) = nominal.ensemble_of(a.ensemble, &nominal.file, &scene)? {
         return frf_ensemble(&a, &scene, &members, &freqs);
     }
-    let bar = progress_bar(2 * freqs.len(), "frf");
+    let work = crate::watch::Work::new(Some(2 * freqs.len()), "frf");
     let start = std::time::Instant::now();
-    let points = lpc_damper::studies::frf::frf(&scene, &freqs, a.model, &|| bar.inc(1));
-    bar.finish_and_clear();
+    let points = lpc_damper::studies::frf::frf(&scene, &freqs, a.model, &|| work.inc());
+    work.finish();
     let elapsed = start.elapsed().as_secs_f64();
     if let Some(dir) = &a.out {
         write_atomic(&dir.join("frf.json"), &serde_json::to_vec_pretty(&points)?).with_context(|| format!("writing {}", dir.display()))?;
@@ -157,10 +157,10 @@ pub fn run(a: Args) -> Result<ExitStatus> {
 
 /// The response over an ensemble: per frequency the distribution of the per-period peaks.
 fn frf_ensemble(a: &Args, scene: &scene::Scene, members: &lpc_damper::studies::ensemble::Ensemble, freqs: &[f64]) -> Result<ExitStatus> {
-    let bar = progress_bar(2 * freqs.len() * members.members.len(), "frf");
+    let work = crate::watch::Work::new(Some(2 * freqs.len() * members.members.len()), "frf");
     let start = std::time::Instant::now();
-    let bands = lpc_damper::studies::frf::frf_ensemble(&members.members, freqs, a.model, &|| bar.inc(1));
-    bar.finish_and_clear();
+    let bands = lpc_damper::studies::frf::frf_ensemble(&members.members, freqs, a.model, &|| work.inc());
+    work.finish();
     let elapsed = start.elapsed().as_secs_f64();
     if let Some(dir) = &a.out {
         write_atomic(&dir.join("frf.json"), &serde_json::to_vec_pretty(&bands)?).with_context(|| format!("writing {}", dir.display()))?;

@@ -4,12 +4,11 @@
 use std::path::PathBuf;
 
 use clap::ValueEnum;
-use indicatif::ProgressStyle;
 
 use lpc_damper::scene;
 use lpc_damper::Model;
 
-use crate::args::{invalid, parse_range, print_json, progress_bar, quantile_arg, EnsembleArgs, Format};
+use crate::args::{invalid, parse_range, print_json, quantile_arg, EnsembleArgs, Format};
 use crate::exit::{ExitStatus, Result};
 use crate::table::{left, right, Table};
 
@@ -106,8 +105,7 @@ pub fn run(a: Args) -> Result<ExitStatus> {
         }
         None => None,
     };
-    let bar = progress_bar(usize::MAX >> 1, "designs");
-    bar.set_style(ProgressStyle::with_template("{msg} {pos} ({elapsed})").expect("valid template"));
+    let work = crate::watch::Work::new(None, "designs");
     let start = std::time::Instant::now();
     let search = optimize(
         &loaded,
@@ -115,9 +113,9 @@ pub fn run(a: Args) -> Result<ExitStatus> {
         &arrangements,
         length,
         Judging { objective, model: a.model, refinements: a.refinements, robust },
-        &|| bar.inc(1),
+        &|| work.inc(),
     )?;
-    bar.finish_and_clear();
+    work.finish();
     match a.format {
         Format::Json => print_json(&search)?,
         Format::Text => {

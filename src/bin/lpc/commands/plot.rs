@@ -79,7 +79,7 @@ pub fn run(a: Args) -> Result<ExitStatus> {
             for c in &mut cases {
                 override_scene(&mut c.scene, a.settings.overrides(None, None), &a.input)?;
             }
-            figs.push(figures::ker_chart(&run_chain(&cases, a.model)?, a.model.name()));
+            figs.push(figures::ker_chart(&run_chain(&cases, a.model, &|| {})?, a.model.name()));
         } else if loaded.file.sweep.is_some() {
             use rayon::prelude::*;
             let mut scenes = lpc_damper::studies::sweep::sweep_scenes(&loaded)?;
@@ -88,17 +88,23 @@ pub fn run(a: Args) -> Result<ExitStatus> {
             }
             let parameter = loaded.file.sweep.as_ref().map_or(String::new(), |s| s.parameter.clone());
             let values: Vec<String> = loaded.file.sweep.as_ref().map_or(vec![], |s| s.values.iter().map(|v| v.to_string()).collect());
+            let work = crate::watch::Work::new(Some(scenes.len()), "sweep");
             let runs = scenes
                 .par_iter()
                 .zip(values)
-                .map(|((_, s), label)| Ok((label, a.model.simulate(s, &RunOptions::default())?)))
+                .map(|((_, s), label)| {
+                    let run = a.model.simulate(s, &RunOptions::default());
+                    work.inc();
+                    Ok((label, run?))
+                })
                 .collect::<std::result::Result<Vec<_>, lpc_damper::model::ModelError>>()?;
+            work.finish();
             figs.push(figures::sweep_curves(&parameter, &runs));
         } else {
             let mut s = loaded.scene.clone().expect("a scene file without [chain] has [frame]");
             override_scene(&mut s, a.settings.overrides(None, None), &a.input)?;
-            let run = a.model.simulate(&s, &RunOptions::default())?;
-            let bare = lpc_damper::Model::Reference.simulate(&s.without_damper(), &RunOptions::default())?;
+            let run = crate::watch::watched(a.model, &s, RunOptions::default(), None)?;
+            let bare = crate::watch::watched(lpc_damper::Model::Reference, &s.without_damper(), RunOptions::default(), None)?;
             figs.extend(figures::time_histories(&run, (!s.balls.is_empty()).then_some(&bare)));
             if !s.balls.is_empty() {
                 figs.push(figures::ball_positions(&run, s.container.map(|c| c.length)));

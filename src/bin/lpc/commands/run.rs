@@ -6,6 +6,8 @@ use std::path::{Path, PathBuf};
 
 use anyhow::Context;
 
+use lpc_damper::model::RunOptions;
+
 use lpc_damper::files::write_atomic;
 use lpc_damper::metrics::{Metric, RunSummary};
 use lpc_damper::output::parquet::{provenance, table_parquet};
@@ -13,7 +15,7 @@ use lpc_damper::output::{table_csv, text_summary, write_run_dir};
 use lpc_damper::studies::ensemble::{self, Ensemble, EnsembleSummary, ShardInfo};
 use lpc_damper::Model;
 
-use crate::args::{load_nominal, parse_shard, print_json, progress_bar, EnsembleArgs, Format, ModelArgs};
+use crate::args::{load_nominal, parse_shard, print_json, EnsembleArgs, Format, ModelArgs};
 use crate::exit::{ExitStatus, Result};
 use crate::table::{left, right, statistic, Table};
 
@@ -54,80 +56,6 @@ pub struct Args {
     max_wall_time: Option<f64>,
 }
 
-/// How long a run goes before its progress is shown.
-const QUIET_FOR_S: f64 = 1.0;
-
-/// `model` on `scene` within the budgets of `a`. A long run says so early, with its estimated
-/// cost ([`lpc_damper::model::cost`], revised when it moves by more than twofold), and shows a
-/// progress bar (on a terminal) once it has run for [`QUIET_FOR_S`]; a run stopped by a budget
-/// is written to `--out` as far as it got before the error is reported.
-fn run_watched(a: &Args, scene: &lpc_damper::scene::Scene) -> Result<lpc_damper::run::Run> {
-    use lpc_damper::model::{cost, Progress, RunOptions};
-    use lpc_damper::scene::human;
-    let progress = Progress::default();
-    let options = RunOptions { max_steps: a.max_steps, max_wall_s: a.max_wall_time, progress: Some(&progress), ..RunOptions::default() };
-    options.check_budgets().map_err(|(budget, rule)| crate::args::invalid(&a.scene, budget.flag(), rule))?;
-    let model = a.model;
-    let unit = model.step_unit();
-    let done = std::sync::atomic::AtomicBool::new(false);
-    let result = std::thread::scope(|s| {
-        let watcher = s.spawn(|| {
-            let bar = indicatif::ProgressBar::new(1000);
-            let shown = std::cell::Cell::new(false);
-            let say = |said: cost::Said| {
-                // Said on a terminal or in a log: what the whole run will cost.
-                let e = said.estimate;
-                let line = format!(
-                    "{model}: `{}` {}: about {} {unit} and {:.1} s of computing in all, at its recent rate (t = {:.3e} of {} s \
-                     after {:.2} s and {} {unit}; lately {} {unit} per simulated second, {:.2e} s each; a run's cost can change \
-                     tenfold as it goes, so this is revised when it moves twofold; --max-steps and --max-wall-time bound it)",
-                    scene.name,
-                    if said.revision { "revised" } else { "is a long run" },
-                    human(e.steps.round()),
-                    e.seconds,
-                    said.t,
-                    human(scene.horizon),
-                    said.elapsed_s,
-                    said.steps,
-                    human(e.steps_per_simulated_second.round()),
-                    e.seconds_per_step,
-                );
-                if bar.is_hidden() || !shown.get() {
-                    eprintln!("{line}");
-                } else {
-                    bar.println(line);
-                }
-            };
-            let tick = |elapsed_s: f64, t: f64, steps: u64| {
-                if elapsed_s < QUIET_FOR_S {
-                    return;
-                }
-                if !shown.replace(true) {
-                    let template = format!("{model} [{{bar:30}}] {{msg}} ({{elapsed}}, about {{eta}} to go)");
-                    bar.set_style(indicatif::ProgressStyle::with_template(&template).expect("valid template"));
-                }
-                bar.set_position((1000.0 * t / scene.horizon).clamp(0.0, 1000.0) as u64);
-                bar.set_message(format!("t = {t:.3e} of {:.3e} s, {steps} {unit}", scene.horizon));
-            };
-            cost::watch(&progress, scene.horizon, &done, say, tick);
-            bar.finish_and_clear();
-        });
-        let result = model.simulate(scene, &options);
-        done.store(true, std::sync::atomic::Ordering::Relaxed);
-        watcher.thread().unpark();
-        result
-    });
-    let e = match result {
-        Ok(run) => return Ok(run),
-        Err(e) => e,
-    };
-    if let (Some(partial), Some(dir)) = (e.partial(), &a.out) {
-        write_run_dir(partial, dir).with_context(|| format!("writing outputs to {}", dir.display()))?;
-        eprintln!("wrote the run up to t = {} s to {}", human(partial.horizon), dir.display());
-    }
-    Err(e.into())
-}
-
 pub fn run(a: Args) -> Result<ExitStatus> {
     let nominal = load_nominal(&a.scene, a.settings.overrides(a.horizon, a.sample_dt))?;
     if let Some(shard) = a.shard {
@@ -147,7 +75,9 @@ pub fn run(a: Args) -> Result<ExitStatus> {
             lpc_damper::scene::human(scene.sample_dt * every as f64)
         );
     }
-    let run = run_watched(&a, &scene)?;
+    let options = RunOptions { max_steps: a.max_steps, max_wall_s: a.max_wall_time, ..RunOptions::default() };
+    options.check_budgets().map_err(|(budget, rule)| crate::args::invalid(&a.scene, budget.flag(), rule))?;
+    let run = crate::watch::watched(a.model, &scene, options, a.out.as_deref())?;
     let summary = RunSummary::of(&run);
     if let Some(dir) = &a.out {
         write_run_dir(&run, dir).with_context(|| format!("writing outputs to {}", dir.display()))?;
@@ -165,11 +95,11 @@ pub fn run(a: Args) -> Result<ExitStatus> {
 }
 
 fn run_ensemble(a: &Args, nominal: &lpc_damper::scene::Scene, members: &Ensemble) -> Result<ExitStatus> {
-    let bar = progress_bar(members.members.len(), "ensemble");
+    let work = crate::watch::Work::new(Some(members.members.len()), "ensemble");
     let start = std::time::Instant::now();
-    let runs = ensemble::run_members(members, a.model, a.out.is_some(), &|| bar.inc(1))?;
+    let runs = ensemble::run_members(members, a.model, a.out.is_some(), &|| work.inc())?;
     let wall_time_s = start.elapsed().as_secs_f64();
-    bar.finish_and_clear();
+    work.finish();
     let summary = EnsembleSummary::of(&nominal.name, a.model, members, &runs.metrics, wall_time_s);
     if let Some(dir) = &a.out {
         write_ensemble_dir(dir, a.model, nominal, members, &runs, &summary)
@@ -184,11 +114,11 @@ fn run_ensemble(a: &Args, nominal: &lpc_damper::scene::Scene, members: &Ensemble
 
 /// One shard of an ensemble: its members' table and `shard.json` for `lpc merge`.
 fn run_shard(a: &Args, nominal: &lpc_damper::scene::Scene, members: &Ensemble, (shard, shards): (usize, usize)) -> Result<ExitStatus> {
-    let bar = progress_bar(members.members.len(), "shard");
+    let work = crate::watch::Work::new(Some(members.members.len()), "shard");
     let start = std::time::Instant::now();
-    let runs = ensemble::run_members(members, a.model, false, &|| bar.inc(1))?;
+    let runs = ensemble::run_members(members, a.model, false, &|| work.inc())?;
     let wall_time_s = start.elapsed().as_secs_f64();
-    bar.finish_and_clear();
+    work.finish();
     let first = members.members.first().map_or(0, |m| m.index);
     let info = ShardInfo {
         scene: nominal.name.clone(),
@@ -293,7 +223,7 @@ fn write_ensemble_dir(
     runs: &ensemble::EnsembleRuns,
     summary: &EnsembleSummary,
 ) -> anyhow::Result<()> {
-    let run = model.simulate(nominal, &lpc_damper::model::RunOptions::default())?;
+    let run = model.simulate(nominal, &RunOptions::default())?;
     write_run_dir(&run, dir)?;
     write_members(dir, model, members.seed, &members.columns, members, &runs.metrics)?;
     write_atomic(&dir.join("ensemble.json"), &serde_json::to_vec_pretty(summary)?)?;

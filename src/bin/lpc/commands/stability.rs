@@ -13,7 +13,9 @@ pub struct Args {
 
 pub fn run(a: Args) -> Result<ExitStatus> {
     use lpc_damper::studies::stability::{self, Case, CONFIGS, DTS, SPEEDS};
-    let cells = stability::map();
+    let work = crate::watch::Work::new(None, "stability map");
+    let cells = stability::map(&|| work.inc());
+    work.finish();
     match a.format {
         Format::Json => print_json(&cells)?,
         Format::Text => {

@@ -5,7 +5,7 @@ use std::path::PathBuf;
 use lpc_damper::files::write_atomic;
 use lpc_damper::Model;
 
-use crate::args::{print_json, progress_bar, Format};
+use crate::args::{print_json, Format};
 use crate::exit::{CommandError, ExitStatus, Result};
 
 #[derive(clap::Args)]
@@ -67,9 +67,9 @@ pub fn run(a: Args) -> Result<ExitStatus> {
     let mut outcomes = Vec::new();
     let start = std::time::Instant::now();
     for &model in &a.models {
-        let bar = progress_bar(a.count as usize, &format!("stress {}", model.name()));
-        outcomes.extend(lpc_damper::studies::stress::stress(model, a.seed, a.count, draws, &|| bar.inc(1)));
-        bar.finish_and_clear();
+        let work = crate::watch::Work::new(Some(a.count as usize), &format!("stress {}", model.name()));
+        outcomes.extend(lpc_damper::studies::stress::stress(model, a.seed, a.count, draws, &|| work.inc()));
+        work.finish();
     }
     let failures: Vec<_> = outcomes.iter().filter(|o| o.failure.is_some()).collect();
     if let Some(dir) = &a.out {

@@ -13,7 +13,7 @@ use lpc_damper::Model;
 use lpc_damper::studies::ensemble;
 use lpc_damper::studies::sweep::{Axis, Coordinates, EnsemblePoint, GridScene, SweepPoint};
 
-use crate::args::{invalid, override_scene, print_json, progress_bar, quantile_arg, EnsembleArgs, Format, ModelArgs, Nominal};
+use crate::args::{invalid, override_scene, print_json, quantile_arg, EnsembleArgs, Format, ModelArgs, Nominal};
 use crate::exit::{ExitStatus, Result};
 use crate::table::{right, statistic, Table};
 
@@ -81,10 +81,10 @@ pub fn run(a: Args) -> Result<ExitStatus> {
         return sweep_ensembles(&a, &nominal, &axes, &parameters, &grid, q);
     }
     let parameter = parameters.join(" x ");
-    let bar = progress_bar(grid.len(), "sweep");
+    let work = crate::watch::Work::new(Some(grid.len()), "sweep");
     let start = std::time::Instant::now();
-    let points = lpc_damper::studies::sweep::run_grid(&parameters, &grid, a.model, &|| bar.inc(1))?;
-    bar.finish_and_clear();
+    let points = lpc_damper::studies::sweep::run_grid(&parameters, &grid, a.model, &|| work.inc())?;
+    work.finish();
     let elapsed = start.elapsed().as_secs_f64();
     if let Some(dir) = &a.out {
         let cells: Vec<Option<f64>> = points.iter().map(|p| Headline::of_summary(&p.summary).value(a.metric)).collect();
@@ -188,12 +188,12 @@ fn write_sweep(
 /// `q` quantile.
 fn sweep_ensembles(a: &Args, nominal: &Nominal, axes: &[Axis], parameters: &[String], grid: &[GridScene], q: f64) -> Result<ExitStatus> {
     let per_point = a.ensemble.ensemble.unwrap_or(1);
-    let bar = progress_bar(grid.len().saturating_mul(per_point), "sweep");
+    let work = crate::watch::Work::new(Some(grid.len().saturating_mul(per_point)), "sweep");
     let start = std::time::Instant::now();
     let mut points = vec![];
     for g in grid {
         let Some(members) = nominal.ensemble_of(a.ensemble, &g.file, &g.scene)? else { continue };
-        let runs = ensemble::run_members(&members, a.model, false, &|| bar.inc(1))?;
+        let runs = ensemble::run_members(&members, a.model, false, &|| work.inc())?;
         points.push(EnsemblePoint {
             at: Coordinates::of(parameters, &g.values),
             members: members.members.len(),
@@ -203,7 +203,7 @@ fn sweep_ensembles(a: &Args, nominal: &Nominal, axes: &[Axis], parameters: &[Str
             at_quantile: ensemble::metric_quantiles(&runs.metrics, q),
         });
     }
-    bar.finish_and_clear();
+    work.finish();
     let elapsed = start.elapsed().as_secs_f64();
     if let Some(dir) = &a.out {
         let cells: Vec<Option<f64>> = points.iter().map(|p| p.at_quantile[a.metric.name()]).collect();

@@ -35,7 +35,7 @@ pub fn run(a: Args) -> Result<ExitStatus> {
         )));
     }
     let s = load_scene(&a.scene, a.settings.overrides(a.horizon, None))?;
-    let run = a.model.simulate(&s, &RunOptions::default())?;
+    let run = crate::watch::watched(a.model, &s, RunOptions::default(), None)?;
     #[cfg(feature = "render")]
     lpc_damper::render::window::view(&s, run);
     #[cfg(not(feature = "render"))]
