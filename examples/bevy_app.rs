@@ -38,7 +38,7 @@ fn main() -> anyhow::Result<()> {
         app.update();
     }
     let reference = lpc_damper::Model::Reference.simulate(&scene, &lpc_damper::model::RunOptions::default())?;
-    let at = |t: f64| reference.series.xs[((t / reference.sample_dt).round() as usize).min(reference.series.len() - 1)];
+    let at = |t: f64| reference.series.xs()[((t / reference.sample_dt).round() as usize).min(reference.series.len() - 1)];
     println!("{:>8} {:>14} {:>14}", "t s", "rapier xs mm", "reference mm");
     for &(t, xs) in &app.world().resource::<Watch>().xs {
         println!("{t:>8.4} {:>14.4} {:>14.4}", xs * 1e3, at(t) * 1e3);

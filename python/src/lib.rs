@@ -292,6 +292,38 @@ impl Run {
         })
     }
 
+    /// The series as one NumPy array `(columns, capacity)`, moved out of the run on first
+    /// reading: every series attribute is a view of it.
+    fn table(&self, py: Python<'_>, run: &mut lpc_damper::run::Run) -> PyResult<(Py<PyAny>, usize, usize)> {
+        {
+            let made = self.made.lock_py_attached(py).expect("not poisoned");
+            if let (Some(table), Some(shape)) = (made.get("table"), made.get("table_shape")) {
+                let (columns, len): (usize, usize) = shape.extract(py)?;
+                return Ok((table.clone_ref(py), columns, len));
+            }
+        }
+        let (data, capacity, len, columns) = std::mem::take(&mut run.series).into_buffer();
+        let array = Array2::from_shape_vec((columns, capacity), data).map_err(|e| PyRuntimeError::new_err(e.to_string()))?;
+        let table = array.into_pyarray(py).into_any().unbind();
+        let mut made = self.made.lock_py_attached(py).expect("not poisoned");
+        made.insert("table", table.clone_ref(py));
+        made.insert("table_shape", (columns, len).into_pyobject(py)?.into_any().unbind());
+        Ok((table, columns, len))
+    }
+
+    /// Row `first` of the series table (`step`: every `step`-th row from `first`, a matrix),
+    /// its used samples only.
+    fn columns(&self, py: Python<'_>, run: &mut lpc_damper::run::Run, first: usize, step: Option<usize>) -> PyResult<Py<PyAny>> {
+        use pyo3::types::PySlice;
+        let (table, columns, len) = self.table(py, run)?;
+        let samples = PySlice::new(py, 0, len as isize, 1);
+        let index = match step {
+            None => (first.into_pyobject(py)?.into_any(), samples.into_any()),
+            Some(step) => (PySlice::new(py, first as isize, columns as isize, step as isize).into_any(), samples.into_any()),
+        };
+        Ok(table.bind(py).get_item(index)?.unbind())
+    }
+
     fn part(&self, py: Python<'_>, key: &str) -> PyResult<Py<PyAny>> {
         Ok(self.summary(py)?.bind(py).get_item(key)?.unbind())
     }
@@ -302,32 +334,32 @@ impl Run {
     /// Sample times, s.
     #[getter]
     fn t(&self, py: Python<'_>) -> PyResult<Py<PyAny>> {
-        self.cached(py, "t", |py, r| Ok(floats(py, std::mem::take(&mut r.series.t))))
+        self.cached(py, "t", |py, r| self.columns(py, r, 0, None))
     }
     /// Frame displacement, m.
     #[getter]
     fn xs(&self, py: Python<'_>) -> PyResult<Py<PyAny>> {
-        self.cached(py, "xs", |py, r| Ok(floats(py, std::mem::take(&mut r.series.xs))))
+        self.cached(py, "xs", |py, r| self.columns(py, r, 1, None))
     }
     /// Frame velocity, m/s.
     #[getter]
     fn vs(&self, py: Python<'_>) -> PyResult<Py<PyAny>> {
-        self.cached(py, "vs", |py, r| Ok(floats(py, std::mem::take(&mut r.series.vs))))
+        self.cached(py, "vs", |py, r| self.columns(py, r, 2, None))
     }
     /// Frame acceleration without impulses and contact forces, m/s^2.
     #[getter]
     fn a(&self, py: Python<'_>) -> PyResult<Py<PyAny>> {
-        self.cached(py, "a", |py, r| Ok(floats(py, std::mem::take(&mut r.series.a))))
+        self.cached(py, "a", |py, r| self.columns(py, r, 3, None))
     }
     /// Ball centres, `(balls, samples)`, m.
     #[getter]
     fn x(&self, py: Python<'_>) -> PyResult<Py<PyAny>> {
-        self.cached(py, "x", |py, r| matrix(py, std::mem::take(&mut r.series.x), r.series.t.len().max(r.series.xs.len())))
+        self.cached(py, "x", |py, r| self.columns(py, r, 4, Some(2)))
     }
     /// Ball velocities, `(balls, samples)`, m/s.
     #[getter]
     fn v(&self, py: Python<'_>) -> PyResult<Py<PyAny>> {
-        self.cached(py, "v", |py, r| matrix(py, std::mem::take(&mut r.series.v), r.series.t.len().max(r.series.xs.len())))
+        self.cached(py, "v", |py, r| self.columns(py, r, 5, Some(2)))
     }
     /// Impacts: `t`, `body_a`, `body_b`, `approach_speed`, `energy_lost`, `peak_force`,
     /// `contact_duration` (NaN for impulse models).
@@ -367,18 +399,6 @@ impl Run {
     fn __repr__(&self) -> String {
         format!("Run(scene={:?}, model={:?}, horizon={}, wall_time_s={:.3e})", self.scene, self.model, self.horizon, self.wall_time_s)
     }
-}
-
-/// `(balls, samples)` from one vector per ball, moved into one array.
-fn matrix(py: Python<'_>, rows: Vec<Vec<f64>>, samples: usize) -> PyResult<Py<PyAny>> {
-    let balls = rows.len();
-    let samples = rows.first().map_or(samples, Vec::len);
-    let mut flat = Vec::with_capacity(balls * samples);
-    for r in rows {
-        flat.extend(r);
-    }
-    let array = Array2::from_shape_vec((balls, samples), flat).map_err(|e| PyRuntimeError::new_err(e.to_string()))?;
-    Ok(array.into_pyarray(py).into_any().unbind())
 }
 
 fn floats(py: Python<'_>, values: Vec<f64>) -> Py<PyAny> {

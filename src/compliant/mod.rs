@@ -106,7 +106,7 @@ fn overlap_bound(scene: &Scene, run: &Run) -> f64 {
     let m_max = scene.balls.iter().map(|b| b.mass).fold(0.0, f64::max);
     let m_all: f64 = scene.balls.iter().map(|b| b.mass).sum();
     let u_max = run.impacts.iter().map(|i| i.approach_speed).fold(0.0, f64::max);
-    let a_max = run.series.a.iter().fold(0.0f64, |m, a| m.max(a.abs()));
+    let a_max = run.series.a().iter().fold(0.0f64, |m, a| m.max(a.abs()));
     1e-9 * scene.container.map_or(1e-3, |c| c.length.max(1e-3))
         + 2.0 * (contact::max_overlap(m_max, u_max, k) + (m_all * a_max / k).powf(2.0 / 3.0))
 }

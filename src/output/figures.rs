@@ -262,11 +262,11 @@ fn scaled(v: &[f64], k: f64) -> Vec<f64> {
 /// when given, without it (the bare frame).
 pub fn time_histories(with: &Run, without: Option<&Run>) -> Vec<Figure> {
     let label = |r: &Run, what: &str| format!("{what} ({})", r.model);
-    let mut disp = vec![Curve { label: label(with, "with damper"), x: with.series.t.clone(), y: scaled(&with.series.xs, 1e3) }];
-    let mut acc = vec![Curve { label: label(with, "with damper"), x: with.series.t.clone(), y: with.series.a.clone() }];
+    let mut disp = vec![Curve { label: label(with, "with damper"), x: with.series.t().to_vec(), y: scaled(with.series.xs(), 1e3) }];
+    let mut acc = vec![Curve { label: label(with, "with damper"), x: with.series.t().to_vec(), y: with.series.a().to_vec() }];
     if let Some(w) = without {
-        disp.insert(0, Curve { label: "without damper".into(), x: w.series.t.clone(), y: scaled(&w.series.xs, 1e3) });
-        acc.insert(0, Curve { label: "without damper".into(), x: w.series.t.clone(), y: w.series.a.clone() });
+        disp.insert(0, Curve { label: "without damper".into(), x: w.series.t().to_vec(), y: scaled(w.series.xs(), 1e3) });
+        acc.insert(0, Curve { label: "without damper".into(), x: w.series.t().to_vec(), y: w.series.a().to_vec() });
     }
     vec![
         Figure {
@@ -292,15 +292,15 @@ pub fn time_histories(with: &Run, without: Option<&Run>) -> Vec<Figure> {
 /// faces when the container length is known.
 pub fn ball_positions(run: &Run, container_length: Option<f64>) -> Figure {
     let s = &run.series;
-    let mut curves: Vec<Curve> = (0..s.x.len())
+    let mut curves: Vec<Curve> = (0..s.balls())
         .map(|i| Curve {
             label: format!("ball{}", i + 1),
-            x: s.t.clone(),
-            y: s.x[i].iter().zip(&s.xs).map(|(x, xs)| (x - xs) * 1e3).collect(),
+            x: s.t().to_vec(),
+            y: s.x(i).iter().zip(s.xs()).map(|(x, xs)| (x - xs) * 1e3).collect(),
         })
         .collect();
     if let Some(l) = container_length {
-        let ends = vec![s.t.first().copied().unwrap_or(0.0), s.t.last().copied().unwrap_or(0.0)];
+        let ends = vec![s.t().first().copied().unwrap_or(0.0), s.t().last().copied().unwrap_or(0.0)];
         curves.push(Curve { label: "left wall".into(), x: ends.clone(), y: vec![0.0, 0.0] });
         curves.push(Curve { label: "right wall".into(), x: ends, y: vec![l * 1e3, l * 1e3] });
     }
@@ -324,7 +324,7 @@ pub fn sweep_curves(parameter: &str, runs: &[(String, Run)]) -> Figure {
         y_desc: "xs (mm)".into(),
         curves: runs
             .iter()
-            .map(|(value, r)| Curve { label: format!("{parameter} = {value}"), x: r.series.t.clone(), y: scaled(&r.series.xs, 1e3) })
+            .map(|(value, r)| Curve { label: format!("{parameter} = {value}"), x: r.series.t().to_vec(), y: scaled(r.series.xs(), 1e3) })
             .collect(),
         points: false,
     }
@@ -386,7 +386,7 @@ pub fn band_chart(nominal: &Run, band: &[[f64; 5]]) -> Figure {
         x_desc: "t (s)".into(),
         y_desc: "xs (mm)".into(),
         curves: vec![
-            Curve { label: "nominal".into(), x: nominal.series.t.clone(), y: nominal.series.xs.iter().map(|x| x * 1e3).collect() },
+            Curve { label: "nominal".into(), x: nominal.series.t().to_vec(), y: nominal.series.xs().iter().map(|x| x * 1e3).collect() },
             Curve { label: "members: 5 %".into(), x: t.clone(), y: column(1) },
             Curve { label: "members: median".into(), x: t.clone(), y: column(2) },
             Curve { label: "members: 95 %".into(), x: t, y: column(3) },
@@ -422,7 +422,7 @@ pub fn overlay(runs: &[(String, Series)], scene: &str) -> Figure {
         title: format!("{scene}: frame displacement, every model"),
         x_desc: "t (s)".into(),
         y_desc: "xs (mm)".into(),
-        curves: runs.iter().map(|(m, s)| Curve { label: m.clone(), x: s.t.clone(), y: scaled(&s.xs, 1e3) }).collect(),
+        curves: runs.iter().map(|(m, s)| Curve { label: m.clone(), x: s.t().to_vec(), y: scaled(s.xs(), 1e3) }).collect(),
         points: false,
     }
 }
@@ -437,25 +437,23 @@ pub fn read_series_csv(path: &Path) -> Result<Series, FigureError> {
         return Err(fail("is not a series.csv (expected columns t, xs, vs, a, x1, v1, ...)".into()));
     }
     let balls = (cols - 4) / 2;
-    let mut s = Series::with_capacity(balls, 0);
-    s.x = vec![vec![]; balls];
-    s.v = vec![vec![]; balls];
+    let mut columns: Vec<Vec<f64>> = vec![vec![]; cols];
     for (line, rec) in r.records().enumerate() {
         let rec = rec.map_err(|e| fail(e.to_string()))?;
-        let num = |k: usize| -> Result<f64, FigureError> {
-            rec.get(k)
-                .and_then(|v| v.parse::<f64>().ok())
-                .ok_or_else(|| fail(format!("row {}: column `{}` is not a number", line + 2, &header[k])))
-        };
-        s.t.push(num(0)?);
-        s.xs.push(num(1)?);
-        s.vs.push(num(2)?);
-        s.a.push(num(3)?);
-        for i in 0..balls {
-            s.x[i].push(num(4 + 2 * i)?);
-            s.v[i].push(num(5 + 2 * i)?);
+        for (k, column) in columns.iter_mut().enumerate() {
+            let value = rec.get(k).and_then(|v| v.parse::<f64>().ok());
+            column.push(value.ok_or_else(|| fail(format!("row {}: column `{}` is not a number", line + 2, &header[k])))?);
         }
     }
+    let mut columns = columns.into_iter();
+    let mut next = || columns.next().unwrap_or_default();
+    let (t, xs, vs, a) = (next(), next(), next(), next());
+    let (mut x, mut v) = (Vec::with_capacity(balls), Vec::with_capacity(balls));
+    for _ in 0..balls {
+        x.push(next());
+        v.push(next());
+    }
+    let s = Series::from_columns(t, xs, vs, a, x, v);
     Ok(s)
 }
 

@@ -20,7 +20,7 @@ pub fn write_series_csv(run: &Run, out: &mut dyn Write) -> std::io::Result<()> {
     let s = &run.series;
     let mut w = csv::Writer::from_writer(out);
     let mut header = vec!["t".to_string(), "xs".into(), "vs".into(), "a".into()];
-    for i in 0..s.x.len() {
+    for i in 0..s.balls() {
         header.push(format!("x{}", i + 1));
         header.push(format!("v{}", i + 1));
     }
@@ -28,10 +28,10 @@ pub fn write_series_csv(run: &Run, out: &mut dyn Write) -> std::io::Result<()> {
     let mut row = Vec::with_capacity(header.len());
     for k in 0..s.len() {
         row.clear();
-        row.extend([s.t[k], s.xs[k], s.vs[k], s.a[k]].iter().map(|x| x.to_string()));
-        for i in 0..s.x.len() {
-            row.push(s.x[i][k].to_string());
-            row.push(s.v[i][k].to_string());
+        row.extend([s.t()[k], s.xs()[k], s.vs()[k], s.a()[k]].iter().map(|x| x.to_string()));
+        for i in 0..s.balls() {
+            row.push(s.x(i)[k].to_string());
+            row.push(s.v(i)[k].to_string());
         }
         w.write_record(&row)?;
     }

@@ -33,7 +33,7 @@ pub use crate::impact_law::impact_law;
 use crate::model::{Budget, Checks, Meter, Model, ModelError, OverBudget, RunOptions, Setting, Simulator};
 pub use crate::oscillator::Oscillator;
 use crate::oscillator::{gauss_legendre, Harmonic, ROUNDOFF_ULPS};
-use crate::run::{EnergyAccount, Impact, Record, Recorder, Run};
+use crate::run::{BallPath, EnergyAccount, Impact, Record, Recorder, Run};
 use crate::scene::{Body, Scene};
 
 /// Most events one run may process before it is declared stalled.

@@ -22,5 +22,5 @@ pub use stage::{Layout, Playback};
 pub fn state_at_sample(run: &Run, k: usize) -> (f64, Vec<f64>) {
     let s = &run.series;
     let k = k.min(s.len().saturating_sub(1));
-    (s.xs.get(k).copied().unwrap_or(0.0), s.x.iter().map(|x| x.get(k).copied().unwrap_or(0.0)).collect())
+    (s.xs().get(k).copied().unwrap_or(0.0), (0..s.balls()).map(|i| s.x(i).get(k).copied().unwrap_or(0.0)).collect())
 }

@@ -125,7 +125,7 @@ impl Playback {
 
     /// Simulated time of the sample shown, s.
     pub fn time(&self) -> f64 {
-        self.run.series.t.get(self.sample).copied().unwrap_or(0.0)
+        self.run.series.t().get(self.sample).copied().unwrap_or(0.0)
     }
 
     /// Impacts up to the sample shown.

@@ -105,11 +105,11 @@ fn advance(time: Res<Time>, mut controls: ResMut<Controls>, mut playback: ResMut
     if controls.paused {
         return;
     }
-    let horizon = playback.run.series.t.last().copied().unwrap_or(0.0);
+    let horizon = playback.run.series.t().last().copied().unwrap_or(0.0);
     controls.t = (controls.t + time.delta_secs_f64() * controls.speed).min(horizon);
     // The sample at or just before the time on screen.
     let t = controls.t;
-    playback.sample = playback.run.series.t.partition_point(|&s| s <= t + 1e-12).saturating_sub(1);
+    playback.sample = playback.run.series.t().partition_point(|&s| s <= t + 1e-12).saturating_sub(1);
 }
 
 fn orbit(
@@ -135,15 +135,15 @@ fn overlay(playback: Res<Playback>, controls: Res<Controls>, scene: Res<ViewScen
     if s.is_empty() {
         return;
     }
-    let frame = scene.0.frame.map_or(0.0, |f| f.energy(s.xs[k], s.vs[k]));
-    let balls: f64 = scene.0.balls.iter().enumerate().map(|(i, b)| 0.5 * b.mass * s.v[i][k].powi(2)).sum();
+    let frame = scene.0.frame.map_or(0.0, |f| f.energy(s.xs()[k], s.vs()[k]));
+    let balls: f64 = scene.0.balls.iter().enumerate().map(|(i, b)| 0.5 * b.mass * s.v(i)[k].powi(2)).sum();
     for mut t in &mut text {
         t.0 = format!(
             "{} ({})\nt = {:.3} s   xs = {:+.2} mm\nimpacts {}   energy {:.4} J\nspeed x{}{}\n[Space] pause  [Right] step  [Up/Down] speed  [R] restart  drag: orbit  wheel: zoom",
             playback.run.scene,
             playback.run.model,
-            s.t[k],
-            1e3 * s.xs[k],
+            s.t()[k],
+            1e3 * s.xs()[k],
             playback.impacts_so_far(),
             frame + balls,
             controls.speed,

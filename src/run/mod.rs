@@ -9,7 +9,7 @@ pub use memory::{
     available_memory, bytes_for_people, check_memory, fits_in_memory, refuse_beyond_memory, series_bytes, series_every, MAX_SERIES_EVERY,
     MEMORY_SHARE,
 };
-pub use series::{Record, Recorder, Series};
+pub use series::{BallPath, Record, Recorder, Series};
 pub use tally::{MotionMetrics, SampleTally, DISSIPATION_LEVELS, SETTLING_FRACTION};
 
 use crate::scene::Body;

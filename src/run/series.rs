@@ -6,48 +6,150 @@ use super::memory::{series_every, MAX_SERIES_EVERY};
 use super::tally::{MotionMetrics, SampleTally};
 use crate::scene::Scene;
 
-/// Series sampled every `sample_dt` from `t = 0` to the horizon (inclusive where it falls on a sample).
-#[derive(Debug, Clone, Default, PartialEq)]
+/// Series sampled every `sample_dt` from `t = 0` to the horizon (inclusive where it falls on a
+/// sample): the time, the frame's displacement, velocity and acceleration, and every ball's
+/// centre and velocity.
+///
+/// The columns live in one allocation, each `capacity` long, so that a run's series costs one
+/// allocation however many balls it has (and a run repeated in one process reuses it rather
+/// than asking the system for fresh pages each time).
+#[derive(Debug, Clone, Default)]
 pub struct Series {
-    /// s.
-    pub t: Vec<f64>,
-    /// Frame displacement, m.
-    pub xs: Vec<f64>,
-    /// Frame velocity, m/s.
-    pub vs: Vec<f64>,
-    /// Frame acceleration without impulses and contact forces, `(Fe - cs vs - ks xs)/ms`
-    /// ([`crate::scene::Scene::frame_acceleration`]), m/s^2.
-    pub a: Vec<f64>,
-    /// Ball centres, `[ball][sample]`, m.
-    pub x: Vec<Vec<f64>>,
-    /// Ball velocities, `[ball][sample]`, m/s.
-    pub v: Vec<Vec<f64>>,
+    /// Column `c` is `data[c * capacity..c * capacity + len]`.
+    data: Vec<f64>,
+    capacity: usize,
+    len: usize,
+    balls: usize,
     /// The series keeps every `every`-th sample of the run (1, or 0 for a series built by
     /// hand: all of them): more when the whole series would not fit in memory
     /// ([`series_every`]). The metrics always see every sample.
     pub every: usize,
 }
 
+/// Columns before the balls': `t`, `xs`, `vs`, `a`.
+const FRAME_COLUMNS: usize = 4;
+
+impl PartialEq for Series {
+    fn eq(&self, other: &Self) -> bool {
+        self.len == other.len
+            && self.balls == other.balls
+            && self.every == other.every
+            && (0..self.columns()).all(|c| self.column(c) == other.column(c))
+    }
+}
+
 impl Series {
     /// An empty series with room for `samples` samples of `balls` balls.
     pub fn with_capacity(balls: usize, samples: usize) -> Self {
-        Series {
-            t: Vec::with_capacity(samples),
-            xs: Vec::with_capacity(samples),
-            vs: Vec::with_capacity(samples),
-            a: Vec::with_capacity(samples),
-            x: (0..balls).map(|_| Vec::with_capacity(samples)).collect(),
-            v: (0..balls).map(|_| Vec::with_capacity(samples)).collect(),
-            every: 1,
+        Series { data: vec![0.0; (FRAME_COLUMNS + 2 * balls) * samples], capacity: samples, len: 0, balls, every: 1 }
+    }
+    /// A series of the given columns (all of one length): times, the frame's displacement,
+    /// velocity and acceleration, and each ball's centre and velocity.
+    pub fn from_columns(t: Vec<f64>, xs: Vec<f64>, vs: Vec<f64>, a: Vec<f64>, x: Vec<Vec<f64>>, v: Vec<Vec<f64>>) -> Self {
+        let mut s = Series::with_capacity(x.len(), t.len());
+        s.len = t.len();
+        let columns = [t, xs, vs, a].into_iter().chain(x.into_iter().zip(v).flat_map(|(x, v)| [x, v]));
+        for (c, column) in columns.enumerate() {
+            assert_eq!(column.len(), s.len, "every column of a series has one length");
+            s.column_mut(c).copy_from_slice(&column);
         }
+        s
     }
     /// Number of samples.
     pub fn len(&self) -> usize {
-        self.t.len()
+        self.len
     }
     /// True when no sample was taken.
     pub fn is_empty(&self) -> bool {
-        self.t.is_empty()
+        self.len == 0
+    }
+    /// Number of balls.
+    pub fn balls(&self) -> usize {
+        self.balls
+    }
+    fn columns(&self) -> usize {
+        FRAME_COLUMNS + 2 * self.balls
+    }
+    fn column(&self, c: usize) -> &[f64] {
+        &self.data[c * self.capacity..c * self.capacity + self.len]
+    }
+    fn column_mut(&mut self, c: usize) -> &mut [f64] {
+        &mut self.data[c * self.capacity..c * self.capacity + self.len]
+    }
+    /// Sample times, s.
+    pub fn t(&self) -> &[f64] {
+        self.column(0)
+    }
+    /// Frame displacement, m.
+    pub fn xs(&self) -> &[f64] {
+        self.column(1)
+    }
+    /// Frame velocity, m/s.
+    pub fn vs(&self) -> &[f64] {
+        self.column(2)
+    }
+    /// Frame acceleration without impulses and contact forces, `(Fe - cs vs - ks xs)/ms`
+    /// ([`crate::scene::Scene::frame_acceleration`]), m/s^2.
+    pub fn a(&self) -> &[f64] {
+        self.column(3)
+    }
+    /// Ball `i`'s centre, m.
+    pub fn x(&self, i: usize) -> &[f64] {
+        self.column(FRAME_COLUMNS + 2 * i)
+    }
+    /// Ball `i`'s velocity, m/s.
+    pub fn v(&self, i: usize) -> &[f64] {
+        self.column(FRAME_COLUMNS + 2 * i + 1)
+    }
+    /// Every column, as vectors: `t`, `xs`, `vs`, `a`, then each ball's `x` and `v`.
+    pub fn into_columns(self) -> Vec<Vec<f64>> {
+        (0..self.columns()).map(|c| self.column(c).to_vec()).collect()
+    }
+    /// The columns as one buffer, moved out: `(data, capacity, len, columns)`, column `c` being
+    /// `data[c * capacity..c * capacity + len]` (`t`, `xs`, `vs`, `a`, then each ball's `x` and
+    /// `v`). For handing the whole series to another owner (NumPy) without a copy.
+    pub fn into_buffer(self) -> (Vec<f64>, usize, usize, usize) {
+        let columns = self.columns();
+        (self.data, self.capacity, self.len, columns)
+    }
+    /// Makes room for `more` samples (moving the columns apart when the capacity grows).
+    fn reserve(&mut self, more: usize) {
+        let need = self.len + more;
+        if need <= self.capacity {
+            return;
+        }
+        let capacity = need.max(2 * self.capacity);
+        let mut data = vec![0.0; self.columns() * capacity];
+        for c in 0..self.columns() {
+            data[c * capacity..c * capacity + self.len].copy_from_slice(self.column(c));
+        }
+        (self.data, self.capacity) = (data, capacity);
+    }
+    /// Appends one sample.
+    #[inline]
+    fn push(&mut self, t: f64, xs: f64, vs: f64, a: f64, mut ball: impl FnMut(usize) -> (f64, f64)) {
+        self.reserve(1);
+        let (k, cap) = (self.len, self.capacity);
+        for (c, value) in [t, xs, vs, a].into_iter().enumerate() {
+            self.data[c * cap + k] = value;
+        }
+        for i in 0..self.balls {
+            let (x, v) = ball(i);
+            self.data[(FRAME_COLUMNS + 2 * i) * cap + k] = x;
+            self.data[(FRAME_COLUMNS + 2 * i + 1) * cap + k] = v;
+        }
+        self.len += 1;
+    }
+    /// The next `count` times, written already, and the next `count` entries of column `c`
+    /// (after the time column), to be written.
+    fn time_and_column(&mut self, c: usize, count: usize) -> (&[f64], &mut [f64]) {
+        let (times, rest) = self.data.split_at_mut(c * self.capacity);
+        (&times[self.len..self.len + count], &mut rest[self.len..self.len + count])
+    }
+    /// The next `count` entries of column `c`, to be written (the caller then sets `len`).
+    fn spare(&mut self, c: usize, count: usize) -> &mut [f64] {
+        let start = c * self.capacity + self.len;
+        &mut self.data[start..start + count]
     }
 }
 
@@ -60,6 +162,37 @@ pub enum Record {
     /// Nothing but the metrics: a run that feeds only statistics (an ensemble member) builds
     /// no series, so it needs no memory per sample.
     MetricsOnly,
+}
+
+/// How a ball moves over an interval between events: in free flight from `x` at time `t`, or
+/// held by the frame at `offset` from it (moving with it).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum BallPath {
+    /// At `x + v (ts - t)`, velocity `v`.
+    Free {
+        /// Position at `t`, m.
+        x: f64,
+        /// Velocity, m/s.
+        v: f64,
+        /// The time of `x`, s.
+        t: f64,
+    },
+    /// At `xs + offset`, the frame's velocity.
+    Held {
+        /// Centre less the frame's displacement, m.
+        offset: f64,
+    },
+}
+
+impl BallPath {
+    /// Position and velocity at `ts`, the frame being at `(xs, vs)`.
+    #[inline]
+    pub fn at(&self, ts: f64, xs: f64, vs: f64) -> (f64, f64) {
+        match *self {
+            BallPath::Free { x, v, t } => (x + v * (ts - t), v),
+            BallPath::Held { offset } => (xs + offset, vs),
+        }
+    }
 }
 
 /// Where a model writes each sample: into the series when they are kept, and always into the
@@ -106,16 +239,11 @@ impl Recorder {
         let kept = self.series.as_mut().filter(|s| self.taken.is_multiple_of(s.every.max(1)));
         self.taken += 1;
         if let Some(s) = kept {
-            s.t.push(t);
-            s.xs.push(xs);
-            s.vs.push(vs);
-            s.a.push(a);
-            for (i, m) in self.masses.iter().enumerate() {
+            s.push(t, xs, vs, a, |i| {
                 let (x, v) = ball(i);
-                s.x[i].push(x);
-                s.v[i].push(v);
-                kinetic += 0.5 * m * v * v;
-            }
+                kinetic += 0.5 * self.masses[i] * v * v;
+                (x, v)
+            });
         } else if wants_energy {
             for (i, m) in self.masses.iter().enumerate() {
                 let v = ball(i).1;
@@ -127,6 +255,74 @@ impl Recorder {
             tally.add(t, xs, a, energy);
         }
     }
+    /// Samples `first, first + 1, ...` (at `k sample_dt`) of an interval in which the frame is
+    /// at `frame[j]` at sample `first + j` and each ball `i` follows `paths[i]`: the same values
+    /// as [`Recorder::sample`] at each, written a column at a time where nothing needs the
+    /// samples one by one (every sample kept, no energy watched).
+    pub fn sample_interval(&mut self, scene: &Scene, first: usize, frame: &[(f64, f64)], paths: &[BallPath]) {
+        let dt = scene.sample_dt;
+        let time = |j: usize| (first + j) as f64 * dt;
+        let bulk = self.series.as_ref().is_some_and(|s| s.every <= 1) && !self.tally.as_ref().is_some_and(|t| t.wants_energy());
+        if !bulk {
+            for (j, &(xs, vs)) in frame.iter().enumerate() {
+                let ts = time(j);
+                self.sample(scene, ts, xs, vs, |i| paths[i].at(ts, xs, vs));
+            }
+            return;
+        }
+        let s = self.series.as_mut().expect("a kept series");
+        let count = frame.len();
+        s.reserve(count);
+        for (j, t) in s.spare(0, count).iter_mut().enumerate() {
+            *t = time(j);
+        }
+        for (x, f) in s.spare(1, count).iter_mut().zip(frame) {
+            *x = f.0;
+        }
+        for (v, f) in s.spare(2, count).iter_mut().zip(frame) {
+            *v = f.1;
+        }
+        match (scene.frame, scene.forcing) {
+            // Free vibration: the acceleration needs no time (a loop the compiler vectorises).
+            (Some(f), None) => {
+                for (a, &(xs, vs)) in s.spare(3, count).iter_mut().zip(frame) {
+                    *a = f.acceleration(xs, vs);
+                }
+            }
+            _ => {
+                for (j, (a, &(xs, vs))) in s.spare(3, count).iter_mut().zip(frame).enumerate() {
+                    *a = scene.frame_acceleration(time(j), xs, vs);
+                }
+            }
+        }
+        for (i, path) in paths.iter().enumerate() {
+            match *path {
+                BallPath::Free { x, v, t } => {
+                    let (times, positions) = s.time_and_column(FRAME_COLUMNS + 2 * i, count);
+                    for (out, &ts) in positions.iter_mut().zip(times) {
+                        *out = x + v * (ts - t);
+                    }
+                    s.spare(FRAME_COLUMNS + 2 * i + 1, count).fill(v);
+                }
+                BallPath::Held { offset } => {
+                    for (out, f) in s.spare(FRAME_COLUMNS + 2 * i, count).iter_mut().zip(frame) {
+                        *out = f.0 + offset;
+                    }
+                    for (out, f) in s.spare(FRAME_COLUMNS + 2 * i + 1, count).iter_mut().zip(frame) {
+                        *out = f.1;
+                    }
+                }
+            }
+        }
+        if let Some(tally) = &mut self.tally {
+            for (j, a) in s.spare(3, count).iter().enumerate() {
+                tally.add(time(j), frame[j].0, *a, 0.0);
+            }
+        }
+        s.len += count;
+        self.taken += frame.len();
+    }
+
     /// The series (empty when not kept) and the metrics tallied at the samples (the default
     /// when untallied).
     pub fn finish(self) -> (Series, MotionMetrics) {
@@ -155,7 +351,7 @@ mod tests {
         assert_eq!(thin.every, 7);
         assert_eq!(thin.len(), scene.sample_count().div_ceil(7));
         for (j, k) in (0..all.len()).step_by(7).enumerate() {
-            assert_eq!((thin.t[j], thin.xs[j], thin.x[2][j]), (all.t[k], all.xs[k], all.x[2][k]));
+            assert_eq!((thin.t()[j], thin.xs()[j], thin.x(2)[j]), (all.t()[k], all.xs()[k], all.x(2)[k]));
         }
         assert_eq!(thin_metrics, all_metrics);
     }

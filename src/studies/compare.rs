@@ -29,20 +29,21 @@ pub struct Errors {
 /// judges that for itself), the ones they share.
 pub fn errors(run: &Run, reference: &Run) -> Errors {
     let (a, r) = (&run.series, &reference.series);
+    let (at, axs, rt, rxs) = (a.t(), a.xs(), r.t(), r.xs());
     let tol = 1e-9 * run.sample_dt;
     let (mut i, mut j) = (0, 0);
     let (mut sq, mut shared) = (0.0, 0usize);
     let mut early: f64 = 0.0;
     while i < a.len() && j < r.len() {
-        if a.t[i] < r.t[j] - tol {
+        if at[i] < rt[j] - tol {
             i += 1;
-        } else if r.t[j] < a.t[i] - tol {
+        } else if rt[j] < at[i] - tol {
             j += 1;
         } else {
-            let d = a.xs[i] - r.xs[j];
+            let d = axs[i] - rxs[j];
             sq += d * d;
             shared += 1;
-            if r.t[j] <= EARLY_WINDOW {
+            if rt[j] <= EARLY_WINDOW {
                 early = early.max(d.abs());
             }
             i += 1;
@@ -68,14 +69,11 @@ mod tests {
 
     /// A run of `samples` samples of `xs = k` (k the sample index), keeping every `every`-th.
     fn thinned(samples: usize, every: usize, offset: f64) -> Run {
-        let mut series = Series::with_capacity(0, samples);
+        let kept: Vec<usize> = (0..samples).step_by(every).collect();
+        let t = kept.iter().map(|&k| k as f64 * 1e-3).collect();
+        let xs = kept.iter().map(|&k| k as f64 + offset).collect();
+        let mut series = Series::from_columns(t, xs, vec![0.0; kept.len()], vec![0.0; kept.len()], vec![], vec![]);
         series.every = every;
-        for k in (0..samples).step_by(every) {
-            series.t.push(k as f64 * 1e-3);
-            series.xs.push(k as f64 + offset);
-            series.vs.push(0.0);
-            series.a.push(0.0);
-        }
         Run { series, sample_dt: 1e-3, ..Run::empty("thinned", crate::run::Model::Reference) }
     }
 

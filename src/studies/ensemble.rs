@@ -391,9 +391,9 @@ pub fn run_members(ensemble: &Ensemble, model: Model, keep_xs: bool, progress: &
                 )));
             }
             if out.t.is_empty() {
-                out.t = s.t;
+                out.t = s.t().to_vec();
             }
-            out.xs.push(s.xs);
+            out.xs.push(s.xs().to_vec());
         }
     }
     Ok(out)

@@ -145,7 +145,7 @@ pub fn period_peaks(run: &Run, period: f64) -> Vec<f64> {
     let s = &run.series;
     let periods = (run.horizon / period).floor() as usize;
     let mut peaks = vec![0.0f64; periods];
-    for (t, x) in s.t.iter().zip(&s.xs) {
+    for (t, x) in s.t().iter().zip(s.xs()) {
         let k = (t / period) as usize;
         if k < periods {
             peaks[k] = peaks[k].max(x.abs());

@@ -227,7 +227,7 @@ pub fn judge(model: Model, scene: &Scene, run: &Run) -> Result<(), Failure> {
     let fail = |check, detail: String| Err(Failure { check, detail });
     let s = &run.series;
     let finite = |v: &[f64]| v.iter().all(|x| x.is_finite());
-    let series_finite = finite(&s.xs) && finite(&s.vs) && finite(&s.a) && s.x.iter().all(|v| finite(v)) && s.v.iter().all(|v| finite(v));
+    let series_finite = finite(s.xs()) && finite(s.vs()) && finite(s.a()) && (0..s.balls()).all(|i| finite(s.x(i)) && finite(s.v(i)));
     let account_finite = [run.energy.final_, run.energy.damping_loss, run.energy.impact_loss].iter().all(|x| x.is_finite());
     if !(series_finite && account_finite) {
         return fail("non-finite", "a series or the energy account holds NaN or infinity".into());
@@ -275,13 +275,13 @@ pub fn judge(model: Model, scene: &Scene, run: &Run) -> Result<(), Failure> {
     if let (Some(f), true) = (scene.frame, !s.is_empty()) {
         // Only an unforced free frame conserves momentum (a force on it does work).
         if f.stiffness == 0.0 && f.damping == 0.0 && scene.forcing.is_none() {
-            let p = |k: usize| f.mass * s.vs[k] + (0..scene.balls.len()).map(|i| scene.balls[i].mass * s.v[i][k]).sum::<f64>();
-            let scale = f.mass * s.vs.iter().fold(0.0f64, |m, v| m.max(v.abs()))
-                + scene.balls.iter().enumerate().map(|(i, b)| b.mass * s.v[i].iter().fold(0.0f64, |m, v| m.max(v.abs()))).sum::<f64>();
+            let p = |k: usize| f.mass * s.vs()[k] + (0..scene.balls.len()).map(|i| scene.balls[i].mass * s.v(i)[k]).sum::<f64>();
+            let scale = f.mass * s.vs().iter().fold(0.0f64, |m, v| m.max(v.abs()))
+                + scene.balls.iter().enumerate().map(|(i, b)| b.mass * s.v(i).iter().fold(0.0f64, |m, v| m.max(v.abs()))).sum::<f64>();
             let tol = checks.momentum * scale.max(1e-300);
             for k in 0..s.len() {
                 if (p(k) - p(0)).abs() > tol {
-                    return fail("momentum", format!("total momentum {} at t = {} (was {})", p(k), s.t[k], p(0)));
+                    return fail("momentum", format!("total momentum {} at t = {} (was {})", p(k), s.t()[k], p(0)));
                 }
             }
         }
@@ -290,15 +290,15 @@ pub fn judge(model: Model, scene: &Scene, run: &Run) -> Result<(), Failure> {
         let tol = checks.wall_overlap;
         for k in 0..s.len() {
             for (i, b) in scene.balls.iter().enumerate() {
-                let (lo, hi) = (s.x[i][k] - b.radius - s.xs[k], s.xs[k] + c.length - s.x[i][k] - b.radius);
+                let (lo, hi) = (s.x(i)[k] - b.radius - s.xs()[k], s.xs()[k] + c.length - s.x(i)[k] - b.radius);
                 if lo < -tol || hi < -tol {
-                    return fail("outside", format!("ball{} outside the container by {:e} m at t = {}", i + 1, -lo.min(hi), s.t[k]));
+                    return fail("outside", format!("ball{} outside the container by {:e} m at t = {}", i + 1, -lo.min(hi), s.t()[k]));
                 }
                 if let (Some(tol), true) = (checks.ball_overlap, i > 0) {
                     // Balls never pass each other (docs/MODEL.md §1).
-                    let g = (s.x[i][k] - b.radius) - (s.x[i - 1][k] + scene.balls[i - 1].radius);
+                    let g = (s.x(i)[k] - b.radius) - (s.x(i - 1)[k] + scene.balls[i - 1].radius);
                     if g < -tol {
-                        return fail("overlap", format!("ball{} and ball{} overlap by {:e} m at t = {}", i, i + 1, -g, s.t[k]));
+                        return fail("overlap", format!("ball{} and ball{} overlap by {:e} m at t = {}", i, i + 1, -g, s.t()[k]));
                     }
                 }
             }

@@ -31,7 +31,7 @@ fn a_step_budget_stops_every_model_with_the_run_so_far() {
         assert!(message.contains(&format!("more than {budget} {}", model.step_unit())) && message.contains("--max-steps"), "{message}");
         let partial = &stop.partial;
         assert!(stop.t > 0.0 && stop.t < scene.horizon && partial.horizon == stop.t, "{model}: stopped at {}", stop.t);
-        assert!(!partial.series.is_empty() && *partial.series.t.last().unwrap() <= stop.t, "{model}");
+        assert!(!partial.series.is_empty() && *partial.series.t().last().unwrap() <= stop.t, "{model}");
         assert!(partial.impacts.iter().all(|i| i.t <= stop.t), "{model}");
         assert!(!partial.impacts.is_empty(), "{model}: the budget leaves some impacts");
         if model == Model::Reference {

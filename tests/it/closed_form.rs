@@ -20,13 +20,13 @@ fn no_damper_follows_the_damped_oscillator() {
     let wd = (f.stiffness / f.mass - sigma * sigma).sqrt();
     let xs0 = scene.initial_displacement;
     assert_eq!(run.series.len(), 5001);
-    for (k, &t) in run.series.t.iter().enumerate() {
+    for (k, &t) in run.series.t().iter().enumerate() {
         let x = xs0 * (-sigma * t).exp() * ((wd * t).cos() + sigma / wd * (wd * t).sin());
         let v = -xs0 * (-sigma * t).exp() * (sigma * sigma / wd + wd) * (wd * t).sin();
-        assert!((run.series.xs[k] - x).abs() <= ROUND_OFF * xs0, "xs at t = {t}");
-        assert!((run.series.vs[k] - v).abs() <= ROUND_OFF * xs0 * wd, "vs at t = {t}");
+        assert!((run.series.xs()[k] - x).abs() <= ROUND_OFF * xs0, "xs at t = {t}");
+        assert!((run.series.vs()[k] - v).abs() <= ROUND_OFF * xs0 * wd, "vs at t = {t}");
         let a = -(f.damping * v + f.stiffness * x) / f.mass;
-        assert!((run.series.a[k] - a).abs() <= ROUND_OFF * xs0 * wd * wd, "a at t = {t}");
+        assert!((run.series.a()[k] - a).abs() <= ROUND_OFF * xs0 * wd * wd, "a at t = {t}");
     }
     assert!(run.impacts.is_empty());
     assert!(run.energy.balance_error.abs() <= ROUND_OFF);
@@ -69,8 +69,8 @@ fn one_ball_on_a_free_frame_bounces_as_worked_out_by_hand() {
     }
     assert!(run.impacts.len() >= 6);
     // Total momentum m v0 is conserved exactly (no spring, no damper).
-    let vs_end = *run.series.vs.last().unwrap();
-    let vb_end = *run.series.v[0].last().unwrap();
+    let vs_end = *run.series.vs().last().unwrap();
+    let vb_end = *run.series.v(0).last().unwrap();
     assert_relative_eq!(m * vb_end + m_frame * vs_end, m * v0, max_relative = ROUND_OFF);
 }
 
@@ -91,7 +91,7 @@ fn first_wall_impact_on_an_undamped_spring_frame() {
     let vs = -xs0 * w * (w * t1).sin();
     assert_relative_eq!(first.approach_speed, -vs, max_relative = 1e-10);
     // Eq. 9: the ball (at rest) leaves with (1 + e) ms vs / (m + ms).
-    let k = run.series.t.partition_point(|&t| t <= t1);
+    let k = run.series.t().partition_point(|&t| t <= t1);
     let expected = (1.0 + 0.9) * frame.mass * vs / (0.11 + frame.mass);
-    assert_relative_eq!(run.series.v[0][k], expected, max_relative = 1e-10);
+    assert_relative_eq!(run.series.v(0)[k], expected, max_relative = 1e-10);
 }

@@ -36,7 +36,7 @@ fn zero_tolerances_reproduce_the_single_run_exactly() {
         let runs = ensemble::run_members(&members, *model, true, &|| {}).unwrap();
         for (k, m) in runs.metrics.iter().enumerate() {
             assert_eq!(m, &expected, "{model}: member {k}'s metrics differ from the single run's");
-            assert_eq!(runs.xs[k], single.series.xs, "{model}: member {k}'s displacement differs from the single run's");
+            assert_eq!(runs.xs[k], single.series.xs(), "{model}: member {k}'s displacement differs from the single run's");
         }
     }
 }
@@ -112,7 +112,7 @@ fn a_uniform_stiffness_tolerance_gives_the_analytic_distribution_of_the_period()
             let run = Model::Reference.simulate(&member.scene, &RunOptions::default())?;
             assert!(run.impacts.is_empty());
             // Two upward zero crossings of xs (linearly interpolated) one period apart.
-            let (t, x) = (&run.series.t, &run.series.xs);
+            let (t, x) = (&run.series.t(), &run.series.xs());
             let ups: Vec<f64> = (1..x.len())
                 .filter(|&i| x[i - 1] < 0.0 && x[i] >= 0.0)
                 .map(|i| t[i - 1] + (t[i] - t[i - 1]) * -x[i - 1] / (x[i] - x[i - 1]))
@@ -321,16 +321,16 @@ fn exact_reference_metrics_bound_the_sampled_ones_within_one_sample() {
         let series = &run.series;
         let mut tally = lpc_damper::run::SampleTally::new(&s);
         for k in 0..series.len() {
-            let kinetic: f64 = s.balls.iter().enumerate().map(|(i, b)| 0.5 * b.mass * series.v[i][k].powi(2)).sum();
-            let energy = s.frame_energy(series.t[k], series.xs[k], series.vs[k]) + kinetic;
-            tally.add(series.t[k], series.xs[k], series.a[k], energy);
+            let kinetic: f64 = s.balls.iter().enumerate().map(|(i, b)| 0.5 * b.mass * series.v(i)[k].powi(2)).sum();
+            let energy = s.frame_energy(series.t()[k], series.xs()[k], series.vs()[k]) + kinetic;
+            tally.add(series.t()[k], series.xs()[k], series.a()[k], energy);
         }
         let sampled = tally.finish();
         let step = |v: &[f64]| v.windows(2).map(|w| (w[1] - w[0]).abs()).fold(0.0, f64::max);
         let dt = s.sample_dt;
         let (dx, da) = (exact.peak_displacement - sampled.peak_displacement, exact.peak_acceleration - sampled.peak_acceleration);
-        assert!((0.0..=step(&series.xs)).contains(&dx), "{name}: peak xs exact - sampled = {dx}");
-        assert!((0.0..=step(&series.a)).contains(&da), "{name}: peak a exact - sampled = {da}");
+        assert!((0.0..=step(&series.xs())).contains(&dx), "{name}: peak xs exact - sampled = {dx}");
+        assert!((0.0..=step(&series.a())).contains(&da), "{name}: peak a exact - sampled = {da}");
         match (exact.settling_time, sampled.settling_time) {
             (Some(e), Some(t)) => assert!(e >= t && e < t + dt, "{name}: settling {e} vs sampled {t}"),
             (e, t) => assert_eq!(e, t, "{name}: settled in one and not the other"),
@@ -345,9 +345,9 @@ fn exact_reference_metrics_bound_the_sampled_ones_within_one_sample() {
         // trapezoid rule's error: dt^2 T / 12 max |(x^2)''| on smooth stretches, plus dt |x| |dv|
         // at each kink (an impact on the frame).
         let n = series.len();
-        let sum: f64 = series.xs.iter().map(|x| x * x).sum::<f64>() - 0.5 * (series.xs[0].powi(2) + series.xs[n - 1].powi(2));
+        let sum: f64 = series.xs().iter().map(|x| x * x).sum::<f64>() - 0.5 * (series.xs()[0].powi(2) + series.xs()[n - 1].powi(2));
         let trapezoid = sum * dt;
-        let (vmax, xmax, amax) = [&series.vs, &series.xs, &series.a].map(|v| v.iter().fold(0.0f64, |m, x| m.max(x.abs()))).into();
+        let (vmax, xmax, amax) = [&series.vs(), &series.xs(), &series.a()].map(|v| v.iter().fold(0.0f64, |m, x| m.max(x.abs()))).into();
         let kinks: f64 = run.impacts.len() as f64 * dt * xmax * 2.0 * vmax;
         let bound = dt * dt * s.horizon / 12.0 * (2.0 * vmax * vmax + 2.0 * xmax * amax) + kinks;
         let integral = exact.rms_displacement.powi(2) * s.horizon;

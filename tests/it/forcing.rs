@@ -6,6 +6,7 @@ use crate::common;
 use lpc_damper::model::RunOptions;
 
 use crate::common::reference;
+use lpc_damper::run::Series;
 use lpc_damper::scene::{Forcing, ForcingKind, Scene};
 use lpc_damper::studies::frf;
 use lpc_damper::Model;
@@ -51,8 +52,13 @@ fn bare_forced_frame_follows_the_textbook_solution_in_both_models() {
             let scale = 0.01 + textbook(kind, amp, f, 0.0, 100.0).abs().max(amp / FRAME.stiffness);
             for model in [Model::Reference, Model::Rapier] {
                 let run = model.simulate(&scene, &RunOptions::default()).unwrap();
-                let worst =
-                    run.series.t.iter().zip(&run.series.xs).map(|(t, x)| (x - textbook(kind, amp, f, 0.01, *t)).abs()).fold(0.0, f64::max);
+                let worst = run
+                    .series
+                    .t()
+                    .iter()
+                    .zip(run.series.xs())
+                    .map(|(t, x)| (x - textbook(kind, amp, f, 0.01, *t)).abs())
+                    .fold(0.0, f64::max);
                 // Both models move the frame in closed form: agreement to round-off, which
                 // grows with the ~3000 samples' phase arguments (w t up to 170 rad).
                 assert!(worst <= 1e-12 * scale * 1e3, "{kind:?} {f} Hz {}: {worst:e} m", model.name());
@@ -83,8 +89,8 @@ fn forced_damper_balances_energy_with_the_forcing_work() {
         assert!(common::min_gap(&s, &run) >= -1e-12);
         // The series' acceleration is the smooth force over ms, forcing included.
         let k = run.series.len() / 2;
-        let (t, x, v) = (run.series.t[k], run.series.xs[k], run.series.vs[k]);
-        assert_eq!(run.series.a[k], s.frame_force(t, x, v) / FRAME.mass);
+        let (t, x, v) = (run.series.t()[k], run.series.xs()[k], run.series.vs()[k]);
+        assert_eq!(run.series.a()[k], s.frame_force(t, x, v) / FRAME.mass);
     }
 }
 
@@ -124,15 +130,13 @@ fn a_steady_reading_needs_agreeing_blocks() {
     let mut run = lpc_damper::run::Run::empty("t", lpc_damper::Model::Reference);
     let period = 0.1;
     run.horizon = 40.0 * period;
-    for k in 0..=4000 {
-        let t = k as f64 * run.horizon / 4000.0;
-        run.series.t.push(t);
-        run.series.xs.push(0.002 * (2.0 * std::f64::consts::PI * t / period).sin());
-    }
+    let t: Vec<f64> = (0..=4000).map(|k| k as f64 * run.horizon / 4000.0).collect();
+    let xs: Vec<f64> = t.iter().map(|t| 0.002 * (2.0 * std::f64::consts::PI * t / period).sin()).collect();
+    let zeros = vec![0.0; t.len()];
+    run.series = Series::from_columns(t.clone(), xs.clone(), zeros.clone(), zeros.clone(), vec![], vec![]);
     let r = frf::steady_state(&run, period);
     assert!(r.steady && (r.amplitude - 0.002).abs() < 1e-9, "{r:?}");
-    for (k, x) in run.series.xs.iter_mut().enumerate() {
-        *x *= (-(k as f64) / 1000.0).exp();
-    }
+    let decaying = xs.iter().enumerate().map(|(k, x)| x * (-(k as f64) / 1000.0).exp()).collect();
+    run.series = Series::from_columns(t, decaying, zeros.clone(), zeros, vec![], vec![]);
     assert!(!frf::steady_state(&run, period).steady);
 }

@@ -153,14 +153,14 @@ pub fn min_gap(scene: &Scene, run: &lpc_damper::run::Run) -> f64 {
         for i in 0..n {
             let r = scene.balls[i].radius;
             if i + 1 < n {
-                min = min.min(s.x[i + 1][k] - scene.balls[i + 1].radius - s.x[i][k] - r);
+                min = min.min(s.x(i + 1)[k] - scene.balls[i + 1].radius - s.x(i)[k] - r);
             }
             if let Some(c) = scene.container {
                 if i == 0 {
-                    min = min.min(s.x[0][k] - r - s.xs[k]);
+                    min = min.min(s.x(0)[k] - r - s.xs()[k]);
                 }
                 if i + 1 == n {
-                    min = min.min(s.xs[k] + c.length - s.x[i][k] - r);
+                    min = min.min(s.xs()[k] + c.length - s.x(i)[k] - r);
                 }
             }
         }

@@ -73,7 +73,7 @@ fn heavy_balls_conserve_momentum_across_every_impact() {
     let run = Model::Rapier.simulate(&scene, &RunOptions::default()).unwrap();
     assert!(run.impacts.len() >= 3, "{:?}", run.impacts);
     let p0 = 0.11 * (0.3 - 0.2);
-    let vs = *run.series.vs.last().unwrap();
+    let vs = *run.series.vs().last().unwrap();
     let p1 = 0.05 * vs + 0.11 * run.final_velocities.iter().sum::<f64>();
     assert!((p1 - p0).abs() <= F32_SOLVE * 0.11 * 0.5 * run.impacts.len() as f64, "momentum {p0} -> {p1}");
 }

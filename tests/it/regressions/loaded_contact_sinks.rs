@@ -35,7 +35,7 @@ fn a_ball_carried_by_a_fast_wall_stays_inside() {
     let r = s.balls[0].radius;
     let worst = (0..run.series.len())
         .map(|k| {
-            let (x, xs) = (run.series.x[0][k], run.series.xs[k]);
+            let (x, xs) = (run.series.x(0)[k], run.series.xs()[k]);
             (x - r - xs).min(xs + c.length - x - r)
         })
         .fold(f64::INFINITY, f64::min);

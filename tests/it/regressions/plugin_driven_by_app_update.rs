@@ -32,7 +32,7 @@ fn the_plugin_in_a_users_app_runs_the_headless_model() {
     assert_eq!(driven.impacts.len(), headless.impacts.len());
     assert_eq!(driven.series.len(), headless.series.len());
     // The same steps on the same f32 bodies: the same numbers.
-    for (k, (a, b)) in driven.series.xs.iter().zip(&headless.series.xs).enumerate() {
+    for (k, (a, b)) in driven.series.xs().iter().zip(headless.series.xs()).enumerate() {
         assert_eq!(a, b, "xs at sample {k}");
     }
 }

@@ -1,5 +1,5 @@
-//! Runs the reference on a scene many times, for profilers: `cargo run --release --example
-//! profile_reference -- scenes/lpc-lsl.toml 2000`.
+//! Runs the reference on a scene many times (with its series), for profilers:
+//! `cargo run --release -p lpc-tools --bin profile_reference -- scenes/lpc-lsl.toml 2000`.
 use lpc_damper::model::{Model, RunOptions};
 
 fn main() {
