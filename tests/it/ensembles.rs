@@ -329,8 +329,8 @@ fn exact_reference_metrics_bound_the_sampled_ones_within_one_sample() {
         let step = |v: &[f64]| v.windows(2).map(|w| (w[1] - w[0]).abs()).fold(0.0, f64::max);
         let dt = s.sample_dt;
         let (dx, da) = (exact.peak_displacement - sampled.peak_displacement, exact.peak_acceleration - sampled.peak_acceleration);
-        assert!((0.0..=step(&series.xs())).contains(&dx), "{name}: peak xs exact - sampled = {dx}");
-        assert!((0.0..=step(&series.a())).contains(&da), "{name}: peak a exact - sampled = {da}");
+        assert!((0.0..=step(series.xs())).contains(&dx), "{name}: peak xs exact - sampled = {dx}");
+        assert!((0.0..=step(series.a())).contains(&da), "{name}: peak a exact - sampled = {da}");
         match (exact.settling_time, sampled.settling_time) {
             (Some(e), Some(t)) => assert!(e >= t && e < t + dt, "{name}: settling {e} vs sampled {t}"),
             (e, t) => assert_eq!(e, t, "{name}: settled in one and not the other"),
@@ -347,7 +347,7 @@ fn exact_reference_metrics_bound_the_sampled_ones_within_one_sample() {
         let n = series.len();
         let sum: f64 = series.xs().iter().map(|x| x * x).sum::<f64>() - 0.5 * (series.xs()[0].powi(2) + series.xs()[n - 1].powi(2));
         let trapezoid = sum * dt;
-        let (vmax, xmax, amax) = [&series.vs(), &series.xs(), &series.a()].map(|v| v.iter().fold(0.0f64, |m, x| m.max(x.abs()))).into();
+        let (vmax, xmax, amax) = [series.vs(), series.xs(), series.a()].map(|v| v.iter().fold(0.0f64, |m, x| m.max(x.abs()))).into();
         let kinks: f64 = run.impacts.len() as f64 * dt * xmax * 2.0 * vmax;
         let bound = dt * dt * s.horizon / 12.0 * (2.0 * vmax * vmax + 2.0 * xmax * amax) + kinks;
         let integral = exact.rms_displacement.powi(2) * s.horizon;
