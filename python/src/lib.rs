@@ -311,17 +311,22 @@ impl Run {
         Ok((table, columns, len))
     }
 
-    /// Row `first` of the series table (`step`: every `step`-th row from `first`, a matrix),
-    /// its used samples only.
-    fn columns(&self, py: Python<'_>, run: &mut lpc_damper::run::Run, first: usize, step: Option<usize>) -> PyResult<Py<PyAny>> {
+    /// Row `first` of the series table, or with `balls = Some(k)` the `k`-th block of the balls'
+    /// rows from `first` (0 their centres, 1 their velocities: a matrix), its used samples only;
+    /// C-contiguous (a view when the series is full, as a finished run's is).
+    fn columns(&self, py: Python<'_>, run: &mut lpc_damper::run::Run, first: usize, balls: Option<usize>) -> PyResult<Py<PyAny>> {
         use pyo3::types::PySlice;
         let (table, columns, len) = self.table(py, run)?;
         let samples = PySlice::new(py, 0, len as isize, 1);
-        let index = match step {
-            None => (first.into_pyobject(py)?.into_any(), samples.into_any()),
-            Some(step) => (PySlice::new(py, first as isize, columns as isize, step as isize).into_any(), samples.into_any()),
+        let view = match balls {
+            None => table.bind(py).get_item((first, samples))?,
+            Some(block) => {
+                let n = (columns - first) / 2;
+                let rows = PySlice::new(py, (first + block * n) as isize, (first + (block + 1) * n) as isize, 1);
+                table.bind(py).get_item((rows, samples))?
+            }
         };
-        Ok(table.bind(py).get_item(index)?.unbind())
+        Ok(py.import("numpy")?.call_method1("ascontiguousarray", (view,))?.unbind())
     }
 
     fn part(&self, py: Python<'_>, key: &str) -> PyResult<Py<PyAny>> {
@@ -354,12 +359,12 @@ impl Run {
     /// Ball centres, `(balls, samples)`, m.
     #[getter]
     fn x(&self, py: Python<'_>) -> PyResult<Py<PyAny>> {
-        self.cached(py, "x", |py, r| self.columns(py, r, 4, Some(2)))
+        self.cached(py, "x", |py, r| self.columns(py, r, 4, Some(0)))
     }
     /// Ball velocities, `(balls, samples)`, m/s.
     #[getter]
     fn v(&self, py: Python<'_>) -> PyResult<Py<PyAny>> {
-        self.cached(py, "v", |py, r| self.columns(py, r, 5, Some(2)))
+        self.cached(py, "v", |py, r| self.columns(py, r, 4, Some(1)))
     }
     /// Impacts: `t`, `body_a`, `body_b`, `approach_speed`, `energy_lost`, `peak_force`,
     /// `contact_duration` (NaN for impulse models).

@@ -48,7 +48,7 @@ impl Series {
     pub fn from_columns(t: Vec<f64>, xs: Vec<f64>, vs: Vec<f64>, a: Vec<f64>, x: Vec<Vec<f64>>, v: Vec<Vec<f64>>) -> Self {
         let mut s = Series::with_capacity(x.len(), t.len());
         s.len = t.len();
-        let columns = [t, xs, vs, a].into_iter().chain(x.into_iter().zip(v).flat_map(|(x, v)| [x, v]));
+        let columns = [t, xs, vs, a].into_iter().chain(x).chain(v);
         for (c, column) in columns.enumerate() {
             assert_eq!(column.len(), s.len, "every column of a series has one length");
             s.column_mut(c).copy_from_slice(&column);
@@ -93,21 +93,29 @@ impl Series {
     pub fn a(&self) -> &[f64] {
         self.column(3)
     }
+    /// The column of ball `i`'s centre: every ball's centres come first, then their velocities.
+    fn x_column(&self, i: usize) -> usize {
+        FRAME_COLUMNS + i
+    }
+    /// The column of ball `i`'s velocity.
+    fn v_column(&self, i: usize) -> usize {
+        FRAME_COLUMNS + self.balls + i
+    }
     /// Ball `i`'s centre, m.
     pub fn x(&self, i: usize) -> &[f64] {
-        self.column(FRAME_COLUMNS + 2 * i)
+        self.column(self.x_column(i))
     }
     /// Ball `i`'s velocity, m/s.
     pub fn v(&self, i: usize) -> &[f64] {
-        self.column(FRAME_COLUMNS + 2 * i + 1)
+        self.column(self.v_column(i))
     }
-    /// Every column, as vectors: `t`, `xs`, `vs`, `a`, then each ball's `x` and `v`.
+    /// Every column, as vectors: `t`, `xs`, `vs`, `a`, then every ball's `x`, then every ball's `v`.
     pub fn into_columns(self) -> Vec<Vec<f64>> {
         (0..self.columns()).map(|c| self.column(c).to_vec()).collect()
     }
     /// The columns as one buffer, moved out: `(data, capacity, len, columns)`, column `c` being
-    /// `data[c * capacity..c * capacity + len]` (`t`, `xs`, `vs`, `a`, then each ball's `x` and
-    /// `v`). For handing the whole series to another owner (NumPy) without a copy.
+    /// `data[c * capacity..c * capacity + len]` (`t`, `xs`, `vs`, `a`, then every ball's `x`, then
+    /// every ball's `v`). For handing the whole series to another owner (NumPy) without a copy.
     pub fn into_buffer(self) -> (Vec<f64>, usize, usize, usize) {
         let columns = self.columns();
         (self.data, self.capacity, self.len, columns)
@@ -135,8 +143,8 @@ impl Series {
         }
         for i in 0..self.balls {
             let (x, v) = ball(i);
-            self.data[(FRAME_COLUMNS + 2 * i) * cap + k] = x;
-            self.data[(FRAME_COLUMNS + 2 * i + 1) * cap + k] = v;
+            self.data[(FRAME_COLUMNS + i) * cap + k] = x;
+            self.data[(FRAME_COLUMNS + self.balls + i) * cap + k] = v;
         }
         self.len += 1;
     }
@@ -298,17 +306,17 @@ impl Recorder {
         for (i, path) in paths.iter().enumerate() {
             match *path {
                 BallPath::Free { x, v, t } => {
-                    let (times, positions) = s.time_and_column(FRAME_COLUMNS + 2 * i, count);
+                    let (times, positions) = s.time_and_column(s.x_column(i), count);
                     for (out, &ts) in positions.iter_mut().zip(times) {
                         *out = x + v * (ts - t);
                     }
-                    s.spare(FRAME_COLUMNS + 2 * i + 1, count).fill(v);
+                    s.spare(s.v_column(i), count).fill(v);
                 }
                 BallPath::Held { offset } => {
-                    for (out, f) in s.spare(FRAME_COLUMNS + 2 * i, count).iter_mut().zip(frame) {
+                    for (out, f) in s.spare(s.x_column(i), count).iter_mut().zip(frame) {
                         *out = f.0 + offset;
                     }
-                    for (out, f) in s.spare(FRAME_COLUMNS + 2 * i + 1, count).iter_mut().zip(frame) {
+                    for (out, f) in s.spare(s.v_column(i), count).iter_mut().zip(frame) {
                         *out = f.1;
                     }
                 }
