@@ -26,16 +26,18 @@ pub struct StepSettings {
     /// steps (the plug-in's choice), rather than Rapier's fixed 0.02 length units (only the
     /// stability map turns this off, to show why it is needed).
     pub speculative_margin: bool,
-    /// Stop with [`crate::model::ModelError::Unstable`] when a ball is pushed through a wall or
-    /// contacts gain energy, rather than return a wrong run (only the stability map turns this
-    /// off, to measure the raw behaviour).
-    pub self_check: bool,
+    /// The plug-in's safeguards: a ball that Rapier's solver pushed into a wall deeper than a
+    /// quarter of its radius is put back by the plug-in (shallower ones always are), and a step
+    /// whose contacts gained energy stops the run with [`crate::model::ModelError::Unstable`]
+    /// rather than return a wrong run. Only the stability map turns them off, to measure
+    /// Rapier's raw behaviour.
+    pub safeguards: bool,
 }
 
 impl StepSettings {
     /// Fixed steps of `dt` with the plug-in's other defaults.
     pub fn fixed(dt: f64, solver_iterations: usize) -> Self {
-        StepSettings { stepping: Stepping::Fixed, dt, solver_iterations, ccd: false, speculative_margin: true, self_check: true }
+        StepSettings { stepping: Stepping::Fixed, dt, solver_iterations, ccd: false, speculative_margin: true, safeguards: true }
     }
 }
 

@@ -59,7 +59,7 @@ pub fn settings(scene: &Scene) -> StepSettings {
         solver_iterations: scene.rapier.solver_iterations.map_or_else(|| default_iterations(scene), |i| i as usize),
         ccd: scene.rapier.ccd.unwrap_or(false),
         speculative_margin: true,
-        self_check: true,
+        safeguards: true,
     }
 }
 

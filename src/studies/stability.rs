@@ -121,7 +121,7 @@ pub fn cell(case: Case, config: Config, dt: f64, speed: f64) -> Cell {
         ccd: config.ccd,
         speculative_margin: config.speculative_margin,
         // The map measures what the contact model does, so it must not stop itself.
-        self_check: false,
+        safeguards: false,
     };
     let e0 = scene.initial_energy();
     let (outcome, energy_error) = match simulate_with(&scene, settings, &RunOptions::default()) {

@@ -90,7 +90,8 @@ pub fn feedback(
     }
     read_balls(&set, handles, x_new, v_new);
     if let (Some(c), Some(f)) = (scene.container, frame.as_ref()) {
-        project_sunk_balls(&mut set, handles, x_new, scene, f.before_impulses.0, c.length);
+        let deepest = if settings.safeguards { f64::INFINITY } else { RAW_PROJECTION };
+        project_sunk_balls(&mut set, handles, x_new, scene, f.before_impulses.0, c.length, deepest);
     }
     mark_pairs_in_contact(sim, colliders, &set, &bodies, n, active);
     let (frame_start, frame_end) = frame.as_ref().map_or(((0.0, 0.0), (0.0, 0.0)), |f| (f.start, f.before_impulses));
@@ -152,7 +153,7 @@ pub fn feedback(
     } else {
         attribute_impacts(ledger, scene, &step, &start, &rec.x, active, j, shares);
     }
-    if settings.self_check && rec.failure.is_none() {
+    if settings.safeguards && rec.failure.is_none() {
         rec.failure = self_check(scene, rec, x_new, v_new, frame_end.0, frame_post, forcing_work, t0 + plan.h);
     }
     std::mem::swap(&mut rec.prev_x, &mut rec.x);
@@ -174,8 +175,16 @@ fn read_balls(set: &RapierRigidBodySet, handles: &[RigidBodyHandle], x: &mut Vec
 
 /// Phase 1b: Rapier's contacts are soft, so a ball pressed by an accelerating wall or a loaded
 /// chain sinks past the allowed error. Project it back (positions only: no energy changes).
-fn project_sunk_balls(set: &mut RapierRigidBodySet, handles: &[RigidBodyHandle], x: &mut [f64], scene: &Scene, frame_x: f64, length: f64) {
-    if !project_inside(x, &scene.balls, frame_x, length) {
+fn project_sunk_balls(
+    set: &mut RapierRigidBodySet,
+    handles: &[RigidBodyHandle],
+    x: &mut [f64],
+    scene: &Scene,
+    frame_x: f64,
+    length: f64,
+    deepest: f64,
+) {
+    if !project_inside(x, &scene.balls, frame_x, length, deepest) {
         return;
     }
     for (i, &h) in handles.iter().enumerate() {
@@ -591,20 +600,23 @@ fn self_check(scene: &Scene, rec: &Recording, x: &[f64], v: &[f64], xs: f64, vs:
 /// Overlap a projected contact keeps: Rapier's allowed error (`0.005 length_unit`), less the
 /// walls' chord error within a step, so that samples inside a step stay within the allowed error.
 pub const PROJECTED_OVERLAP: f64 = ALLOWED_OVERLAP - WALL_CHORD_ERROR;
-/// Deepest overlap projected back, as a fraction of the ball's radius: anything deeper is a
-/// failure of the contact model and is left for the checks to see.
-pub const MAX_PROJECTION: f64 = 0.25;
+/// Deepest overlap put back without the plug-in's safeguards, as a fraction of the ball's
+/// radius: Rapier's soft contacts sink a pressed ball this far; deeper, its solver has pushed
+/// the ball through, which the raw behaviour shows and the safeguards resolve.
+pub const RAW_PROJECTION: f64 = 0.25;
 
 /// Moves balls that overlap a wall (at `left` and `left + length`) or a neighbour by more than
-/// [`PROJECTED_OVERLAP`] (and at most [`MAX_PROJECTION`] of the radius) back to that overlap:
-/// a sweep from the left wall, then one from the right. Returns whether any ball moved.
-pub fn project_inside(x: &mut [f64], balls: &[crate::scene::Ball], left: f64, length: f64) -> bool {
+/// [`PROJECTED_OVERLAP`] (and at most `deepest` times the radius) back to that overlap: a
+/// sweep from the left wall, then one from the right. Returns whether any ball moved. The
+/// velocities are left to the impact phase before the next step, which resolves a ball that
+/// now touches a wall and approaches it as any impact (`super::impacts`).
+pub fn project_inside(x: &mut [f64], balls: &[crate::scene::Ball], left: f64, length: f64, deepest: f64) -> bool {
     let mut moved = false;
     let mut edge = left;
     for (i, b) in balls.iter().enumerate() {
         let lowest = edge + b.radius - PROJECTED_OVERLAP;
         let depth = lowest - x[i];
-        if depth > 0.0 && depth <= MAX_PROJECTION * b.radius {
+        if depth > 0.0 && depth <= deepest * b.radius {
             x[i] = lowest;
             moved = true;
         }
@@ -614,7 +626,7 @@ pub fn project_inside(x: &mut [f64], balls: &[crate::scene::Ball], left: f64, le
     for (i, b) in balls.iter().enumerate().rev() {
         let highest = edge - b.radius + PROJECTED_OVERLAP;
         let depth = x[i] - highest;
-        if depth > 0.0 && depth <= MAX_PROJECTION * b.radius {
+        if depth > 0.0 && depth <= deepest * b.radius {
             x[i] = highest;
             moved = true;
         }
