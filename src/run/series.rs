@@ -148,6 +148,42 @@ impl Series {
         }
         self.len += 1;
     }
+    /// Appends the samples `first, first + 1, ...` of an interval a column at a time: the frame
+    /// at `frame[j]` with acceleration `accelerations[j]`, ball `i` on `paths[i]`.
+    fn write_interval(&mut self, first: usize, dt: f64, frame: &[(f64, f64)], accelerations: &[f64], paths: &[BallPath]) {
+        let count = frame.len();
+        self.reserve(count);
+        for (j, t) in self.spare(0, count).iter_mut().enumerate() {
+            *t = (first + j) as f64 * dt;
+        }
+        for (x, f) in self.spare(1, count).iter_mut().zip(frame) {
+            *x = f.0;
+        }
+        for (v, f) in self.spare(2, count).iter_mut().zip(frame) {
+            *v = f.1;
+        }
+        self.spare(3, count).copy_from_slice(accelerations);
+        for (i, path) in paths.iter().enumerate() {
+            match *path {
+                BallPath::Free { x, v, t } => {
+                    let (times, positions) = self.time_and_column(self.x_column(i), count);
+                    for (out, &ts) in positions.iter_mut().zip(times) {
+                        *out = x + v * (ts - t);
+                    }
+                    self.spare(self.v_column(i), count).fill(v);
+                }
+                BallPath::Held { offset } => {
+                    for (out, f) in self.spare(self.x_column(i), count).iter_mut().zip(frame) {
+                        *out = f.0 + offset;
+                    }
+                    for (out, f) in self.spare(self.v_column(i), count).iter_mut().zip(frame) {
+                        *out = f.1;
+                    }
+                }
+            }
+        }
+        self.len += count;
+    }
     /// The next `count` times, written already, and the next `count` entries of column `c`
     /// (after the time column), to be written.
     fn time_and_column(&mut self, c: usize, count: usize) -> (&[f64], &mut [f64]) {
@@ -214,6 +250,8 @@ pub struct Recorder {
     /// `None` when the model computes the metrics itself ([`Recorder::untallied`]).
     tally: Option<SampleTally>,
     masses: Vec<f64>,
+    /// Scratch: the frame's acceleration at each sample of an interval.
+    accelerations: Vec<f64>,
 }
 
 impl Recorder {
@@ -226,7 +264,13 @@ impl Recorder {
     fn thinned(scene: &Scene, record: Record, every: usize) -> Self {
         let series = (record == Record::Series)
             .then(|| Series { every, ..Series::with_capacity(scene.balls.len(), scene.sample_count().div_ceil(every)) });
-        Recorder { series, taken: 0, tally: Some(SampleTally::new(scene)), masses: scene.balls.iter().map(|b| b.mass).collect() }
+        Recorder {
+            series,
+            taken: 0,
+            tally: Some(SampleTally::new(scene)),
+            masses: scene.balls.iter().map(|b| b.mass).collect(),
+            accelerations: Vec::new(),
+        }
     }
     /// This recorder keeping the series only: for a model that computes the metrics itself
     /// (the reference, exactly, in free vibration).
@@ -265,70 +309,57 @@ impl Recorder {
     }
     /// Samples `first, first + 1, ...` (at `k sample_dt`) of an interval in which the frame is
     /// at `frame[j]` at sample `first + j` and each ball `i` follows `paths[i]`: the same values
-    /// as [`Recorder::sample`] at each, written a column at a time where nothing needs the
-    /// samples one by one (every sample kept, no energy watched).
+    /// as [`Recorder::sample`] at each, written a column at a time unless the series is thinned.
     pub fn sample_interval(&mut self, scene: &Scene, first: usize, frame: &[(f64, f64)], paths: &[BallPath]) {
         let dt = scene.sample_dt;
         let time = |j: usize| (first + j) as f64 * dt;
-        let bulk = self.series.as_ref().is_some_and(|s| s.every <= 1) && !self.tally.as_ref().is_some_and(|t| t.wants_energy());
-        if !bulk {
+        if self.series.as_ref().is_some_and(|s| s.every > 1) {
             for (j, &(xs, vs)) in frame.iter().enumerate() {
                 let ts = time(j);
                 self.sample(scene, ts, xs, vs, |i| paths[i].at(ts, xs, vs));
             }
             return;
         }
-        let s = self.series.as_mut().expect("a kept series");
         let count = frame.len();
-        s.reserve(count);
-        for (j, t) in s.spare(0, count).iter_mut().enumerate() {
-            *t = time(j);
-        }
-        for (x, f) in s.spare(1, count).iter_mut().zip(frame) {
-            *x = f.0;
-        }
-        for (v, f) in s.spare(2, count).iter_mut().zip(frame) {
-            *v = f.1;
-        }
+        let mut accelerations = std::mem::take(&mut self.accelerations);
+        accelerations.clear();
         match (scene.frame, scene.forcing) {
             // Free vibration: the acceleration needs no time (a loop the compiler vectorises).
-            (Some(f), None) => {
-                for (a, &(xs, vs)) in s.spare(3, count).iter_mut().zip(frame) {
-                    *a = f.acceleration(xs, vs);
-                }
-            }
-            _ => {
-                for (j, (a, &(xs, vs))) in s.spare(3, count).iter_mut().zip(frame).enumerate() {
-                    *a = scene.frame_acceleration(time(j), xs, vs);
-                }
-            }
+            (Some(f), None) => accelerations.extend(frame.iter().map(|&(xs, vs)| f.acceleration(xs, vs))),
+            _ => accelerations.extend(frame.iter().enumerate().map(|(j, &(xs, vs))| scene.frame_acceleration(time(j), xs, vs))),
         }
-        for (i, path) in paths.iter().enumerate() {
-            match *path {
-                BallPath::Free { x, v, t } => {
-                    let (times, positions) = s.time_and_column(s.x_column(i), count);
-                    for (out, &ts) in positions.iter_mut().zip(times) {
-                        *out = x + v * (ts - t);
-                    }
-                    s.spare(s.v_column(i), count).fill(v);
-                }
-                BallPath::Held { offset } => {
-                    for (out, f) in s.spare(s.x_column(i), count).iter_mut().zip(frame) {
-                        *out = f.0 + offset;
-                    }
-                    for (out, f) in s.spare(s.v_column(i), count).iter_mut().zip(frame) {
-                        *out = f.1;
-                    }
-                }
-            }
+        if let Some(s) = &mut self.series {
+            s.write_interval(first, dt, frame, &accelerations, paths);
         }
         if let Some(tally) = &mut self.tally {
-            for (j, a) in s.spare(3, count).iter().enumerate() {
-                tally.add(time(j), frame[j].0, *a, 0.0);
+            let wants_energy = tally.wants_energy();
+            // The balls' kinetic energy, summed ball by ball in order as `sample` does so that
+            // the bits agree; the same at every sample when no ball moves with the frame.
+            let kinetic = |vs: f64| {
+                let mut kinetic = 0.0;
+                for (path, m) in paths.iter().zip(&self.masses) {
+                    let v = match *path {
+                        BallPath::Free { v, .. } => v,
+                        BallPath::Held { .. } => vs,
+                    };
+                    kinetic += 0.5 * m * v * v;
+                }
+                kinetic
+            };
+            let all_free = paths.iter().all(|p| matches!(p, BallPath::Free { .. }));
+            let free_kinetic = if wants_energy && all_free { kinetic(0.0) } else { 0.0 };
+            for (j, (&(xs, vs), &a)) in frame.iter().zip(&accelerations).enumerate() {
+                let ts = time(j);
+                let energy = match (wants_energy, all_free) {
+                    (false, _) => 0.0,
+                    (true, true) => scene.frame_energy(ts, xs, vs) + free_kinetic,
+                    (true, false) => scene.frame_energy(ts, xs, vs) + kinetic(vs),
+                };
+                tally.add(ts, xs, a, energy);
             }
         }
-        s.len += count;
-        self.taken += frame.len();
+        self.taken += count;
+        self.accelerations = accelerations;
     }
 
     /// The series (empty when not kept) and the metrics tallied at the samples (the default
