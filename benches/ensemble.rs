@@ -9,7 +9,7 @@
 //! `cargo bench --bench ensemble`.
 
 use criterion::{criterion_group, criterion_main, Criterion};
-use lpc_damper::model::{Model, RunOptions};
+use lpc_damper::model::{Limits, Model, RunOptions};
 use lpc_damper::scene::{load, scenes_dir};
 use lpc_damper::studies::ensemble::{draw, run_members, Ensemble};
 
@@ -28,9 +28,11 @@ fn ensembles(c: &mut Criterion) {
     let mut group = c.benchmark_group("reference");
     group.sample_size(20);
     group.bench_function("single run with series", |b| b.iter(|| Model::Reference.simulate(&nominal, &RunOptions::default()).unwrap()));
-    group.bench_function("1000 members (global pool)", |b| b.iter(|| run_members(&big, Model::Reference, false, &|| {}).unwrap()));
+    group.bench_function("1000 members (global pool)", |b| {
+        b.iter(|| run_members(&big, Model::Reference, Limits::NONE, false, &|| {}).unwrap())
+    });
     group.bench_function("1000 members (1 thread)", |b| {
-        b.iter(|| one_thread.install(|| run_members(&big, Model::Reference, false, &|| {}).unwrap()))
+        b.iter(|| one_thread.install(|| run_members(&big, Model::Reference, Limits::NONE, false, &|| {}).unwrap()))
     });
     group.finish();
     for model in [Model::Rapier, Model::Compliant] {
@@ -38,7 +40,7 @@ fn ensembles(c: &mut Criterion) {
         group.sample_size(10);
         group.bench_function("single run with series", |b| b.iter(|| model.simulate(&nominal, &RunOptions::default()).unwrap()));
         group.bench_function("200 members (1 thread)", |b| {
-            b.iter(|| one_thread.install(|| run_members(&small, model, false, &|| {}).unwrap()))
+            b.iter(|| one_thread.install(|| run_members(&small, model, Limits::NONE, false, &|| {}).unwrap()))
         });
         group.finish();
     }

@@ -20,7 +20,7 @@ impl Model {
     /// its rule, when the model cannot represent the scene, or when the series it keeps would
     /// not fit in memory.
     pub fn simulate(self, scene: &Scene, options: &RunOptions) -> Result<Run, ModelError> {
-        if let Err((budget, rule)) = options.check_budgets() {
+        if let Err((budget, rule)) = options.limits.check() {
             return Err(ModelError::Refused(format!("{}: {rule}", budget.flag())));
         }
         let model = simulator(self);

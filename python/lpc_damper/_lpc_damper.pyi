@@ -88,6 +88,8 @@ def ensemble(
     solver_iterations: int | None = None,
     ccd: bool = False,
     tolerance: float | None = None,
+    max_steps: int | None = None,
+    max_wall_time: float | None = None,
 ) -> Columns: ...
 def sweep_cells(scene: Scene, axes: Sequence[str] | None = None) -> int: ...
 def sweep(
@@ -104,6 +106,21 @@ def sweep(
     solver_iterations: int | None = None,
     ccd: bool = False,
     tolerance: float | None = None,
+    max_steps: int | None = None,
+    max_wall_time: float | None = None,
 ) -> Columns: ...
-def frf(scene: Scene, frequencies: Sequence[float], *, model: ModelName = "reference") -> Columns: ...
-def chain(scene: Scene, *, model: ModelName = "reference") -> Columns: ...
+def frf(
+    scene: Scene,
+    frequencies: Sequence[float],
+    *,
+    model: ModelName = "reference",
+    max_steps: int | None = None,
+    max_wall_time: float | None = None,
+) -> Columns: ...
+def chain(
+    scene: Scene,
+    *,
+    model: ModelName = "reference",
+    max_steps: int | None = None,
+    max_wall_time: float | None = None,
+) -> Columns: ...

@@ -20,7 +20,7 @@ use pyo3::types::PyDict;
 
 use lpc_damper::files::write_atomic;
 use lpc_damper::metrics::{Headline, Metric, RunSummary};
-use lpc_damper::model::{ModelError as RustModelError, RunOptions};
+use lpc_damper::model::{Limits, ModelError as RustModelError, RunOptions};
 use lpc_damper::output::parquet::{provenance, table_parquet, Constant, TOOL_VERSION};
 use lpc_damper::scene::{self, Loaded, Overrides, SceneError as RustSceneError, SceneFile, Stepping};
 use lpc_damper::studies::{chain as chains, ensemble as ensembles, frf as frfs, sweep as sweeps};
@@ -423,6 +423,14 @@ impl Run {
     }
 }
 
+/// The budgets of every run a function makes, checked by their rules (`max_steps`,
+/// `max_wall_time`, as the CLI's `--max-steps` and `--max-wall-time`).
+fn limits(max_steps: Option<u64>, max_wall_time: Option<f64>) -> PyResult<Limits> {
+    let limits = Limits { max_steps, max_wall_s: max_wall_time };
+    limits.check().map_err(|(budget, rule)| SceneError::new_err(format!("{}: {rule}", budget.keyword())))?;
+    Ok(limits)
+}
+
 /// Runs one model on a damper scene. Every model takes budgets, as the CLI's `--max-steps`
 /// and `--max-wall-time`: a run that exceeds one raises `ModelError` whose `partial` attribute
 /// is the run so far.
@@ -445,8 +453,7 @@ fn run(
 ) -> PyResult<Run> {
     let model = parse_model(model)?;
     let s = scene.damper(&Settings { horizon, sample_dt, stepping, dt, solver_iterations, ccd, tolerance })?;
-    let options = RunOptions { max_steps, max_wall_s: max_wall_time, ..RunOptions::default() };
-    options.check_budgets().map_err(|(budget, rule)| SceneError::new_err(format!("{}: {rule}", budget.keyword())))?;
+    let options = RunOptions::limited(limits(max_steps, max_wall_time)?);
     match py.detach(|| model.simulate(&s, &options)) {
         Ok(run) => Ok(Run::of(run)),
         Err(RustModelError::OverBudget(stop)) => {
@@ -511,7 +518,7 @@ fn write_part(
 /// Members `start..stop` (default all) of an ensemble of `members` drawn under the scene's
 /// `[tolerances]`: a dict of columns `member`, the drawn values, then every metric.
 #[pyfunction]
-#[pyo3(signature = (scene, members, *, seed = None, model = "reference", start = 0, stop = None, out = None, horizon = None, sample_dt = None, stepping = None, dt = None, solver_iterations = None, ccd = false, tolerance = None))]
+#[pyo3(signature = (scene, members, *, seed = None, model = "reference", start = 0, stop = None, out = None, horizon = None, sample_dt = None, stepping = None, dt = None, solver_iterations = None, ccd = false, tolerance = None, max_steps = None, max_wall_time = None))]
 #[allow(clippy::too_many_arguments)]
 fn ensemble<'py>(
     py: Python<'py>,
@@ -529,8 +536,11 @@ fn ensemble<'py>(
     solver_iterations: Option<u32>,
     ccd: bool,
     tolerance: Option<f64>,
+    max_steps: Option<u64>,
+    max_wall_time: Option<f64>,
 ) -> PyResult<Bound<'py, PyDict>> {
     let model = parse_model(model)?;
+    let limits = limits(max_steps, max_wall_time)?;
     let nominal = scene.damper(&Settings { horizon, sample_dt, stepping, dt, solver_iterations, ccd, tolerance })?;
     let l = &scene.loaded;
     let stop = stop.unwrap_or(members);
@@ -541,7 +551,7 @@ fn ensemble<'py>(
     let metrics = batched(py, all.len(), |range| {
         ensembles::map_members(
             &all[range],
-            |m| model.simulate(&m.scene, &RunOptions::metrics_only()).map(|r| Headline::of_run(&r).values()),
+            |m| model.simulate(&m.scene, &RunOptions { limits, ..RunOptions::metrics_only() }).map(|r| Headline::of_run(&r).values()),
             &|| {},
         )
         .map_err(model_error)
@@ -584,7 +594,7 @@ fn sweep_cells(scene: &Scene, axes: Option<Vec<String>>) -> PyResult<usize> {
 /// Cells `start..stop` (default all) of a sweep: a dict of columns `cell`, each axis' value
 /// as written, then every metric.
 #[pyfunction]
-#[pyo3(signature = (scene, axes = None, *, model = "reference", start = 0, stop = None, out = None, horizon = None, stepping = None, dt = None, solver_iterations = None, ccd = false, tolerance = None))]
+#[pyo3(signature = (scene, axes = None, *, model = "reference", start = 0, stop = None, out = None, horizon = None, stepping = None, dt = None, solver_iterations = None, ccd = false, tolerance = None, max_steps = None, max_wall_time = None))]
 #[allow(clippy::too_many_arguments)]
 fn sweep<'py>(
     py: Python<'py>,
@@ -600,8 +610,11 @@ fn sweep<'py>(
     solver_iterations: Option<u32>,
     ccd: bool,
     tolerance: Option<f64>,
+    max_steps: Option<u64>,
+    max_wall_time: Option<f64>,
 ) -> PyResult<Bound<'py, PyDict>> {
     let model = parse_model(model)?;
+    let limits = limits(max_steps, max_wall_time)?;
     let (parameters, grid) =
         grid(scene, axes, &Settings { horizon, stepping, dt, solver_iterations, ccd, tolerance, ..Settings::default() })?;
     let stop = stop.unwrap_or(grid.len()).min(grid.len());
@@ -611,7 +624,7 @@ fn sweep<'py>(
     let cells = &grid[start..stop];
     let points = batched(py, cells.len(), |range| {
         let offset = range.start;
-        sweeps::run_grid(&parameters, &cells[range], model, &|| {})
+        sweeps::run_grid(&parameters, &cells[range], model, limits, &|| {})
             .map(|p| p.into_iter().enumerate().map(|(i, p)| (start + offset + i, p)).collect::<Vec<_>>())
             .map_err(model_error)
     })?;
@@ -627,9 +640,17 @@ fn sweep<'py>(
 /// damper and of the bare frame (m; NaN where a run failed), whether each reached a steady
 /// state, the horizon used and the impacts per period.
 #[pyfunction]
-#[pyo3(signature = (scene, frequencies, *, model = "reference"))]
-fn frf<'py>(py: Python<'py>, scene: &Scene, frequencies: Vec<f64>, model: &str) -> PyResult<Bound<'py, PyDict>> {
+#[pyo3(signature = (scene, frequencies, *, model = "reference", max_steps = None, max_wall_time = None))]
+fn frf<'py>(
+    py: Python<'py>,
+    scene: &Scene,
+    frequencies: Vec<f64>,
+    model: &str,
+    max_steps: Option<u64>,
+    max_wall_time: Option<f64>,
+) -> PyResult<Bound<'py, PyDict>> {
     let model = parse_model(model)?;
+    let limits = limits(max_steps, max_wall_time)?;
     let s = scene.damper(&Settings::default())?;
     let path = &scene.loaded.path;
     if s.forcing.is_none() {
@@ -642,7 +663,7 @@ fn frf<'py>(py: Python<'py>, scene: &Scene, frequencies: Vec<f64>, model: &str) 
             other => scene_error(other),
         })?;
     }
-    let points = batched(py, frequencies.len(), |range| Ok(frfs::frf(&s, &frequencies[range], model, &|| {})))?;
+    let points = batched(py, frequencies.len(), |range| Ok(frfs::frf(&s, &frequencies[range], model, limits, &|| {})))?;
     let d = PyDict::new(py);
     let col = |f: &dyn Fn(&frfs::FrfPoint) -> f64| floats(py, points.iter().map(f).collect());
     d.set_item("frequency", col(&|p| p.frequency))?;
@@ -658,14 +679,21 @@ fn frf<'py>(py: Python<'py>, scene: &Scene, frequencies: Vec<f64>, model: &str) 
 
 /// The KER experiment of a chain scene: per chain, `large` (N_L), `small` and `ker`.
 #[pyfunction]
-#[pyo3(signature = (scene, *, model = "reference"))]
-fn chain<'py>(py: Python<'py>, scene: &Scene, model: &str) -> PyResult<Bound<'py, PyDict>> {
+#[pyo3(signature = (scene, *, model = "reference", max_steps = None, max_wall_time = None))]
+fn chain<'py>(
+    py: Python<'py>,
+    scene: &Scene,
+    model: &str,
+    max_steps: Option<u64>,
+    max_wall_time: Option<f64>,
+) -> PyResult<Bound<'py, PyDict>> {
     let model = parse_model(model)?;
+    let limits = limits(max_steps, max_wall_time)?;
     let cases =
         scene.loaded.chain.as_ref().ok_or_else(|| {
             SceneError::new_err(format!("{}: `chain` is missing: the KER experiment needs a chain scene", scene.loaded.path))
         })?;
-    let rows = py.detach(|| chains::run_chain(cases, model, &|| {})).map_err(model_error)?;
+    let rows = py.detach(|| chains::run_chain(cases, model, limits, &|| {})).map_err(model_error)?;
     let d = PyDict::new(py);
     d.set_item("large", rows.iter().map(|r| r.large as i64).collect::<Vec<_>>().into_pyarray(py))?;
     d.set_item("small", rows.iter().map(|r| r.small as i64).collect::<Vec<_>>().into_pyarray(py))?;

@@ -217,6 +217,23 @@ def test_a_budget_stops_every_model_and_keeps_the_run_so_far(scenes):
         lpc.run(scene, model="compliant", max_wall_time=-1.0)
 
 
+def test_studies_give_each_run_the_budget(scenes):
+    """Every function that runs a model takes the budgets: a chain whose runs exceed one
+    raises, a frequency response reports each frequency's stop, bad budgets are refused."""
+    with pytest.raises(lpc.ModelError, match="--max-steps"):
+        lpc.chain(lpc.load_scene(scenes / "chain-ker.toml"), max_steps=2)
+    forced = lpc.load_scene(scenes / "forced-lsl.toml")
+    response = lpc.frf(forced, [3.0], max_steps=5)
+    assert np.isnan(response["amplitude"][0])
+    for call in (
+        lambda: lpc.frf(forced, [3.0], max_steps=0),
+        lambda: lpc.sweep(lpc.load_scene(scenes / "sweep-gap.toml"), max_steps=0),
+        lambda: lpc.ensemble(lpc.load_scene(scenes / "lpc-lsl.toml"), 2, max_wall_time=0.0),
+    ):
+        with pytest.raises(lpc.SceneError, match="max_steps|max_wall_time"):
+            call()
+
+
 def test_frf_needs_a_forced_scene_and_valid_frequencies(scenes):
     """Regression: `frf` on a scene without `[forcing]` panicked inside the library
     (PanicException); it is a SceneError, and each frequency keeps the file's rules."""

@@ -18,7 +18,7 @@ mod rosenbrock;
 mod stepper;
 mod system;
 
-use crate::model::{Checks, Meter, Model, ModelError, RunOptions, Setting, Simulator};
+use crate::model::{Checks, Limits, Meter, Model, ModelError, RunOptions, Setting, Simulator};
 use crate::run::Run;
 use crate::scene::Scene;
 use driver::Driver;
@@ -63,7 +63,8 @@ impl Simulator for Compliant {
 
     fn simulate(&self, scene: &Scene, options: &RunOptions) -> Result<Run, ModelError> {
         // Without a step budget the model still stops at MAX_STEPS rather than run for ever.
-        let meter = Meter::new(&RunOptions { max_steps: Some(options.max_steps.unwrap_or(MAX_STEPS)), ..*options }, PROGRESS_STEPS);
+        let limits = Limits { max_steps: Some(options.limits.max_steps.unwrap_or(MAX_STEPS)), ..options.limits };
+        let meter = Meter::new(&RunOptions { limits, ..*options }, PROGRESS_STEPS);
         let system = System::new(scene);
         let mut run = Driver::new(&system, options.record).run(&meter)?;
         run.wall_time_s = meter.elapsed();

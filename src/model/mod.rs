@@ -10,7 +10,7 @@ mod options;
 
 pub use crate::run::Model;
 pub use error::{ModelError, OverBudget};
-pub use options::{Budget, Meter, Progress, RunOptions};
+pub use options::{Budget, Limits, Meter, Progress, RunOptions};
 
 use crate::run::Run;
 use crate::scene::Scene;

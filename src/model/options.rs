@@ -11,11 +11,8 @@ use crate::run::Record;
 pub struct RunOptions<'a> {
     /// What the run keeps besides its metrics.
     pub record: Record,
-    /// Most steps (the reference: events) before the run stops with the run so far
-    /// ([`super::ModelError::OverBudget`]).
-    pub max_steps: Option<u64>,
-    /// Most seconds of computing before the run stops, likewise.
-    pub max_wall_s: Option<f64>,
+    /// What the run may cost before it stops with the run so far.
+    pub limits: Limits,
     /// Where the run reports the simulated time reached and the steps taken as it goes.
     pub progress: Option<&'a Progress>,
 }
@@ -25,11 +22,30 @@ impl RunOptions<'_> {
     pub fn metrics_only() -> Self {
         RunOptions { record: Record::MetricsOnly, ..RunOptions::default() }
     }
+    /// A run that keeps its series, within `limits`.
+    pub fn limited(limits: Limits) -> Self {
+        RunOptions { limits, ..RunOptions::default() }
+    }
+}
+
+/// What one run may cost: past either budget it stops with the run so far
+/// ([`super::ModelError::OverBudget`]). A study gives each of its runs the same limits.
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct Limits {
+    /// Most steps (the reference: events).
+    pub max_steps: Option<u64>,
+    /// Most seconds of computing.
+    pub max_wall_s: Option<f64>,
+}
+
+impl Limits {
+    /// No budget: the run goes to its horizon (or to a model's own limit).
+    pub const NONE: Limits = Limits { max_steps: None, max_wall_s: None };
 
     /// The rules the budgets keep (`--max-steps`, `--max-wall-time` and their Python keywords):
     /// at least one step, a positive and finite number of seconds. The rule broken, for the
     /// caller to name its field.
-    pub fn check_budgets(&self) -> Result<(), (Budget, String)> {
+    pub fn check(&self) -> Result<(), (Budget, String)> {
         if self.max_steps == Some(0) {
             return Err((Budget::Steps, "must be at least 1".into()));
         }
@@ -108,8 +124,8 @@ impl<'a> Meter<'a> {
         Meter {
             start: Instant::now(),
             every: every.max(1),
-            max_steps: options.max_steps,
-            max_wall_s: options.max_wall_s,
+            max_steps: options.limits.max_steps,
+            max_wall_s: options.limits.max_wall_s,
             progress: options.progress,
         }
     }

@@ -4,7 +4,7 @@
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
-use crate::model::{Model, ModelError, RunOptions};
+use crate::model::{Limits, Model, ModelError, RunOptions};
 use crate::run::Run;
 use crate::scene::{ChainCase, Scene};
 
@@ -25,12 +25,13 @@ pub fn ker(scene: &Scene, run: &Run) -> f64 {
     after / scene.initial_energy()
 }
 
-/// Runs every case with `model`, in parallel; `progress` is called after each.
-pub fn run_chain(cases: &[ChainCase], model: Model, progress: &(dyn Fn() + Sync)) -> Result<Vec<KerRow>, ModelError> {
+/// Runs every case with `model`, in parallel, each within `limits`; `progress` is called after
+/// each.
+pub fn run_chain(cases: &[ChainCase], model: Model, limits: Limits, progress: &(dyn Fn() + Sync)) -> Result<Vec<KerRow>, ModelError> {
     cases
         .par_iter()
         .map(|c| {
-            let run = model.simulate(&c.scene, &RunOptions::default());
+            let run = model.simulate(&c.scene, &RunOptions::limited(limits));
             progress();
             let run = run?;
             Ok(KerRow { large: c.large, small: if c.small { c.large - 1 } else { 0 }, ker: ker(&c.scene, &run) })

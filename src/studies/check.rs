@@ -21,7 +21,7 @@ use serde::{Deserialize, Serialize};
 
 use super::StudyError;
 use crate::metrics::{metrics, Headline, Metric, Metrics};
-use crate::model::{Model, RunOptions};
+use crate::model::{Limits, Model, RunOptions};
 use crate::scene;
 use crate::studies::chain::{run_chain, KerRow};
 use crate::studies::sweep::sweep_scenes;
@@ -92,7 +92,13 @@ pub fn current(dir: &Path, models: &[Model], progress: &(dyn Fn() + Sync)) -> Re
             }
             if let Some(chain) = &loaded.chain {
                 let name = loaded.file.name.clone().unwrap_or_else(|| "chain".into());
-                out.push(Golden { case: name, model, impact_count: 0, metrics: None, ker: run_chain(chain, model, progress)? });
+                out.push(Golden {
+                    case: name,
+                    model,
+                    impact_count: 0,
+                    metrics: None,
+                    ker: run_chain(chain, model, Limits::NONE, progress)?,
+                });
             }
         }
     }

@@ -12,7 +12,7 @@ use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
 use crate::metrics::{Headline, Metric};
-use crate::model::{Model, ModelError, RunOptions};
+use crate::model::{Limits, Model, ModelError, RunOptions};
 use crate::run::{refuse_beyond_memory, Record};
 use crate::scene::{self, Distribution, Length, Parameter, Scene, SceneError, SceneFile, Tolerances};
 
@@ -356,9 +356,15 @@ pub struct EnsembleRuns {
     pub xs: Vec<Vec<f64>>,
 }
 
-/// Runs every member with `model`. Members build no series unless `keep_xs`, which keeps each
+/// Runs every member with `model`, each within `limits`. Members build no series unless `keep_xs`, which keeps each
 /// member's frame displacement (the ensemble's band) and drops the rest.
-pub fn run_members(ensemble: &Ensemble, model: Model, keep_xs: bool, progress: &(dyn Fn() + Sync)) -> Result<EnsembleRuns, ModelError> {
+pub fn run_members(
+    ensemble: &Ensemble,
+    model: Model,
+    limits: Limits,
+    keep_xs: bool,
+    progress: &(dyn Fn() + Sync),
+) -> Result<EnsembleRuns, ModelError> {
     let record = if keep_xs { Record::Series } else { Record::MetricsOnly };
     if keep_xs {
         if let Some(first) = ensemble.members.first() {
@@ -368,7 +374,7 @@ pub fn run_members(ensemble: &Ensemble, model: Model, keep_xs: bool, progress: &
     let runs = map_members(
         &ensemble.members,
         |m| {
-            let run = model.simulate(&m.scene, &RunOptions { record, ..RunOptions::default() })?;
+            let run = model.simulate(&m.scene, &RunOptions { record, limits, ..RunOptions::default() })?;
             let metrics = Headline::of_run(&run).values();
             let series = keep_xs.then_some(run.series);
             Ok::<_, ModelError>((metrics, series))

@@ -18,7 +18,7 @@
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
-use crate::model::{Model, ModelError, RunOptions};
+use crate::model::{Limits, Model, ModelError, RunOptions};
 use crate::run::Run;
 use crate::scene::Scene;
 use crate::studies::ensemble::{Member, Stats};
@@ -109,13 +109,13 @@ pub fn forced_at(scene: &Scene, frequency: f64) -> Scene {
 }
 
 /// Runs `scene` with `model` until its response is steady (or the horizon has doubled
-/// [`MAX_DOUBLINGS`] times); returns the reading and the horizon used.
-pub fn steady_run(scene: &Scene, model: Model) -> Result<(SteadyState, f64), ModelError> {
-    steady_peaks(scene, model).map(|(reading, horizon, _)| (reading, horizon))
+/// [`MAX_DOUBLINGS`] times), each run within `limits`; returns the reading and the horizon used.
+pub fn steady_run(scene: &Scene, model: Model, limits: Limits) -> Result<(SteadyState, f64), ModelError> {
+    steady_peaks(scene, model, limits).map(|(reading, horizon, _)| (reading, horizon))
 }
 
 /// [`steady_run`], with the per-period peaks of the last two blocks of the last run.
-pub fn steady_peaks(scene: &Scene, model: Model) -> Result<(SteadyState, f64, Vec<f64>), ModelError> {
+pub fn steady_peaks(scene: &Scene, model: Model, limits: Limits) -> Result<(SteadyState, f64, Vec<f64>), ModelError> {
     let period = 1.0 / scene.forcing.expect("a forced scene").frequency;
     let mut s = scene.clone();
     for doubling in 0..=MAX_DOUBLINGS {
@@ -128,7 +128,7 @@ pub fn steady_peaks(scene: &Scene, model: Model) -> Result<(SteadyState, f64, Ve
                 crate::scene::human(s.sample_dt)
             ))
         })?;
-        let run = model.simulate(&s, &RunOptions::default())?;
+        let run = model.simulate(&s, &RunOptions::limited(limits))?;
         let peaks = period_peaks(&run, period);
         let reading = steady_reading(&run, &peaks, period);
         if reading.steady || doubling == MAX_DOUBLINGS {
@@ -192,7 +192,7 @@ pub fn check_ensemble_memory(members: usize, frequencies: usize) -> Result<(), S
 /// The frequency response over `members`: each run per frequency with and without the damper,
 /// as [`frf`] runs the nominal scene (the horizon doubling until steady, or to its limit),
 /// every run in parallel.
-pub fn frf_ensemble(members: &[Member], frequencies: &[f64], model: Model, progress: &(dyn Fn() + Sync)) -> Vec<FrfBand> {
+pub fn frf_ensemble(members: &[Member], frequencies: &[f64], model: Model, limits: Limits, progress: &(dyn Fn() + Sync)) -> Vec<FrfBand> {
     let jobs: Vec<(usize, usize, bool)> =
         (0..frequencies.len()).flat_map(|k| (0..members.len()).flat_map(move |m| [(k, m, true), (k, m, false)])).collect();
     let results: Vec<Result<(Vec<f64>, SteadyState), ModelError>> = jobs
@@ -200,7 +200,7 @@ pub fn frf_ensemble(members: &[Member], frequencies: &[f64], model: Model, progr
         .map(|&(k, m, damper)| {
             let scene = &members[m].scene;
             let base = if damper { scene.clone() } else { scene.without_damper() };
-            let r = steady_peaks(&forced_at(&base, frequencies[k]), model).map(|(reading, _, peaks)| (peaks, reading));
+            let r = steady_peaks(&forced_at(&base, frequencies[k]), model, limits).map(|(reading, _, peaks)| (peaks, reading));
             progress();
             r
         })
@@ -251,16 +251,16 @@ pub fn frequencies(from: f64, to: f64, steps: usize) -> Vec<f64> {
 }
 
 /// The frequency response of `scene` (which must be forced) at each frequency, with and
-/// without the damper, in parallel; `progress` is called after each run. A run that fails
+/// without the damper, in parallel, each run within `limits`; `progress` is called after each run. A run that fails
 /// leaves its frequency without that amplitude, not steady, with the error.
-pub fn frf(scene: &Scene, frequencies: &[f64], model: Model, progress: &(dyn Fn() + Sync)) -> Vec<FrfPoint> {
+pub fn frf(scene: &Scene, frequencies: &[f64], model: Model, limits: Limits, progress: &(dyn Fn() + Sync)) -> Vec<FrfPoint> {
     let bare = scene.without_damper();
     let jobs: Vec<(usize, bool)> = (0..frequencies.len()).flat_map(|k| [(k, true), (k, false)]).collect();
     let results: Vec<Result<(SteadyState, f64), ModelError>> = jobs
         .par_iter()
         .map(|&(k, damper)| {
             let base = if damper { scene } else { &bare };
-            let r = steady_run(&forced_at(base, frequencies[k]), model);
+            let r = steady_run(&forced_at(base, frequencies[k]), model, limits);
             progress();
             r
         })

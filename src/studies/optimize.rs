@@ -11,7 +11,7 @@ use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
 use super::StudyError;
-use crate::model::{Model, RunOptions};
+use crate::model::{Limits, Model, RunOptions};
 use crate::scene::{self, Arrangement, Length, Loaded, Parameter, Scene, SceneError};
 use crate::studies::ensemble;
 use crate::studies::frf;
@@ -91,6 +91,8 @@ pub struct Judging {
     pub objective: Objective,
     /// The model that runs each design.
     pub model: Model,
+    /// What each run may cost.
+    pub limits: Limits,
     /// Refinements around the best grid point.
     pub refinements: u32,
     /// Over ensembles (ranked by a quantile), or one run per design.
@@ -108,7 +110,7 @@ pub fn optimize(
     judging: Judging,
     progress: &(dyn Fn() + Sync),
 ) -> Result<Search, StudyError> {
-    let Judging { objective, model, refinements, robust } = judging;
+    let Judging { objective, refinements, robust, .. } = judging;
     let invalid = |field: &str, rule: String| SceneError::Invalid { file: loaded.path.clone(), field: field.into(), rule };
     if axes.iter().any(|a| a.parameter == Parameter::Clearance) {
         return Err(invalid("clearance", "follows from the container length here: vary gap, mass_ratio, ... instead".into()).into());
@@ -130,7 +132,7 @@ pub fn optimize(
         file.balls.as_mut().expect("checked").arrangement = Arrangement::Letters(arrangement.clone());
         let mut grid: Vec<Vec<Length>> = axes.iter().map(|a| a.values.clone()).collect();
         for pass in 0..=refinements {
-            let (designs, bad) = evaluate(loaded, &file, arrangement, axes, &grid, objective, model, robust, progress)?;
+            let (designs, bad) = evaluate(loaded, &file, arrangement, axes, &grid, judging, progress)?;
             infeasible += bad;
             let best = designs.iter().filter(|d| d.objective.is_some()).min_by(|a, b| cmp(a, b)).cloned();
             all.extend(designs);
@@ -196,11 +198,10 @@ fn evaluate(
     arrangement: &str,
     axes: &[Axis],
     grid: &[Vec<Length>],
-    objective: Objective,
-    model: Model,
-    robust: Option<Robust>,
+    judging: Judging,
     progress: &(dyn Fn() + Sync),
 ) -> Result<(Vec<Design>, usize), StudyError> {
+    let Judging { objective, model, limits, robust, .. } = judging;
     let mut points: Vec<Vec<Length>> = vec![vec![]];
     for values in grid {
         points = points.iter().flat_map(|p| values.iter().map(move |v| [p.clone(), vec![*v]].concat())).collect();
@@ -228,11 +229,13 @@ fn evaluate(
             };
             let objective_of = |scene: &Scene| -> Result<Option<f64>, StudyError> {
                 Ok(match objective {
-                    Objective::SettlingTime => crate::metrics::metrics(&model.simulate(scene, &RunOptions::metrics_only())?).settling_time,
+                    Objective::SettlingTime => {
+                        crate::metrics::metrics(&model.simulate(scene, &RunOptions { limits, ..RunOptions::metrics_only() })?).settling_time
+                    }
                     Objective::ResonantAmplitude { from, to, steps } => {
                         let mut worst: f64 = 0.0;
                         for f in frf::frequencies(from, to, steps) {
-                            let (reading, _) = frf::steady_run(&frf::forced_at(scene, f), model)?;
+                            let (reading, _) = frf::steady_run(&frf::forced_at(scene, f), model, limits)?;
                             worst = worst.max(reading.amplitude);
                         }
                         Some(worst)

@@ -9,7 +9,7 @@ use rand::{Rng, SeedableRng};
 use rand_pcg::Pcg64;
 use serde::Serialize;
 
-use crate::model::{Model, ModelError, RunOptions};
+use crate::model::{Limits, Model, ModelError, RunOptions};
 use crate::run::Run;
 use crate::scene::format::{BallsFile, ForcingFile, FrameFile, RunFile};
 use crate::scene::{self, Arrangement, ForcingKind, Length, Scene, SceneFile};
@@ -196,7 +196,7 @@ pub enum Passed {
 /// Runs `model` on `scene` within `max_wall_s` seconds of computing (if given) and checks the
 /// run.
 pub fn judge_run(model: Model, scene: &Scene, max_wall_s: Option<f64>) -> Result<Passed, Failure> {
-    let options = RunOptions { max_wall_s, ..RunOptions::default() };
+    let options = RunOptions::limited(Limits { max_wall_s, ..Limits::NONE });
     let outcome = catch_unwind(AssertUnwindSafe(|| model.simulate(scene, &options)));
     let run = match outcome {
         Err(panic) => {

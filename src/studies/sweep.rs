@@ -6,7 +6,7 @@ use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
 use crate::metrics::{Headline, Metric, RunSummary};
-use crate::model::{Model, ModelError, RunOptions};
+use crate::model::{Limits, Model, ModelError, RunOptions};
 use crate::scene::{self, Length, Loaded, Parameter, Scene, SceneError};
 
 /// Where a point of a sweep lies (the first fields of `lpc sweep`'s JSON).
@@ -205,29 +205,32 @@ pub fn sweep_scenes(loaded: &Loaded) -> Result<Vec<(f64, Scene)>, SceneError> {
     Ok(grid_scenes(loaded, &axes[..1])?.into_iter().map(|g| (g.values[0], g.scene)).collect())
 }
 
-/// Runs every scene with `model` in parallel; `progress` is called after each run.
+/// Runs every scene with `model` in parallel, each within `limits`; `progress` is called after
+/// each run.
 pub fn run_sweep(
     parameter: &str,
     scenes: &[(f64, Scene)],
     model: Model,
+    limits: Limits,
     progress: &(dyn Fn() + Sync),
 ) -> Result<Vec<SweepPoint>, ModelError> {
     let axes = [parameter.to_string()];
     let grid: Vec<GridScene> =
         scenes.iter().map(|(v, s)| GridScene { values: vec![*v], scene: s.clone(), file: Default::default() }).collect();
-    run_grid(&axes, &grid, model, progress)
+    run_grid(&axes, &grid, model, limits, progress)
 }
 
-/// Runs every point of a grid with `model` in parallel.
+/// Runs every point of a grid with `model` in parallel, each within `limits`.
 pub fn run_grid(
     parameters: &[String],
     grid: &[GridScene],
     model: Model,
+    limits: Limits,
     progress: &(dyn Fn() + Sync),
 ) -> Result<Vec<SweepPoint>, ModelError> {
     grid.par_iter()
         .map(|g| {
-            let run = model.simulate(&g.scene, &RunOptions::default())?;
+            let run = model.simulate(&g.scene, &RunOptions::limited(limits))?;
             progress();
             Ok(SweepPoint { at: Coordinates::of(parameters, &g.values), summary: RunSummary::of(&run) })
         })

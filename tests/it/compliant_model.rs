@@ -17,7 +17,7 @@ use crate::common;
 use crate::common::compliant;
 use lpc_damper::compliant::contact;
 use lpc_damper::impact_law::impact_law;
-use lpc_damper::model::{ModelError, OverBudget, RunOptions};
+use lpc_damper::model::{Limits, ModelError, OverBudget, RunOptions};
 use lpc_damper::run::Run;
 use lpc_damper::scene::DEFAULT_COMPLIANT_TOLERANCE as DEFAULT_TOLERANCE;
 use lpc_damper::scene::{
@@ -293,7 +293,7 @@ fn runs_are_bitwise_repeatable() {
 #[test]
 fn a_step_limit_stops_the_run_and_keeps_it_so_far() {
     let scene = load_scene(scenes_dir().join("lpc-lsl.toml")).unwrap();
-    let err = Model::Compliant.simulate(&scene, &RunOptions { max_steps: Some(3000), ..RunOptions::default() }).unwrap_err();
+    let err = Model::Compliant.simulate(&scene, &RunOptions::limited(Limits { max_steps: Some(3000), ..Limits::NONE })).unwrap_err();
     let msg = err.to_string();
     assert!(msg.contains("lpc-lsl") && msg.contains("--max-steps"), "{msg}");
     let ModelError::OverBudget(stop) = err else { panic!("{msg}") };
@@ -318,11 +318,11 @@ const PACKED_COLUMN: &str = include_str!("../../examples/scenes/packed-column.to
 #[test]
 fn a_budget_says_what_the_steps_cost() {
     let scene = lpc_damper::scene::parse(PACKED_COLUMN, "packed.toml", "packed").unwrap().scene.unwrap();
-    let err = Model::Compliant.simulate(&scene, &RunOptions { max_steps: Some(20_000), ..RunOptions::default() }).unwrap_err();
+    let err = Model::Compliant.simulate(&scene, &RunOptions::limited(Limits { max_steps: Some(20_000), ..Limits::NONE })).unwrap_err();
     let msg = err.to_string();
     assert!(msg.contains("packed-column") && msg.contains("contacts open, the stiffest ball") && msg.contains("Hertz period"), "{msg}");
     // A wall-time budget of a nanosecond stops at its first look, after PROGRESS_STEPS steps.
-    let err = Model::Compliant.simulate(&scene, &RunOptions { max_wall_s: Some(1e-9), ..RunOptions::default() }).unwrap_err();
+    let err = Model::Compliant.simulate(&scene, &RunOptions::limited(Limits { max_wall_s: Some(1e-9), ..Limits::NONE })).unwrap_err();
     let ModelError::OverBudget(stop) = err else { panic!("not a budget stop") };
     assert_eq!(stop.steps, lpc_damper::compliant::PROGRESS_STEPS - 1);
     assert!(stop.budget_text().contains("--max-wall-time"), "{}", stop.budget_text());
@@ -372,7 +372,7 @@ fn cut(mut scene: Scene, horizon: f64) -> Scene {
 /// final state are integration error away from the finer one's. Chaos amplifies a step's error
 /// over a long run, so these runs are short.
 fn converges(scene: &Scene, tol: f64, max_steps: u64) -> (Run, Run) {
-    let options = RunOptions { max_steps: Some(max_steps), ..RunOptions::default() };
+    let options = RunOptions::limited(Limits { max_steps: Some(max_steps), ..Limits::NONE });
     let coarse = Model::Compliant.simulate(&with_tolerance(scene, tol), &options).unwrap();
     let fine = Model::Compliant.simulate(&with_tolerance(scene, tol / 10.0), &options).unwrap();
     for r in [&coarse, &fine] {

@@ -100,7 +100,13 @@ fn optimize_finds_the_best_of_an_exhaustive_evaluation() {
         &axes,
         &arrangements,
         Length::Metres(length),
-        Judging { objective: Objective::SettlingTime, model: lpc_damper::Model::Reference, refinements: 0, robust: None },
+        Judging {
+            objective: Objective::SettlingTime,
+            model: lpc_damper::Model::Reference,
+            limits: lpc_damper::model::Limits::NONE,
+            refinements: 0,
+            robust: None,
+        },
         &|| {},
     )
     .unwrap();

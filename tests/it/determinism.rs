@@ -9,7 +9,7 @@ fn sweep_on(threads: usize, model: Model) -> Vec<RunSummary> {
     let loaded = load(scenes_dir().join("sweep-mass-ratio.toml")).unwrap();
     let scenes = sweep_scenes(&loaded).unwrap();
     let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
-    pool.install(|| run_sweep("mass_ratio", &scenes, model, &|| {}))
+    pool.install(|| run_sweep("mass_ratio", &scenes, model, lpc_damper::model::Limits::NONE, &|| {}))
         .unwrap()
         .into_iter()
         .map(|p| RunSummary { wall_time_s: 0.0, ..p.summary })

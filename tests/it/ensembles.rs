@@ -3,7 +3,7 @@
 //! the frame's period; the draws depend only on (seed, k), never on threads; a metrics-only
 //! member has exactly the metrics of a full run; bad tolerances are refused with the field.
 
-use lpc_damper::model::RunOptions;
+use lpc_damper::model::{Limits, RunOptions};
 use std::f64::consts::PI;
 
 use lpc_damper::metrics::Headline;
@@ -33,7 +33,7 @@ fn zero_tolerances_reproduce_the_single_run_exactly() {
     for model in Model::ALL {
         let single = model.simulate(l.scene.as_ref().unwrap(), &RunOptions::default()).unwrap();
         let expected = Headline::of_run(&single).values();
-        let runs = ensemble::run_members(&members, *model, true, &|| {}).unwrap();
+        let runs = ensemble::run_members(&members, *model, Limits::NONE, true, &|| {}).unwrap();
         for (k, m) in runs.metrics.iter().enumerate() {
             assert_eq!(m, &expected, "{model}: member {k}'s metrics differ from the single run's");
             assert_eq!(runs.xs[k], single.series.xs(), "{model}: member {k}'s displacement differs from the single run's");

@@ -105,7 +105,7 @@ fn frequency_response_of_the_bare_frame_is_its_receptance() {
             s
         };
         let freqs = frf::frequencies(3.0, 5.0, 5);
-        let points = frf::frf(&scene, &freqs, Model::Reference, &|| {});
+        let points = frf::frf(&scene, &freqs, Model::Reference, lpc_damper::model::Limits::NONE, &|| {});
         assert_eq!(points.len(), 5);
         for p in points {
             let w = 2.0 * std::f64::consts::PI * p.frequency;

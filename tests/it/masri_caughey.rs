@@ -165,7 +165,9 @@ fn frf_reads_the_periodic_motion() {
         d.frequency
     );
     let scene = lpc_damper::scene::parse(&text, "masri.toml", "masri").unwrap().scene.unwrap();
-    let point = lpc_damper::studies::frf::frf(&scene, &[d.frequency], lpc_damper::Model::Reference, &|| {}).remove(0);
+    let point =
+        lpc_damper::studies::frf::frf(&scene, &[d.frequency], lpc_damper::Model::Reference, lpc_damper::model::Limits::NONE, &|| {})
+            .remove(0);
     let exact = d.solutions().into_iter().filter(|p| p.admissible).map(|p| p.amplitude).fold(0.0, f64::max);
     assert!(point.steady, "{point:?}");
     assert_eq!(point.impacts_per_period, Some(2.0));

@@ -5,6 +5,7 @@ use std::path::Path;
 
 use clap::ValueEnum;
 
+use lpc_damper::model::Limits;
 use lpc_damper::scene::{self, Loaded, Overrides, Scene, SceneError, SceneFile, Stepping, Tolerances};
 use lpc_damper::studies::ensemble::{self, Ensemble};
 
@@ -44,6 +45,28 @@ pub struct ModelArgs {
     /// Compliant model: error tolerance per step, relative to the contact scales (default 1e-9).
     #[arg(long)]
     tolerance: Option<f64>,
+}
+
+/// What each run may cost; every command that runs a model accepts them.
+#[derive(clap::Args, Clone, Copy)]
+pub struct BudgetArgs {
+    /// Stop a run after this many steps (the reference: events; the compliant model stops at
+    /// 5e7 without one), saying what its steps cost and keeping the run so far (`lpc run`
+    /// writes it with --out); in a study, the point of that run reports the stop.
+    #[arg(long, value_name = "N")]
+    max_steps: Option<u64>,
+    /// Stop a run after this many seconds of computing, likewise.
+    #[arg(long, value_name = "S")]
+    max_wall_time: Option<f64>,
+}
+
+impl BudgetArgs {
+    /// The budgets, checked by their rules (an error naming the flag and `scene`).
+    pub fn limits(self, scene: &Path) -> Result<Limits> {
+        let limits = Limits { max_steps: self.max_steps, max_wall_s: self.max_wall_time };
+        limits.check().map_err(|(budget, rule)| invalid(scene, budget.flag(), rule))?;
+        Ok(limits)
+    }
 }
 
 impl ModelArgs {

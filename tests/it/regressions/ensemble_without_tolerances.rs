@@ -2,7 +2,7 @@
 //! the first toleranced parameter, of which there was none). Every member is the nominal scene.
 
 use lpc_damper::metrics::Headline;
-use lpc_damper::model::RunOptions;
+use lpc_damper::model::{Limits, RunOptions};
 use lpc_damper::studies::ensemble;
 use lpc_damper::Model;
 
@@ -13,7 +13,7 @@ fn an_ensemble_without_tolerances_is_the_nominal_scene_repeated() {
     let nominal = l.scene.as_ref().unwrap();
     let members = ensemble::draw(&l.file, &l.path, nominal, None, 3, None).unwrap();
     let single = Headline::of_run(&Model::Reference.simulate(nominal, &RunOptions::default()).unwrap()).values();
-    let runs = ensemble::run_members(&members, Model::Reference, false, &|| {}).unwrap();
+    let runs = ensemble::run_members(&members, Model::Reference, Limits::NONE, false, &|| {}).unwrap();
     assert!(members.columns.is_empty());
     assert_eq!(runs.metrics, vec![single; 3]);
 }

@@ -7,7 +7,7 @@
 //! touching pairs itself, one pair at a time as Eq. 9-10 and the reference say.
 
 use approx::assert_relative_eq;
-use lpc_damper::model::RunOptions;
+use lpc_damper::model::{Limits, RunOptions};
 use lpc_damper::scene::{ball_radius, Ball, BallKind, Frame};
 use lpc_damper::Model;
 
@@ -89,8 +89,8 @@ fn forced_single_ball_damper_matches_the_reference_in_steady_state() {
     let scene = common::scene_from_toml(&text.replace("arrangement = \"LSL\"", "arrangement = \"L\""));
     for f in [3.0, 4.4] {
         let s = lpc_damper::studies::frf::forced_at(&scene, f);
-        let (reference, _) = lpc_damper::studies::frf::steady_run(&s, Model::Reference).unwrap();
-        let (rapier, _) = lpc_damper::studies::frf::steady_run(&s, Model::Rapier).unwrap();
+        let (reference, _) = lpc_damper::studies::frf::steady_run(&s, Model::Reference, Limits::NONE).unwrap();
+        let (rapier, _) = lpc_damper::studies::frf::steady_run(&s, Model::Rapier, Limits::NONE).unwrap();
         assert!(reference.steady && rapier.steady, "{f} Hz: {reference:?} {rapier:?}");
         assert_eq!(reference.impacts_per_period, rapier.impacts_per_period, "{f} Hz");
         assert!((rapier.amplitude / reference.amplitude - 1.0).abs() <= 1e-2, "{f} Hz: {reference:?} {rapier:?}");

@@ -3,7 +3,7 @@
 //! solved plastically: a small ball between two large ones stuck to one of them. The plug-in
 //! now applies the bounce Rapier skipped; the chain experiment must match the reference.
 
-use lpc_damper::model::RunOptions;
+use lpc_damper::model::{Limits, RunOptions};
 use lpc_damper::scene::{load, scenes_dir};
 use lpc_damper::studies::chain::{ker, run_chain};
 use lpc_damper::Model;
@@ -11,8 +11,8 @@ use lpc_damper::Model;
 #[test]
 fn chain_with_small_balls_matches_the_reference_ker() {
     let cases = load(scenes_dir().join("chain-ker.toml")).unwrap().chain.unwrap();
-    let reference = run_chain(&cases, Model::Reference, &|| {}).unwrap();
-    let rapier = run_chain(&cases, Model::Rapier, &|| {}).unwrap();
+    let reference = run_chain(&cases, Model::Reference, Limits::NONE, &|| {}).unwrap();
+    let rapier = run_chain(&cases, Model::Rapier, Limits::NONE, &|| {}).unwrap();
     for (r, a) in reference.iter().zip(&rapier) {
         // f32 velocities and one-impact-per-step resolution: KER within 0.01 (the plastic
         // failure loses tens of per cent).

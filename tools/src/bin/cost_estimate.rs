@@ -4,7 +4,7 @@
 //! when, against what the run took.
 //!
 //! `cargo run --release -p lpc-tools --bin cost_estimate -- examples/scenes/packed-column.toml 31338 80056 ...`
-use lpc_damper::model::{cost, Model, Progress, RunOptions};
+use lpc_damper::model::{cost, Limits, Model, Progress, RunOptions};
 use lpc_damper::run::Record;
 
 fn main() {
@@ -22,8 +22,11 @@ fn main() {
         let done = std::sync::atomic::AtomicBool::new(false);
         let mut said = Vec::new();
         let start = std::time::Instant::now();
-        let options =
-            RunOptions { record: Record::MetricsOnly, max_wall_s: Some(60.0), progress: Some(&progress), ..RunOptions::default() };
+        let options = RunOptions {
+            record: Record::MetricsOnly,
+            limits: Limits { max_wall_s: Some(60.0), ..Limits::NONE },
+            progress: Some(&progress),
+        };
         let run = std::thread::scope(|s| {
             let watcher = s.spawn(|| {
                 let mut said = Vec::new();

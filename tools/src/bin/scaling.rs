@@ -3,7 +3,7 @@
 
 use std::time::Instant;
 
-use lpc_damper::model::{Model, RunOptions};
+use lpc_damper::model::{Limits, Model, RunOptions};
 use lpc_damper::scene::{load, load_scene, scenes_dir, Arrangement, Length};
 use lpc_damper::studies::sweep::{run_sweep, sweep_scenes};
 
@@ -56,7 +56,7 @@ fn main() {
         let scenes = sweep_scenes(&loaded).unwrap();
         for &model in models {
             let start = Instant::now();
-            run_sweep("gap", &scenes, model, &|| {}).unwrap();
+            run_sweep("gap", &scenes, model, Limits::NONE, &|| {}).unwrap();
             let wall = start.elapsed().as_secs_f64();
             println!("| {values} | {} | {wall:.3} | {:.1} |", model.name(), values as f64 / wall);
         }

@@ -6,7 +6,7 @@ use lpc_damper::scene;
 use lpc_damper::studies::chain::{run_chain, KerRow};
 use lpc_damper::Model;
 
-use crate::args::{invalid, override_scene, print_json, Format, ModelArgs};
+use crate::args::{invalid, override_scene, print_json, BudgetArgs, Format, ModelArgs};
 use crate::exit::{ExitStatus, Result};
 use crate::table::{right, Table};
 
@@ -22,10 +22,13 @@ pub struct Args {
     format: Format,
     #[command(flatten)]
     settings: ModelArgs,
+    #[command(flatten)]
+    budget: BudgetArgs,
 }
 
 pub fn run(a: Args) -> Result<ExitStatus> {
     let path = a.scene.unwrap_or_else(|| PathBuf::from("scenes/chain-ker.toml"));
+    let limits = a.budget.limits(&path)?;
     let loaded = scene::load(&path)?;
     let mut cases =
         loaded.chain.ok_or_else(|| invalid(&path, "chain", "is missing: `lpc chain` needs a scene file with a [chain] table"))?;
@@ -33,7 +36,7 @@ pub fn run(a: Args) -> Result<ExitStatus> {
         override_scene(&mut c.scene, a.settings.overrides(None, None), &path)?;
     }
     let work = crate::watch::Work::new(Some(cases.len()), "chain");
-    let rows: Vec<KerRow> = run_chain(&cases, a.model, &|| work.inc())?;
+    let rows: Vec<KerRow> = run_chain(&cases, a.model, limits, &|| work.inc())?;
     work.finish();
     match a.format {
         Format::Json => print_json(&rows)?,

@@ -14,7 +14,7 @@ use lpc_damper::Model;
 use lpc_damper::metrics::Metric;
 use lpc_damper::studies::ensemble::{self, Agreement, Ensemble, Stats};
 
-use crate::args::{load_nominal, print_json, EnsembleArgs, Format, ModelArgs};
+use crate::args::{load_nominal, print_json, BudgetArgs, EnsembleArgs, Format, ModelArgs};
 use crate::exit::{ExitStatus, Result};
 use crate::table::{left, right, statistic, Table};
 
@@ -30,6 +30,8 @@ pub struct Args {
     horizon: Option<f64>,
     #[command(flatten)]
     settings: ModelArgs,
+    #[command(flatten)]
+    budget: BudgetArgs,
     /// Output format on standard output.
     #[arg(long, value_enum, default_value_t = Format::Text)]
     format: Format,
@@ -56,16 +58,17 @@ struct Comparison {
 }
 
 pub fn run(a: Args) -> Result<ExitStatus> {
+    let limits = a.budget.limits(&a.scene)?;
     let nominal = load_nominal(&a.scene, a.settings.overrides(a.horizon, None))?;
     if let Some(members) = nominal.ensemble(a.ensemble)? {
         return compare_ensembles(&a, &nominal.scene.name, &members);
     }
     let scene = nominal.scene;
-    let reference = crate::watch::watched(Model::Reference, &scene, RunOptions::default(), None)?;
+    let reference = crate::watch::watched(Model::Reference, &scene, RunOptions::limited(limits), None)?;
     let mut models = std::collections::BTreeMap::new();
     let mut runs = vec![];
     for &m in a.models.iter().filter(|m| **m != Model::Reference) {
-        let run = crate::watch::watched(m, &scene, RunOptions::default(), None)?;
+        let run = crate::watch::watched(m, &scene, RunOptions::limited(limits), None)?;
         models.insert(m.name().to_string(), ModelComparison { summary: RunSummary::of(&run), errors: errors(&run, &reference) });
         runs.push(run);
     }
@@ -152,7 +155,7 @@ fn compare_ensembles(a: &Args, scene: &str, members: &Ensemble) -> Result<ExitSt
     for &m in std::iter::once(&Model::Reference).chain(a.models.iter().filter(|m| **m != Model::Reference)) {
         let work = crate::watch::Work::new(Some(members.members.len()), m.name());
         let start = std::time::Instant::now();
-        let r = ensemble::run_members(members, m, false, &|| work.inc())?;
+        let r = ensemble::run_members(members, m, a.budget.limits(&a.scene)?, false, &|| work.inc())?;
         work.finish();
         runs.insert(m, (r.metrics, start.elapsed().as_secs_f64()));
     }

@@ -9,7 +9,7 @@ use lpc_damper::files::write_atomic;
 use lpc_damper::scene::{self, Overrides};
 use lpc_damper::Model;
 
-use crate::args::{invalid, load_nominal, parse_range, print_json, EnsembleArgs, Format, ModelArgs};
+use crate::args::{invalid, load_nominal, parse_range, print_json, BudgetArgs, EnsembleArgs, Format, ModelArgs};
 use crate::exit::{CommandError, ExitStatus, Result};
 use crate::table::{right, Table};
 
@@ -42,6 +42,8 @@ pub struct Args {
     #[command(flatten)]
     settings: ModelArgs,
     #[command(flatten)]
+    budget: BudgetArgs,
+    #[command(flatten)]
     ensemble: EnsembleArgs,
 }
 
@@ -52,6 +54,7 @@ enum ForcingKindArg {
 }
 
 pub fn run(a: Args) -> Result<ExitStatus> {
+    let limits = a.budget.limits(&a.scene)?;
     let nominal = load_nominal(&a.scene, a.settings.overrides(None, None))?;
     let scene = nominal.scene.clone();
     let (from, to) = parse_range(&a.freq, &a.scene, "--freq")?;
@@ -91,7 +94,7 @@ pub fn run(a: Args) -> Result<ExitStatus> {
     }
     let work = crate::watch::Work::new(Some(2 * freqs.len()), "frf");
     let start = std::time::Instant::now();
-    let points = lpc_damper::studies::frf::frf(&scene, &freqs, a.model, &|| work.inc());
+    let points = lpc_damper::studies::frf::frf(&scene, &freqs, a.model, limits, &|| work.inc());
     work.finish();
     let elapsed = start.elapsed().as_secs_f64();
     if let Some(dir) = &a.out {
@@ -159,7 +162,7 @@ pub fn run(a: Args) -> Result<ExitStatus> {
 fn frf_ensemble(a: &Args, scene: &scene::Scene, members: &lpc_damper::studies::ensemble::Ensemble, freqs: &[f64]) -> Result<ExitStatus> {
     let work = crate::watch::Work::new(Some(2 * freqs.len() * members.members.len()), "frf");
     let start = std::time::Instant::now();
-    let bands = lpc_damper::studies::frf::frf_ensemble(&members.members, freqs, a.model, &|| work.inc());
+    let bands = lpc_damper::studies::frf::frf_ensemble(&members.members, freqs, a.model, a.budget.limits(&a.scene)?, &|| work.inc());
     work.finish();
     let elapsed = start.elapsed().as_secs_f64();
     if let Some(dir) = &a.out {

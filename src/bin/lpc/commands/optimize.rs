@@ -8,7 +8,7 @@ use clap::ValueEnum;
 use lpc_damper::scene;
 use lpc_damper::Model;
 
-use crate::args::{invalid, parse_range, print_json, quantile_arg, EnsembleArgs, Format};
+use crate::args::{invalid, parse_range, print_json, quantile_arg, BudgetArgs, EnsembleArgs, Format};
 use crate::exit::{ExitStatus, Result};
 use crate::table::{left, right, Table};
 
@@ -48,6 +48,8 @@ pub struct Args {
     format: Format,
     #[command(flatten)]
     ensemble: EnsembleArgs,
+    #[command(flatten)]
+    budget: BudgetArgs,
     /// With --ensemble: rank designs by this quantile of their members' objectives (default
     /// 0.5, the median; 0.9 asks for a design that is good on nine dampers out of ten).
     #[arg(long, requires = "ensemble")]
@@ -62,6 +64,7 @@ enum ObjectiveArg {
 
 pub fn run(a: Args) -> Result<ExitStatus> {
     use lpc_damper::studies::optimize::{optimize, Judging, Objective};
+    let limits = a.budget.limits(&a.scene)?;
     let loaded = scene::load(&a.scene)?;
     let invalid = |field: &str, rule: String| invalid(&a.scene, field, rule);
     let Some(base) = loaded.scene.clone() else {
@@ -112,7 +115,7 @@ pub fn run(a: Args) -> Result<ExitStatus> {
         &axes,
         &arrangements,
         length,
-        Judging { objective, model: a.model, refinements: a.refinements, robust },
+        Judging { objective, model: a.model, limits, refinements: a.refinements, robust },
         &|| work.inc(),
     )?;
     work.finish();

@@ -7,7 +7,7 @@ use lpc_damper::scene;
 use lpc_damper::studies::chain::run_chain;
 use lpc_damper::Model;
 
-use crate::args::{invalid, override_scene, parse_size, ModelArgs};
+use crate::args::{invalid, override_scene, parse_size, BudgetArgs, ModelArgs};
 use crate::exit::{ExitStatus, Result};
 
 #[derive(clap::Args)]
@@ -27,10 +27,13 @@ pub struct Args {
     size: (u32, u32),
     #[command(flatten)]
     settings: ModelArgs,
+    #[command(flatten)]
+    budget: BudgetArgs,
 }
 
 pub fn run(a: Args) -> Result<ExitStatus> {
     use lpc_damper::output::figures::{self, Figure};
+    let limits = a.budget.limits(&a.input)?;
     let mut figs: Vec<Figure> = vec![];
     if a.input.is_dir() {
         let series = |dir: &Path| dir.join("series.csv");
@@ -79,7 +82,7 @@ pub fn run(a: Args) -> Result<ExitStatus> {
             for c in &mut cases {
                 override_scene(&mut c.scene, a.settings.overrides(None, None), &a.input)?;
             }
-            figs.push(figures::ker_chart(&run_chain(&cases, a.model, &|| {})?, a.model.name()));
+            figs.push(figures::ker_chart(&run_chain(&cases, a.model, limits, &|| {})?, a.model.name()));
         } else if loaded.file.sweep.is_some() {
             use rayon::prelude::*;
             let mut scenes = lpc_damper::studies::sweep::sweep_scenes(&loaded)?;
@@ -93,7 +96,7 @@ pub fn run(a: Args) -> Result<ExitStatus> {
                 .par_iter()
                 .zip(values)
                 .map(|((_, s), label)| {
-                    let run = a.model.simulate(s, &RunOptions::default());
+                    let run = a.model.simulate(s, &RunOptions::limited(limits));
                     work.inc();
                     Ok((label, run?))
                 })
@@ -103,8 +106,8 @@ pub fn run(a: Args) -> Result<ExitStatus> {
         } else {
             let mut s = loaded.scene.clone().expect("a scene file without [chain] has [frame]");
             override_scene(&mut s, a.settings.overrides(None, None), &a.input)?;
-            let run = crate::watch::watched(a.model, &s, RunOptions::default(), None)?;
-            let bare = crate::watch::watched(lpc_damper::Model::Reference, &s.without_damper(), RunOptions::default(), None)?;
+            let run = crate::watch::watched(a.model, &s, RunOptions::limited(limits), None)?;
+            let bare = crate::watch::watched(lpc_damper::Model::Reference, &s.without_damper(), RunOptions::limited(limits), None)?;
             figs.extend(figures::time_histories(&run, (!s.balls.is_empty()).then_some(&bare)));
             if !s.balls.is_empty() {
                 figs.push(figures::ball_positions(&run, s.container.map(|c| c.length)));

@@ -9,7 +9,7 @@ use lpc_damper::output::write_run_dir;
 use lpc_damper::scene::{Overrides, Scene};
 use lpc_damper::Model;
 
-use crate::args::{invalid, load_scene, parse_size, ModelArgs};
+use crate::args::{invalid, load_scene, parse_size, BudgetArgs, ModelArgs};
 use crate::exit::{CommandError, ExitStatus, Result};
 
 #[derive(clap::Args)]
@@ -33,6 +33,8 @@ pub struct Args {
     model: Model,
     #[command(flatten)]
     settings: ModelArgs,
+    #[command(flatten)]
+    budget: BudgetArgs,
 }
 
 pub fn run(a: Args) -> Result<ExitStatus> {
@@ -49,7 +51,7 @@ pub fn run(a: Args) -> Result<ExitStatus> {
     let (sample_dt, per_frame) = lpc_damper::run::frame_sampling(a.fps, s.sample_dt);
     let timing = Overrides { horizon: a.horizon, sample_dt: Some(sample_dt), ..Overrides::default() };
     let s = timing.apply(s, &a.scene.display().to_string())?;
-    let run = crate::watch::watched(a.model, &s, RunOptions::default(), None)?;
+    let run = crate::watch::watched(a.model, &s, RunOptions::limited(a.budget.limits(&a.scene)?), None)?;
     write_run_dir(&run, &a.out).with_context(|| format!("writing outputs to {}", a.out.display()))?;
     render_run(&s, &run, &a, per_frame)?;
     Ok(ExitStatus::Success)

@@ -15,7 +15,7 @@ use lpc_damper::output::{table_csv, text_summary, write_run_dir};
 use lpc_damper::studies::ensemble::{self, Ensemble, EnsembleSummary, ShardInfo};
 use lpc_damper::Model;
 
-use crate::args::{load_nominal, parse_shard, print_json, EnsembleArgs, Format, ModelArgs};
+use crate::args::{load_nominal, parse_shard, print_json, BudgetArgs, EnsembleArgs, Format, ModelArgs};
 use crate::exit::{ExitStatus, Result};
 use crate::table::{left, right, statistic, Table};
 
@@ -34,6 +34,8 @@ pub struct Args {
     sample_dt: Option<f64>,
     #[command(flatten)]
     settings: ModelArgs,
+    #[command(flatten)]
+    budget: BudgetArgs,
     /// Write series.csv, impacts.csv and summary.json into this directory.
     #[arg(long)]
     out: Option<PathBuf>,
@@ -47,16 +49,10 @@ pub struct Args {
     /// members.csv, members.parquet and shard.json, which `lpc merge` joins.
     #[arg(long, value_name = "I/K", requires = "ensemble", value_parser = parse_shard)]
     shard: Option<(usize, usize)>,
-    /// Stop after this many steps (the reference: events; the compliant model stops at 5e7
-    /// without one), keeping the run so far (written with --out) and saying what its steps cost.
-    #[arg(long, value_name = "N")]
-    max_steps: Option<u64>,
-    /// Stop after this many seconds of computing, likewise.
-    #[arg(long, value_name = "S")]
-    max_wall_time: Option<f64>,
 }
 
 pub fn run(a: Args) -> Result<ExitStatus> {
+    let limits = a.budget.limits(&a.scene)?;
     let nominal = load_nominal(&a.scene, a.settings.overrides(a.horizon, a.sample_dt))?;
     if let Some(shard) = a.shard {
         let members = nominal.ensemble_shard(a.ensemble, shard)?.expect("--shard requires --ensemble");
@@ -75,9 +71,7 @@ pub fn run(a: Args) -> Result<ExitStatus> {
             lpc_damper::scene::human(scene.sample_dt * every as f64)
         );
     }
-    let options = RunOptions { max_steps: a.max_steps, max_wall_s: a.max_wall_time, ..RunOptions::default() };
-    options.check_budgets().map_err(|(budget, rule)| crate::args::invalid(&a.scene, budget.flag(), rule))?;
-    let run = crate::watch::watched(a.model, &scene, options, a.out.as_deref())?;
+    let run = crate::watch::watched(a.model, &scene, RunOptions::limited(limits), a.out.as_deref())?;
     let summary = RunSummary::of(&run);
     if let Some(dir) = &a.out {
         write_run_dir(&run, dir).with_context(|| format!("writing outputs to {}", dir.display()))?;
@@ -97,7 +91,7 @@ pub fn run(a: Args) -> Result<ExitStatus> {
 fn run_ensemble(a: &Args, nominal: &lpc_damper::scene::Scene, members: &Ensemble) -> Result<ExitStatus> {
     let work = crate::watch::Work::new(Some(members.members.len()), "ensemble");
     let start = std::time::Instant::now();
-    let runs = ensemble::run_members(members, a.model, a.out.is_some(), &|| work.inc())?;
+    let runs = ensemble::run_members(members, a.model, a.budget.limits(&a.scene)?, a.out.is_some(), &|| work.inc())?;
     let wall_time_s = start.elapsed().as_secs_f64();
     work.finish();
     let summary = EnsembleSummary::of(&nominal.name, a.model, members, &runs.metrics, wall_time_s);
@@ -116,7 +110,7 @@ fn run_ensemble(a: &Args, nominal: &lpc_damper::scene::Scene, members: &Ensemble
 fn run_shard(a: &Args, nominal: &lpc_damper::scene::Scene, members: &Ensemble, (shard, shards): (usize, usize)) -> Result<ExitStatus> {
     let work = crate::watch::Work::new(Some(members.members.len()), "shard");
     let start = std::time::Instant::now();
-    let runs = ensemble::run_members(members, a.model, false, &|| work.inc())?;
+    let runs = ensemble::run_members(members, a.model, a.budget.limits(&a.scene)?, false, &|| work.inc())?;
     let wall_time_s = start.elapsed().as_secs_f64();
     work.finish();
     let first = members.members.first().map_or(0, |m| m.index);

@@ -44,8 +44,8 @@ pub struct Args {
 }
 
 pub fn run(a: Args) -> Result<ExitStatus> {
-    let budget = lpc_damper::model::RunOptions { max_wall_s: a.max_wall_time, ..Default::default() };
-    budget.check_budgets().map_err(|(_, rule)| lpc_damper::scene::SceneError::Invalid {
+    let budget = lpc_damper::model::Limits { max_wall_s: a.max_wall_time, ..lpc_damper::model::Limits::NONE };
+    budget.check().map_err(|(_, rule)| lpc_damper::scene::SceneError::Invalid {
         file: "(command line)".into(),
         field: "--max-wall-time".into(),
         rule,

@@ -13,7 +13,7 @@ use lpc_damper::Model;
 use lpc_damper::studies::ensemble;
 use lpc_damper::studies::sweep::{Axis, Coordinates, EnsemblePoint, GridScene, SweepPoint};
 
-use crate::args::{invalid, override_scene, print_json, quantile_arg, EnsembleArgs, Format, ModelArgs, Nominal};
+use crate::args::{invalid, override_scene, print_json, quantile_arg, BudgetArgs, EnsembleArgs, Format, ModelArgs, Nominal};
 use crate::exit::{ExitStatus, Result};
 use crate::table::{right, statistic, Table};
 
@@ -48,6 +48,8 @@ pub struct Args {
     #[command(flatten)]
     settings: ModelArgs,
     #[command(flatten)]
+    budget: BudgetArgs,
+    #[command(flatten)]
     ensemble: EnsembleArgs,
     /// With --ensemble: the quantile of each cell's distribution that the map shows (default
     /// 0.5, the median).
@@ -56,6 +58,7 @@ pub struct Args {
 }
 
 pub fn run(a: Args) -> Result<ExitStatus> {
+    let limits = a.budget.limits(&a.scene)?;
     let loaded = scene::load(&a.scene)?;
     let invalid = |field: &str, rule: String| invalid(&a.scene, field, rule);
     let mut axes = match &a.x {
@@ -83,7 +86,7 @@ pub fn run(a: Args) -> Result<ExitStatus> {
     let parameter = parameters.join(" x ");
     let work = crate::watch::Work::new(Some(grid.len()), "sweep");
     let start = std::time::Instant::now();
-    let points = lpc_damper::studies::sweep::run_grid(&parameters, &grid, a.model, &|| work.inc())?;
+    let points = lpc_damper::studies::sweep::run_grid(&parameters, &grid, a.model, limits, &|| work.inc())?;
     work.finish();
     let elapsed = start.elapsed().as_secs_f64();
     if let Some(dir) = &a.out {
@@ -193,7 +196,7 @@ fn sweep_ensembles(a: &Args, nominal: &Nominal, axes: &[Axis], parameters: &[Str
     let mut points = vec![];
     for g in grid {
         let Some(members) = nominal.ensemble_of(a.ensemble, &g.file, &g.scene)? else { continue };
-        let runs = ensemble::run_members(&members, a.model, false, &|| work.inc())?;
+        let runs = ensemble::run_members(&members, a.model, a.budget.limits(&a.scene)?, false, &|| work.inc())?;
         points.push(EnsemblePoint {
             at: Coordinates::of(parameters, &g.values),
             members: members.members.len(),

@@ -5,7 +5,7 @@ use std::path::PathBuf;
 use lpc_damper::model::RunOptions;
 use lpc_damper::Model;
 
-use crate::args::{load_scene, ModelArgs};
+use crate::args::{load_scene, BudgetArgs, ModelArgs};
 use crate::exit::{CommandError, ExitStatus, Result};
 
 #[derive(clap::Args)]
@@ -20,6 +20,8 @@ pub struct Args {
     horizon: Option<f64>,
     #[command(flatten)]
     settings: ModelArgs,
+    #[command(flatten)]
+    budget: BudgetArgs,
 }
 
 pub fn run(a: Args) -> Result<ExitStatus> {
@@ -35,7 +37,7 @@ pub fn run(a: Args) -> Result<ExitStatus> {
         )));
     }
     let s = load_scene(&a.scene, a.settings.overrides(a.horizon, None))?;
-    let run = crate::watch::watched(a.model, &s, RunOptions::default(), None)?;
+    let run = crate::watch::watched(a.model, &s, RunOptions::limited(a.budget.limits(&a.scene)?), None)?;
     #[cfg(feature = "render")]
     lpc_damper::render::window::view(&s, run);
     #[cfg(not(feature = "render"))]
