@@ -1,8 +1,9 @@
 //! The compliant system's Jacobian and the linear solve of a Rosenbrock stage,
 //! `(I / (h gamma) - J) u = r`, in O(n).
 //!
-//! Contacts couple neighbours only: ball `i` with ball `i + 1`, and the end balls with the
-//! frame through the walls. Eliminating the position increments (`u_x = h gamma (r_x + u_v)`)
+//! Contacts couple neighbours only: ball `i` with ball `i + 1` of its chain, and each chain's
+//! end balls with the frame through the walls (between chains the coupling is zero, so the
+//! tridiagonal part is block tridiagonal, one block per chain). Eliminating the position increments (`u_x = h gamma (r_x + u_v)`)
 //! leaves one equation per body for the velocity increments, whose matrix, each row times its
 //! body's mass, is `m / (h gamma) + sum over the body's contacts of w` on the diagonal and `-w`
 //! between the two bodies of a contact, with `w = h gamma dF/dd + dF/dd'` (never negative: a
@@ -241,7 +242,7 @@ impl System<'_> {
             Side::Ball(i) => (r[self.x(i)], r[self.v(i)]),
             Side::Wall(_) => (r[XS], r[VS]),
         };
-        for p in 0..=n {
+        for p in 0..self.slots.count() {
             r[self.dissipation(p)] *= hg;
         }
         for (pair, p) in self.pairs.iter().zip(&stage.partials) {

@@ -58,7 +58,7 @@ impl Simulator for Compliant {
         if !(tolerance > 0.0 && tolerance <= 1e-2) {
             return Err(format!("its error tolerance must lie in (0, 1e-2] (got {})", crate::scene::human(tolerance)));
         }
-        Ok(())
+        scene.space.beyond_lines(&scene.initial_positions).map_or(Ok(()), Err)
     }
 
     fn simulate(&self, scene: &Scene, options: &RunOptions) -> Result<Run, ModelError> {

@@ -87,7 +87,7 @@ impl Driver<'_, '_> {
             }
         }
         self.impacts.sort_by(|a, b| a.t.total_cmp(&b.t).then(a.a.cmp(&b.a)));
-        let impact_loss: f64 = (0..=sys.n).map(|p| self.y[sys.dissipation(p)]).sum();
+        let impact_loss: f64 = (0..sys.slots.count()).map(|p| self.y[sys.dissipation(p)]).sum();
         let energy = EnergyAccount::forced(
             initial,
             sys.energy(self.t, &self.y),

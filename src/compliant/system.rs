@@ -4,7 +4,7 @@
 
 use super::contact;
 use super::FLOOR_SPEED_FRACTION;
-use crate::scene::{Body, Scene};
+use crate::scene::{Body, Pairs, Scene};
 
 /// One side of a pair.
 #[derive(Debug, Clone, Copy)]
@@ -18,7 +18,7 @@ pub(super) enum Side {
 /// Two neighbouring bodies that can touch.
 #[derive(Debug, Clone, Copy)]
 pub(super) struct Pair {
-    /// Pair number as the reference counts it: between body `p - 1` and body `p`.
+    /// Pair number as the scene counts it ([`Pairs`]).
     pub(super) p: usize,
     pub(super) left: Side,
     pub(super) right: Side,
@@ -42,6 +42,8 @@ pub(super) struct System<'a> {
     pub(super) mass: Vec<f64>,
     pub(super) radius: Vec<f64>,
     pub(super) pairs: Vec<Pair>,
+    /// The scene's pairs of neighbours, numbered on its chains.
+    pub(super) slots: Pairs,
     /// `c = alpha v0` giving the scene's restitution.
     pub(super) c: f64,
     /// Overlap rates below this set the damping as if they were this (resting contacts).
@@ -72,9 +74,11 @@ impl<'a> System<'a> {
         let v_scale = scene.speed_scale();
         let mut pairs = Vec::new();
         let walls = scene.container.map(|c| c.length);
-        for p in crate::scene::pair_range(n, walls.is_some()) {
-            let left = if p == 0 { Side::Wall(0.0) } else { Side::Ball(p - 1) };
-            let right = if p == n { Side::Wall(walls.unwrap_or(0.0)) } else { Side::Ball(p) };
+        let slots = Pairs::new(n, &scene.space.chain_starts, walls.is_some());
+        for p in slots.range() {
+            let (left, right) = slots.balls(p);
+            let left = left.map_or(Side::Wall(0.0), Side::Ball);
+            let right = right.map_or(Side::Wall(walls.unwrap_or(0.0)), Side::Ball);
             let (r_star, m_star) = match (left, right) {
                 (Side::Ball(i), Side::Ball(j)) => {
                     (contact::effective_radius(radius[i], Some(radius[j])), mass[i] * mass[j] / (mass[i] + mass[j]))
@@ -112,6 +116,7 @@ impl<'a> System<'a> {
             mass,
             radius,
             pairs,
+            slots,
             c: contact::damping_for(scene.restitution),
             v_floor: FLOOR_SPEED_FRACTION * v_scale,
             v_scale,
@@ -122,7 +127,7 @@ impl<'a> System<'a> {
     }
 
     pub(super) fn len(&self) -> usize {
-        4 + 2 * self.n + (self.n + 1)
+        4 + 2 * self.n + self.slots.count()
     }
     pub(super) fn x(&self, i: usize) -> usize {
         2 + i
@@ -222,6 +227,6 @@ impl<'a> System<'a> {
     }
 
     pub(super) fn bodies(&self, pair: &Pair) -> (Body, Body) {
-        crate::scene::pair_bodies(pair.p, self.n)
+        self.slots.bodies(pair.p)
     }
 }

@@ -222,6 +222,7 @@ mod tests {
             container: Some(Container { length: x + 0.01, gap: 0.0, clearance: 0.01 }),
             initial_velocities: vec![0.0; balls.len()],
             reference_radius: balls[0].radius,
+            space: crate::scene::Space::line(balls.len()),
             balls,
             restitution: e,
             initial_displacement: 0.0,

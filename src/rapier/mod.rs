@@ -55,8 +55,14 @@ impl Simulator for Rapier {
         Model::Rapier
     }
 
-    fn supports(&self, _scene: &Scene) -> Result<(), String> {
-        Ok(())
+    fn supports(&self, scene: &Scene) -> Result<(), String> {
+        if scene.space.chains() > 1 {
+            return Err(format!(
+                "the scene has {} chains; this model moves one chain of balls along the container's axis",
+                scene.space.chains()
+            ));
+        }
+        scene.space.beyond_lines(&scene.initial_positions).map_or(Ok(()), Err)
     }
 
     fn simulate(&self, scene: &Scene, options: &RunOptions) -> Result<Run, ModelError> {

@@ -2,7 +2,7 @@
 //! which the frame holds (and where on it). The gap of each pair of neighbours follows from them
 //! alone, as a function of time ([`Gap`]).
 
-use crate::scene::Scene;
+use crate::scene::{Pairs, Scene};
 
 /// Which wall a stuck ball is held by.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -10,6 +10,8 @@ pub(super) enum Hold {
     Free,
     Left,
     Right,
+    /// Its chain is packed wall to wall: it moves with the frame for good.
+    Packed,
 }
 
 /// The gap of a pair as a function of time.
@@ -41,8 +43,12 @@ pub(super) struct Balls {
     pub(super) hold: Vec<Hold>,
     /// A held ball's centre less the frame's position.
     pub(super) offset: Vec<f64>,
-    /// The container is packed wall to wall: it moves as one body for good.
+    /// No held ball can be released: every held ball's chain is packed wall to wall.
     pub(super) packed: bool,
+    /// The balls of each chain.
+    pub(super) chains: Vec<std::ops::Range<usize>>,
+    /// The pairs of neighbours on the scene's chains.
+    pub(super) pairs: Pairs,
 }
 
 impl Balls {
@@ -60,13 +66,14 @@ impl Balls {
             hold: vec![Hold::Free; n],
             offset: vec![0.0; n],
             packed: false,
+            chains: (0..scene.space.chains()).map(|k| scene.space.chain(k, n)).collect(),
+            pairs: Pairs::new(n, &scene.space.chain_starts, scene.container.is_some()),
         }
     }
 
-    /// Pairs that can touch: `p` lies between body `p - 1` and body `p` (body `-1` is the left
-    /// wall, body `n` the right wall).
+    /// Pairs that can touch (see [`Pairs`]).
     pub(super) fn pair_range(&self) -> std::ops::Range<usize> {
-        crate::scene::pair_range(self.n, self.walls)
+        self.pairs.range()
     }
 
     /// Moves the free balls on by `dt`, counting the rounding each step adds to their positions.
@@ -86,8 +93,9 @@ impl Balls {
     /// [`Balls::gap`]'s kind without its arithmetic.
     #[inline]
     pub(super) fn is_frame_pair(&self, p: usize) -> bool {
-        let left_frame = p == 0 || self.hold[p - 1] != Hold::Free;
-        let right_frame = p == self.n || self.hold[p] != Hold::Free;
+        let (left, right) = self.pairs.balls(p);
+        let left_frame = left.is_none_or(|i| self.hold[i] != Hold::Free);
+        let right_frame = right.is_none_or(|j| self.hold[j] != Hold::Free);
         left_frame != right_frame
     }
 
@@ -96,32 +104,34 @@ impl Balls {
     pub(super) fn gap(&self, p: usize) -> Gap {
         // The left body's right edge and the right body's left edge: a free ball's, or the
         // frame's (a wall, or a ball the frame holds, at an offset from `xs`).
-        let left_free = p >= 1 && self.hold[p - 1] == Hold::Free;
-        let right_free = p < self.n && self.hold[p] == Hold::Free;
+        let (left, right) = self.pairs.balls(p);
+        let left_free = left.filter(|&i| self.hold[i] == Hold::Free);
+        let right_free = right.filter(|&j| self.hold[j] == Hold::Free);
         match (left_free, right_free) {
-            (true, true) => {
-                let (i, j) = (p - 1, p);
+            (Some(i), Some(j)) => {
                 Gap::Linear { g: (self.x[j] - self.radius[j]) - (self.x[i] + self.radius[i]), rate: self.v[j] - self.v[i] }
             }
-            (false, true) => {
-                let c = if p == 0 { 0.0 } else { self.offset[p - 1] + self.radius[p - 1] };
-                Gap::Frame { ball: p, s: 1.0, k: -self.radius[p] - c }
+            (None, Some(j)) => {
+                let c = left.map_or(0.0, |i| self.offset[i] + self.radius[i]);
+                Gap::Frame { ball: j, s: 1.0, k: -self.radius[j] - c }
             }
-            (true, false) => {
-                let c = if p == self.n { self.length } else { self.offset[p] - self.radius[p] };
-                Gap::Frame { ball: p - 1, s: -1.0, k: c - self.radius[p - 1] }
+            (Some(i), None) => {
+                let c = right.map_or(self.length, |j| self.offset[j] - self.radius[j]);
+                Gap::Frame { ball: i, s: -1.0, k: c - self.radius[i] }
             }
-            (false, false) => Gap::Fixed,
+            (None, None) => Gap::Fixed,
         }
     }
 
-    /// Whether the body left of pair `p` is a free ball.
-    pub(super) fn left_body_free(&self, p: usize) -> bool {
-        p >= 1 && self.hold[p - 1] == Hold::Free
+    /// The free ball left of pair `p`, if the body there is one.
+    #[inline]
+    pub(super) fn left_free_ball(&self, p: usize) -> Option<usize> {
+        self.pairs.balls(p).0.filter(|&i| self.hold[i] == Hold::Free)
     }
 
-    /// Whether the body right of pair `p` is a free ball.
-    pub(super) fn right_body_free(&self, p: usize) -> bool {
-        p < self.n && self.hold[p] == Hold::Free
+    /// The free ball right of pair `p`, if the body there is one.
+    #[inline]
+    pub(super) fn right_free_ball(&self, p: usize) -> Option<usize> {
+        self.pairs.balls(p).1.filter(|&j| self.hold[j] == Hold::Free)
     }
 }

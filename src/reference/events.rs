@@ -17,11 +17,11 @@ pub(super) struct Ledger {
 }
 
 impl Ledger {
-    pub(super) fn new(n: usize) -> Self {
+    pub(super) fn new(pairs: usize) -> Self {
         Ledger {
             // Room for a paper scene's impacts: growing a vector of them copies it each time.
             impacts: Vec::with_capacity(IMPACTS_RESERVED),
-            last_impact: vec![None; n + 1],
+            last_impact: vec![None; pairs],
             impact_loss: 0.0,
             damping_loss: 0.0,
             forcing_work: 0.0,
@@ -56,7 +56,7 @@ impl Solver<'_> {
     }
 
     pub(super) fn touch_ball(&mut self, i: usize) {
-        self.search.touch_ball(i);
+        self.search.touch_pairs_from(self.balls.pairs.left_of(i));
     }
 
     pub(super) fn record(&mut self, p: usize, approach_speed: f64, energy_lost: f64, impulses: u32) {
@@ -90,7 +90,7 @@ impl Solver<'_> {
         match self.balls.gap(p) {
             Gap::Fixed => {}
             Gap::Linear { .. } => {
-                let (i, j) = (p - 1, p);
+                let (Some(i), Some(j)) = self.balls.pairs.balls(p) else { unreachable!("a linear gap is between two balls") };
                 let (vi, vj, lost) = impact_law(self.balls.mass[i], self.balls.v[i], self.balls.mass[j], self.balls.v[j], self.e);
                 self.balls.v[i] = vi;
                 self.balls.v[j] = vj;
@@ -121,17 +121,19 @@ impl Solver<'_> {
         let range = self.pair_range();
         let (mut lo, mut hi) = (p, p);
         // Extend across pairs of free balls only: the frame's group is one body already.
-        while lo > range.start && self.balls.left_body_free(lo) && self.stuck_pair(lo - 1) {
+        while lo > range.start && self.balls.left_free_ball(lo).is_some() && self.stuck_pair(lo - 1) {
             lo -= 1;
         }
-        while hi + 1 < range.end && self.balls.right_body_free(hi) && self.stuck_pair(hi + 1) {
+        while hi + 1 < range.end && self.balls.right_free_ball(hi).is_some() && self.stuck_pair(hi + 1) {
             hi += 1;
         }
-        // The run holds bodies lo-1 ..= hi (body -1 and body n being the walls).
-        let reaches_left = lo == 0 || self.balls.hold[lo - 1] != Hold::Free;
-        let reaches_right = hi == self.balls.n || self.balls.hold[hi] != Hold::Free;
+        // The run holds the bodies either side of pairs lo ..= hi, a wall or a held ball at
+        // either end being the frame.
+        let reaches_left = self.balls.left_free_ball(lo).is_none();
+        let reaches_right = self.balls.right_free_ball(hi).is_none();
         let with_frame = self.has_frame() && self.balls.walls && (reaches_left || reaches_right);
-        let balls: Vec<usize> = (lo.saturating_sub(1)..(hi + 1).min(self.balls.n)).filter(|&i| self.balls.hold[i] == Hold::Free).collect();
+        let balls: Vec<usize> =
+            self.balls.left_free_ball(lo).into_iter().chain((lo..=hi).filter_map(|q| self.balls.right_free_ball(q))).collect();
         let (_, vs, _) = self.frame.now(self.t);
         let group = self.frame.mass + self.frame.held_mass;
         let (mut pm, mut m) = (0.0, 0.0);
@@ -160,8 +162,14 @@ impl Solver<'_> {
                 self.frame.held_mass += self.balls.mass[i];
             }
             if reaches_left && reaches_right {
-                self.balls.packed = true;
+                // The chain is packed wall to wall: all its balls move with the frame for good.
+                let first = balls.first().copied();
+                let chain = self.balls.chains.iter().find(|c| first.is_some_and(|i| c.contains(&i))).cloned().unwrap_or_default();
+                for i in chain {
+                    self.balls.hold[i] = Hold::Packed;
+                }
             }
+            self.balls.packed = !self.balls.hold.iter().any(|h| matches!(h, Hold::Left | Hold::Right));
             self.set_frame(vc);
         }
         self.record(p, approach_speed, lost, balls.len() as u32 + with_frame as u32);
@@ -178,7 +186,7 @@ impl Solver<'_> {
             let pulled = match self.balls.hold[i] {
                 Hold::Left => a < 0.0,
                 Hold::Right => a > 0.0,
-                Hold::Free => false,
+                Hold::Free | Hold::Packed => false,
             };
             if pulled {
                 self.balls.hold[i] = Hold::Free;
@@ -194,6 +202,7 @@ impl Solver<'_> {
             if self.balls.hold.iter().all(|h| *h == Hold::Free) {
                 self.frame.held_mass = 0.0; // no round-off residue
             }
+            self.balls.packed = !self.balls.hold.iter().any(|h| matches!(h, Hold::Left | Hold::Right));
             self.set_frame(vs);
         }
         released
@@ -236,7 +245,7 @@ impl Solver<'_> {
         let range = self.pair_range();
         let mut contacts = std::mem::take(&mut self.scratch.contacts);
         contacts.clear();
-        contacts.resize(self.balls.n + 1, Contact { approach: None, pressed: false, frame: false });
+        contacts.resize(self.balls.pairs.count(), Contact { approach: None, pressed: false, frame: false });
         let mut impulses = 0usize;
         // Pairs to re-read: all, or the neighbours of `changed` (and the frame's pairs).
         let mut all = true;

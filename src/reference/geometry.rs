@@ -46,6 +46,8 @@ pub(super) struct Scratch {
     pub(super) pairs_now: Vec<Option<PairNow>>,
     /// Each pair's contact now.
     pub(super) contacts: Vec<Contact>,
+    /// The ball-frame pairs `refresh_candidates` searches.
+    pub(super) frame_pairs: Vec<usize>,
 }
 
 impl Solver<'_> {
@@ -87,7 +89,7 @@ impl Solver<'_> {
     /// [`Solver::frame_gap_tolerance`]).
     #[inline(always)]
     pub(super) fn ball_gap_tolerance(&self, p: usize, rate: f64) -> f64 {
-        let (i, j) = (p - 1, p);
+        let (Some(i), Some(j)) = self.balls.pairs.balls(p) else { unreachable!("a ball-ball pair") };
         let eps = f64::EPSILON;
         self.limits.tol
             + self.balls.drift[i]
@@ -131,7 +133,7 @@ impl Solver<'_> {
     pub(super) fn check_contacts(&mut self, trigger: Option<usize>) -> Result<(), ModelError> {
         let mut pairs_now = std::mem::take(&mut self.scratch.pairs_now);
         pairs_now.clear();
-        pairs_now.resize(self.balls.n + 1, None);
+        pairs_now.resize(self.balls.pairs.count(), None);
         for p in self.pair_range() {
             pairs_now[p] = self.pair_now(p);
             let Some(PairNow { g, tol, .. }) = pairs_now[p] else { continue };
@@ -160,6 +162,6 @@ impl Solver<'_> {
 
     /// The bodies either side of pair `p`.
     pub(super) fn pair_bodies(&self, p: usize) -> (Body, Body) {
-        crate::scene::pair_bodies(p, self.balls.n)
+        self.balls.pairs.bodies(p)
     }
 }

@@ -83,8 +83,8 @@ impl Simulator for Reference {
         Model::Reference
     }
 
-    fn supports(&self, _scene: &Scene) -> Result<(), String> {
-        Ok(())
+    fn supports(&self, scene: &Scene) -> Result<(), String> {
+        scene.space.beyond_lines(&scene.initial_positions).map_or(Ok(()), Err)
     }
 
     fn simulate(&self, scene: &Scene, options: &RunOptions) -> Result<Run, ModelError> {
@@ -172,7 +172,8 @@ struct Solver<'a> {
 
 impl<'a> Solver<'a> {
     fn new(scene: &'a Scene, record: Record) -> Self {
-        let n = scene.balls.len();
+        let balls = Balls::new(scene);
+        let pairs = balls.pairs.count();
         let time_scale = scene.frame.map_or(scene.horizon, |f| {
             let p = f.damped_period();
             if p > 0.0 {
@@ -184,9 +185,9 @@ impl<'a> Solver<'a> {
         let speed_scale = scene.speed_scale();
         Solver {
             scene,
-            balls: Balls::new(scene),
+            balls,
             frame: FrameMotion::new(scene),
-            search: Search::new(n),
+            search: Search::new(pairs),
             limits: Limits {
                 tol: LENGTH_TOLERANCE * scene.length_scale(),
                 v_stick: STICK_SPEED * speed_scale,
@@ -194,7 +195,7 @@ impl<'a> Solver<'a> {
                 accepted_overlap: 0.0,
                 t_stick: STICK_TIME * time_scale,
             },
-            ledger: Ledger::new(n),
+            ledger: Ledger::new(pairs),
             sampler: Sampler::new(scene, record),
             scratch: Scratch::default(),
             e: scene.restitution,
@@ -208,8 +209,7 @@ impl<'a> Solver<'a> {
         self.frame.exists()
     }
 
-    /// Pairs that can touch: `p` lies between body `p - 1` and body `p` (body `-1` is the left
-    /// wall, body `n` the right wall).
+    /// Pairs that can touch (see [`crate::scene::Pairs`]).
     fn pair_range(&self) -> std::ops::Range<usize> {
         self.balls.pair_range()
     }

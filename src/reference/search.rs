@@ -27,14 +27,14 @@ pub(super) struct Search {
 }
 
 impl Search {
-    pub(super) fn new(n: usize) -> Self {
-        Search { cand: vec![NO_EVENT; n + 1], dirty: vec![true; n + 1], frame_dirty: true, release_at: f64::INFINITY }
+    pub(super) fn new(pairs: usize) -> Self {
+        Search { cand: vec![NO_EVENT; pairs], dirty: vec![true; pairs], frame_dirty: true, release_at: f64::INFINITY }
     }
 
-    /// Ball `i` changed: both its pairs are searched again.
-    pub(super) fn touch_ball(&mut self, i: usize) {
-        self.dirty[i] = true;
-        self.dirty[i + 1] = true;
+    /// The ball whose left pair is `p` changed: both its pairs are searched again.
+    pub(super) fn touch_pairs_from(&mut self, p: usize) {
+        self.dirty[p] = true;
+        self.dirty[p + 1] = true;
     }
 }
 
@@ -257,16 +257,16 @@ impl Solver<'_> {
         // frame pairs' searches are the costly ones): exact ball-ball times first, then the
         // frame pairs, each bounded by everything found so far.
         let mut bound = self.exact_event_bound(None);
-        let mut frame = [usize::MAX; 2];
-        let mut frames = 0;
+        let mut frame = std::mem::take(&mut self.scratch.frame_pairs);
+        frame.clear();
         for p in self.pair_range() {
             if !self.search.dirty[p] {
                 continue;
             }
             if self.balls.is_frame_pair(p) {
-                // At most two: the free balls next to the walls (or to balls the frame holds).
-                frame[frames.min(1)] = p;
-                frames += 1;
+                // At most two per chain: the free balls next to the walls (or to balls the
+                // frame holds).
+                frame.push(p);
             } else {
                 self.search.cand[p] = self.candidate(p, self.t, bound);
                 self.search.dirty[p] = false;
@@ -275,8 +275,7 @@ impl Solver<'_> {
                 }
             }
         }
-        debug_assert!(frames <= 2, "more than two ball-frame pairs");
-        let frame = &frame[..frames.min(2)];
+        debug_assert!(frame.len() <= 2 * self.balls.chains.len().max(1), "more than two ball-frame pairs per chain");
         match self.frame.seg.forced {
             // Both frame pairs searched side by side over windows that double from a scan
             // step: the far wall's search then stops where the near wall's contact is. As
@@ -287,7 +286,7 @@ impl Solver<'_> {
                 let mut bound = bound.min(self.t + self.frame.span);
                 loop {
                     let until = (reached + window).min(bound);
-                    for &p in frame {
+                    for &p in &frame {
                         if let Gap::Frame { ball, s, k } = self.balls.gap(p) {
                             self.search.cand[p] = self.search_frame_pair(ball, s, k, reached, until);
                             if self.search.cand[p].exact {
@@ -303,14 +302,15 @@ impl Solver<'_> {
                 }
             }
             None => {
-                for &p in frame {
+                for &p in &frame {
                     self.search.cand[p] = self.candidate(p, self.t, bound);
                 }
             }
         }
-        for &p in frame {
+        for &p in &frame {
             self.search.dirty[p] = false;
         }
+        self.scratch.frame_pairs = frame;
     }
 
     /// The earliest exact event among the clean pairs but `except`, the release and the horizon.

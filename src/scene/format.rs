@@ -32,6 +32,89 @@ pub struct SceneFile {
     pub chain: Option<ChainFile>,
     /// Manufacturing tolerances: how an ensemble's members scatter about this scene.
     pub tolerances: Option<TolerancesFile>,
+    /// The container's size across the frame's motion (and its length for a bed).
+    pub container: Option<ContainerFile>,
+    /// Gravity, friction, and the restitution of balls not given by `[balls]`.
+    pub world: Option<WorldFile>,
+    /// A generated bed of balls: a count or fill fraction of given sizes, placed on a lattice
+    /// or at random.
+    pub bed: Option<BedFile>,
+    /// Explicit balls, one `[[ball]]` table each.
+    #[serde(rename = "ball")]
+    pub explicit_balls: Option<Vec<ExplicitBallFile>>,
+}
+
+/// `[container]`: the container's inner size. Its axis (y = z = 0) runs along the frame's
+/// motion through the middle of its cross-section; its left wall is at x = 0.
+#[derive(Debug, Clone, Deserialize, Serialize, Default)]
+#[serde(deny_unknown_fields)]
+pub struct ContainerFile {
+    /// Inner length along x, m (for `[bed]` and `[[ball]]`; `[balls]` sets it by Eq. 11).
+    pub length: Option<Length>,
+    /// Inner width along y, m (default: each chain's channel as wide as its largest ball).
+    pub width: Option<Length>,
+    /// Inner height along z, m (default: as high as the largest ball).
+    pub height: Option<Length>,
+}
+
+/// `[world]`: what acts on every ball.
+#[derive(Debug, Clone, Deserialize, Serialize, Default)]
+#[serde(deny_unknown_fields)]
+pub struct WorldFile {
+    /// `[gx, gy, gz]`, m/s^2 (default none).
+    pub gravity: Option<[f64; 3]>,
+    /// Coulomb friction coefficient of every contact (default 0).
+    pub friction: Option<f64>,
+    /// Coefficient of restitution `e` of every impact, for balls from `[bed]` or `[[ball]]`.
+    pub restitution: Option<f64>,
+}
+
+/// How a bed's balls are placed.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize, Serialize, Default)]
+#[serde(rename_all = "lowercase")]
+pub enum Placement {
+    /// On a cubic lattice as wide as the largest ball, filled from the floor (z low) up.
+    #[default]
+    Lattice,
+    /// At random positions without overlaps (seeded).
+    Random,
+}
+
+/// `[bed]`: a generated bed of balls.
+#[derive(Debug, Clone, Deserialize, Serialize)]
+#[serde(deny_unknown_fields)]
+pub struct BedFile {
+    /// Number of balls. Give this or `fill_fraction`.
+    pub count: Option<u32>,
+    /// Solid fraction of the container's volume the balls fill.
+    pub fill_fraction: Option<f64>,
+    /// Radii of the ball sizes, m.
+    pub radii: Vec<f64>,
+    /// Relative numbers of balls of each size (default equal).
+    pub proportions: Option<Vec<f64>>,
+    /// kg/m^3.
+    pub density: f64,
+    /// `"lattice"` (default) or `"random"`.
+    #[serde(default)]
+    pub placement: Placement,
+    /// Seed of a random placement (default 1).
+    pub seed: Option<u64>,
+}
+
+/// `[[ball]]`: one ball placed by hand.
+#[derive(Debug, Clone, Deserialize, Serialize)]
+#[serde(deny_unknown_fields)]
+pub struct ExplicitBallFile {
+    /// Centre `[x, y, z]`, m, in the container's frame.
+    pub position: [f64; 3],
+    /// kg.
+    pub mass: f64,
+    /// m. Give this or `density`.
+    pub radius: Option<f64>,
+    /// kg/m^3. Give this or `radius`.
+    pub density: Option<f64>,
+    /// Initial velocity `[vx, vy, vz]`, m/s, relative to the ground (default at rest).
+    pub velocity: Option<[f64; 3]>,
 }
 
 /// `[tolerances]`: the spread of each parameter an ensemble draws (the `[sweep]` parameters),
@@ -119,6 +202,8 @@ pub struct BallsFile {
     pub clearance: Option<Length>,
     /// `Le`: inner container length; the clearance then follows from Eq. 11.
     pub container_length: Option<Length>,
+    /// Number of copies of the arrangement side by side, each in its own channel (default 1).
+    pub chains: Option<u32>,
 }
 
 /// The order of balls, left to right.

@@ -50,6 +50,9 @@ pub enum Body {
     Ball(usize),
     /// The container's right wall (the frame).
     RightWall,
+    /// A wall along the motion (the container's floor, ceiling, front or back, or a divider
+    /// between chains): part of the frame, but its normal has no component along the motion.
+    SideWall,
 }
 
 impl Body {
@@ -58,6 +61,7 @@ impl Body {
         match self {
             Body::LeftWall => "left-wall".into(),
             Body::RightWall => "right-wall".into(),
+            Body::SideWall => "side-wall".into(),
             Body::Ball(i) => format!("ball{}", i + 1),
         }
     }
@@ -92,5 +96,130 @@ pub fn pair_gap(balls: &[Ball], x: &[f64], walls: Option<(f64, f64)>, p: usize) 
         (p, Some((xs, length))) if p == n && n > 0 => Some(xs + length - x[n - 1] - r(n - 1)),
         (p, _) if p > 0 && p < n => Some(x[p] - r(p) - x[p - 1] - r(p - 1)),
         _ => None,
+    }
+}
+
+/// The pairs of neighbours that can touch on a scene's chains, each chain in its own channel
+/// between the container's walls: chain `k`, whose balls are `s_k .. s_k + n_k`, has the pairs
+/// `s_k + k ..= s_k + k + n_k` (its left wall and first ball, its neighbours, its last ball
+/// and its right wall), so ball `i` of chain `k` has pair `i + k` on its left and `i + k + 1`
+/// on its right. On one chain this is [`pair_range`] and [`pair_bodies`]. Chains are coupled
+/// only through the walls, which are all the frame.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Pairs {
+    /// The ball left of each pair, `None` for a wall.
+    left: Vec<Option<usize>>,
+    /// The ball right of each pair, `None` for a wall.
+    right: Vec<Option<usize>>,
+    /// The pair left of each ball.
+    left_of_ball: Vec<usize>,
+    /// The pairs that can touch.
+    range: std::ops::Range<usize>,
+}
+
+impl Pairs {
+    /// The pairs of `n` balls on the chains starting at `chain_starts`, with or without walls
+    /// (balls without walls are on one chain).
+    pub fn new(n: usize, chain_starts: &[usize], walls: bool) -> Pairs {
+        let chains = chain_starts.len().max(1);
+        let count = n + chains;
+        let (mut left, mut right) = (vec![None; count], vec![None; count]);
+        let mut left_of_ball = vec![0; n];
+        for i in 0..n {
+            let k = chain_starts.partition_point(|&s| s <= i).saturating_sub(1);
+            let first = chain_starts.get(k).is_none_or(|&s| s == i);
+            let last = chain_starts.get(k + 1).map_or(i + 1 == n, |&s| s == i + 1);
+            let p = i + k;
+            left_of_ball[i] = p;
+            right[p] = Some(i);
+            left[p + 1] = Some(i);
+            debug_assert!(!first || left[p].is_none());
+            debug_assert!(!last || right[p + 1].is_none());
+        }
+        let range = if walls { 0..count } else { 1..n.max(1) };
+        Pairs { left, right, left_of_ball, range }
+    }
+
+    /// The pairs that can touch.
+    pub fn range(&self) -> std::ops::Range<usize> {
+        self.range.clone()
+    }
+
+    /// How many pair slots there are (the walls' included, touchable or not).
+    pub fn count(&self) -> usize {
+        self.left.len()
+    }
+
+    /// The balls either side of pair `p`, `None` for a wall.
+    #[inline(always)]
+    pub fn balls(&self, p: usize) -> (Option<usize>, Option<usize>) {
+        (self.left[p], self.right[p])
+    }
+
+    /// The pair left of ball `i`; the pair right of it is the next.
+    #[inline(always)]
+    pub fn left_of(&self, i: usize) -> usize {
+        self.left_of_ball[i]
+    }
+
+    /// The bodies either side of pair `p`.
+    pub fn bodies(&self, p: usize) -> (Body, Body) {
+        (self.left[p].map_or(Body::LeftWall, Body::Ball), self.right[p].map_or(Body::RightWall, Body::Ball))
+    }
+
+    /// The gap across pair `p` of balls `balls` at centres `x`, with the container's walls at
+    /// `(left wall, length)` when there are walls, m (`None` for a wall pair without walls).
+    pub fn gap(&self, balls: &[Ball], x: &[f64], walls: Option<(f64, f64)>, p: usize) -> Option<f64> {
+        match (self.balls(p), walls) {
+            ((Some(i), Some(j)), _) => Some(x[j] - balls[j].radius - x[i] - balls[i].radius),
+            ((None, Some(j)), Some((xs, _))) => Some(x[j] - balls[j].radius - xs),
+            ((Some(i), None), Some((xs, length))) => Some(xs + length - x[i] - balls[i].radius),
+            _ => None,
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn one_chain_pairs_are_the_line_pairs() {
+        let balls = vec![Ball { mass: 1.0, radius: 0.1, kind: BallKind::Large }; 4];
+        let x = [0.2, 0.5, 0.8, 1.1];
+        for walls in [true, false] {
+            let pairs = Pairs::new(4, &[0], walls);
+            assert_eq!(pairs.range(), pair_range(4, walls));
+            for p in pairs.range() {
+                assert_eq!(pairs.bodies(p), pair_bodies(p, 4));
+                let w = walls.then_some((0.0, 1.3));
+                assert_eq!(pairs.gap(&balls, &x, w, p), pair_gap(&balls, &x, w, p));
+            }
+        }
+    }
+
+    #[test]
+    fn chains_touch_only_their_own_walls_and_neighbours() {
+        // Chains of 2, 1 and 3 balls: pairs 0-2, 3-4 and 5-8.
+        let pairs = Pairs::new(6, &[0, 2, 3], true);
+        assert_eq!(pairs.range(), 0..9);
+        let expect = [
+            (None, Some(0)),
+            (Some(0), Some(1)),
+            (Some(1), None),
+            (None, Some(2)),
+            (Some(2), None),
+            (None, Some(3)),
+            (Some(3), Some(4)),
+            (Some(4), Some(5)),
+            (Some(5), None),
+        ];
+        for (p, e) in expect.iter().enumerate() {
+            assert_eq!(pairs.balls(p), *e, "pair {p}");
+        }
+        for i in 0..6 {
+            assert_eq!(pairs.balls(pairs.left_of(i)).1, Some(i));
+            assert_eq!(pairs.balls(pairs.left_of(i) + 1).0, Some(i));
+        }
     }
 }

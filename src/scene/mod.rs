@@ -6,19 +6,23 @@ pub mod format;
 mod geometry;
 mod overrides;
 mod parameters;
+mod placement;
 mod rules;
 mod settings;
+mod space;
 mod structure;
 
 use std::path::{Path, PathBuf};
 
 pub use excitation::Forcing;
 pub use format::{Arrangement, Distribution, ForcingKind, Length, SceneFile, Stepping};
-pub use geometry::{ball_radius, pair_bodies, pair_gap, pair_range, Ball, BallKind, Body, Container};
+pub use geometry::{ball_radius, pair_bodies, pair_gap, pair_range, Ball, BallKind, Body, Container, Pairs};
 pub use overrides::{with_settings_of, Overrides};
 pub use parameters::{Parameter, Tolerances};
+pub use placement::MAX_BED_BALLS;
 pub use rules::{from_file, validate_sample_dt};
 pub use settings::{CompliantSettings, RapierSettings, DEFAULT_COMPLIANT_TOLERANCE};
+pub use space::Space;
 pub use structure::Frame;
 
 /// Default simulated time, s (docs/MODEL.md §8).
@@ -92,6 +96,8 @@ pub struct Scene {
     pub forcing: Option<Forcing>,
     /// Reference radius `Rr`, m (radius of a large ball).
     pub reference_radius: f64,
+    /// The chains, the balls' places across the motion, gravity and friction.
+    pub space: Space,
 }
 
 impl Scene {
@@ -105,7 +111,13 @@ impl Scene {
     /// Initial mechanical energy: spring energy plus balls' kinetic energy.
     pub fn initial_energy(&self) -> f64 {
         let spring = self.frame.map_or(0.0, |f| f.energy(self.initial_displacement, 0.0));
-        spring + self.balls.iter().zip(&self.initial_velocities).map(|(b, v)| 0.5 * b.mass * v * v).sum::<f64>()
+        let across: f64 = (0..self.balls.len())
+            .map(|i| {
+                let [vy, vz] = self.space.lateral_velocity_of(i);
+                0.5 * self.balls[i].mass * (vy * vy + vz * vz)
+            })
+            .sum();
+        spring + self.balls.iter().zip(&self.initial_velocities).map(|(b, v)| 0.5 * b.mass * v * v).sum::<f64>() + across
     }
 
     /// The fastest motion the scene sets going, m/s: the frame's free swing from its initial
@@ -121,7 +133,8 @@ impl Scene {
             });
             (osc.w0sq.sqrt() * self.initial_displacement.abs()).max(forced)
         });
-        self.initial_velocities.iter().fold(frame, |m: f64, v| m.max(v.abs()))
+        let across = self.space.lateral_velocities.iter().fold(0.0, |m: f64, [vy, vz]| m.max(vy.hypot(*vz)));
+        self.initial_velocities.iter().fold(frame.max(across), |m: f64, v| m.max(v.abs()))
     }
 
     /// The scene's length scale, m: the container's length (or a free chain's span), the
@@ -134,7 +147,8 @@ impl Scene {
             _ => 0.0,
         };
         let largest = self.balls.iter().map(|b| b.radius).fold(0.0, f64::max);
-        extent.max(self.initial_displacement.abs()).max(largest).max(1e-9)
+        let across = self.space.section[0].max(self.space.section[1]);
+        extent.max(self.initial_displacement.abs()).max(largest).max(across).max(1e-9)
     }
 
     /// The scene's speed scale, m/s: the fastest motion it sets going
@@ -213,6 +227,7 @@ impl Scene {
             balls: vec![],
             initial_positions: vec![],
             initial_velocities: vec![],
+            space: Space::line(0),
             ..self.clone()
         }
     }

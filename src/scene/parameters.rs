@@ -69,6 +69,12 @@ parameters! {
     ForcingAmplitude = "forcing_amplitude", "forcing.amplitude", false;
     /// The forcing's frequency, Hz.
     ForcingFrequency = "forcing_frequency", "forcing.frequency", false;
+    /// Number of chains side by side (a whole number).
+    Chains = "chains", "balls.chains", false;
+    /// Coulomb friction coefficient.
+    Friction = "friction", "world.friction", false;
+    /// Solid fraction of the container a bed fills.
+    FillFraction = "fill_fraction", "bed.fill_fraction", false;
 }
 
 impl std::fmt::Display for Parameter {
@@ -107,6 +113,19 @@ impl Parameter {
         };
         let frame = f.frame.as_mut().ok_or("needs a [frame] table")?;
         match self {
+            Parameter::Chains => {
+                let x = number()?;
+                if !((1.0..=10_000.0).contains(&x) && x.fract() == 0.0) {
+                    return Err(format!("`chains` must be a whole number in 1..=10000 (got {})", super::human(x)));
+                }
+                f.balls.as_mut().ok_or("needs a [balls] table")?.chains = Some(x as u32);
+            }
+            Parameter::Friction => f.world.get_or_insert_with(Default::default).friction = Some(number()?),
+            Parameter::FillFraction => {
+                let bed = f.bed.as_mut().ok_or("needs a [bed] table")?;
+                bed.fill_fraction = Some(number()?);
+                bed.count = None;
+            }
             Parameter::FrameMass => frame.mass = number()?,
             Parameter::Stiffness => frame.stiffness = number()?,
             Parameter::Damping => frame.damping = number()?,
@@ -160,6 +179,9 @@ impl Parameter {
             Parameter::Damping => scene.frame.map(|f| f.damping),
             Parameter::ForcingAmplitude => scene.forcing.map(|g| g.amplitude),
             Parameter::ForcingFrequency => scene.forcing.map(|g| g.frequency),
+            Parameter::Chains => Some(scene.space.chains() as f64),
+            Parameter::Friction => Some(scene.space.friction),
+            Parameter::FillFraction => file.bed.as_ref().and_then(|b| b.fill_fraction),
         }
     }
 }

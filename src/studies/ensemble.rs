@@ -306,7 +306,11 @@ impl Drawer<'_> {
 fn shift_gaps(scene: &mut Scene, deviation: &[f64]) -> Result<Vec<f64>, Failure> {
     let Some(container) = scene.container.as_mut() else { return Ok(vec![]) };
     let gaps: Vec<f64> = deviation.iter().map(|d| container.gap + d).collect();
-    let clearance = container.clearance - deviation.iter().sum::<f64>();
+    // Each chain's balls shift with their own gaps; its clearance takes up its own sum.
+    let n = scene.initial_positions.len();
+    let chains: Vec<_> = (0..scene.space.chains()).map(|k| scene.space.chain(k, n)).collect();
+    let clearance = chains.iter().map(|c| container.clearance - deviation[c.clone()].iter().sum::<f64>()).fold(f64::INFINITY, f64::min);
+    let clearance = if chains.is_empty() { container.clearance } else { clearance };
     if let Some((i, g)) = gaps.iter().enumerate().find(|(_, g)| **g < 0.0) {
         return Err(Failure {
             parameter: Parameter::Gap,
@@ -320,10 +324,12 @@ fn shift_gaps(scene: &mut Scene, deviation: &[f64]) -> Result<Vec<f64>, Failure>
         });
     }
     container.clearance = clearance;
-    let mut shift = 0.0;
-    for (x, d) in scene.initial_positions.iter_mut().zip(deviation) {
-        shift += d;
-        *x += shift;
+    for chain in chains {
+        let mut shift = 0.0;
+        for i in chain {
+            shift += deviation[i];
+            scene.initial_positions[i] += shift;
+        }
     }
     Ok(gaps)
 }

@@ -103,6 +103,7 @@ pub fn random_extreme_scene_file(seed: u64, max_horizon: f64) -> SceneFile {
             gap: Length::Rr(gap),
             clearance: Some(Length::Rr(clearance)),
             container_length: None,
+            chains: None,
         }),
         run: RunFile { horizon: Some(horizon), sample_dt: Some(horizon / 2000.0) },
         ..SceneFile::default()
@@ -169,6 +170,7 @@ pub fn random_scene_file(seed: u64, max_horizon: f64, forced: bool) -> SceneFile
             gap: Length::Rr(gap),
             clearance: Some(Length::Rr(clearance)),
             container_length: None,
+            chains: None,
         }),
         run: RunFile { horizon: Some(horizon), sample_dt: Some((horizon / 2000.0).max(1e-4)) },
         forcing,

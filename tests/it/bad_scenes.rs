@@ -162,3 +162,38 @@ fn model_errors_print_times_for_people() {
     };
     assert!(e.to_string().contains("at t = 0.3 s of 5 s after 7 steps and 600.0 s of computing"), "{e}");
 }
+
+/// A scene of explicit balls or a bed in a 0.1 x 0.04 x 0.03 m box, `body` its balls' tables.
+fn boxed(body: &str) -> String {
+    format!(
+        "[frame]\nmass = 1.35\nstiffness = 865.0\ndamping = 1.092\ninitial_displacement = 0.01\n\
+         [container]\nlength = 0.1\nwidth = 0.04\nheight = 0.03\n[world]\nrestitution = 0.6\n{body}\n"
+    )
+}
+
+const BALL: &str = "[[ball]]\nposition = [0.05, 0.0, 0.0]\nmass = 0.01\nradius = 0.007\n";
+
+#[test]
+fn chains_containers_beds_and_explicit_balls() {
+    let chains = |n: &str| GOOD.replace("arrangement = \"LSL\"", &format!("arrangement = \"LSL\"\nchains = {n}"));
+    expect_error(&chains("0"), &[], "balls.chains", "1..=10000");
+    expect_error(&format!("{}\n[container]\nwidth = \"2.5 Rr\"\n", chains("2")), &[], "container.width", "narrower");
+    expect_error(&format!("{}\n[container]\nlength = 0.2\n", chains("2")), &[], "container.length", "eq. 11");
+    expect_error(&format!("{GOOD}\n[world]\nrestitution = 0.5\n"), &[], "world.restitution", "give one");
+    expect_error(&format!("{GOOD}\n[world]\nfriction = -0.1\n"), &[], "world.friction", "negative");
+    expect_error(&format!("{GOOD}\n[world]\ngravity = [0.0, nan, 0.0]\n"), &[], "world.gravity[1]", "finite");
+    expect_error(&format!("{}\n{BALL}", GOOD), &[], "ball", "cannot be combined with [balls]");
+    expect_error(&boxed(BALL).replace("[world]\nrestitution = 0.6\n", ""), &[], "world.restitution", "missing");
+    expect_error(&boxed(BALL).replace("width = 0.04\n", ""), &[], "container.width", "missing");
+    expect_error(&boxed(&BALL.replace("0.05, 0.0, 0.0", "0.05, 0.0, 0.01")), &[], "ball[0].position", "outside the container along z");
+    expect_error(&boxed(&format!("{BALL}{}", BALL.replace("0.05, 0.0", "0.06, 0.0"))), &[], "ball[1].position", "overlap ball[0]");
+    expect_error(&boxed(&BALL.replace("mass = 0.01", "mass = -1.0")), &[], "ball[0].mass", "positive");
+    expect_error(&boxed(&format!("{BALL}density = 7800.0\n")), &[], "ball[0].radius", "give one");
+    let bed = "[bed]\ncount = 100\nradii = [0.005]\ndensity = 7800.0\n";
+    expect_error(&boxed(&bed.replace("100", "1000")), &[], "bed", "holds at most");
+    expect_error(&boxed(&bed.replace("count = 100", "fill_fraction = 0.6")), &[], "bed.fill_fraction", "pi/6");
+    expect_error(&boxed(&format!("{bed}fill_fraction = 0.1\n")), &[], "bed.fill_fraction", "give one");
+    expect_error(&boxed(&format!("{bed}proportions = [1.0, 2.0]\n")), &[], "bed.proportions", "one per size");
+    expect_error(&boxed(&bed.replace("[0.005]", "[0.02]")), &[], "bed", "cannot be placed");
+    expect_error(&boxed(&format!("{}placement = \"random\"\n", bed.replace("count = 100", "fill_fraction = 0.5"))), &[], "bed", "random");
+}

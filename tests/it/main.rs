@@ -8,6 +8,7 @@ mod regressions;
 
 mod bad_scenes;
 mod bench_matches_compare;
+mod beyond_one_line;
 mod budgets;
 mod check_goldens;
 mod closed_form;

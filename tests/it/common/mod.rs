@@ -82,6 +82,7 @@ pub fn damper(frame: Frame, xs0: f64, masses: &[f64], e: f64, gap: f64, clearanc
         container: Some(Container { length, gap, clearance }),
         initial_velocities: vec![0.0; balls.len()],
         reference_radius: balls.first().map_or(0.0, |b| b.radius),
+        space: lpc_damper::scene::Space::line(balls.len()),
         balls,
         restitution: e,
         initial_displacement: xs0,
@@ -106,6 +107,7 @@ pub fn free_chain(balls: Vec<Ball>, gaps: &[f64], speeds: &[f64], e: f64, horizo
         frame: None,
         container: None,
         reference_radius: balls.first().map_or(0.0, |b| b.radius),
+        space: lpc_damper::scene::Space::line(balls.len()),
         balls,
         restitution: e,
         initial_displacement: 0.0,
@@ -148,20 +150,17 @@ pub fn all_paper_scenes() -> Vec<Scene> {
 pub fn min_gap(scene: &Scene, run: &lpc_damper::run::Run) -> f64 {
     let s = &run.series;
     let n = scene.balls.len();
+    let pairs = lpc_damper::scene::Pairs::new(n, &scene.space.chain_starts, scene.container.is_some());
     let mut min = f64::INFINITY;
+    let mut x = vec![0.0; n];
     for k in 0..s.len() {
-        for i in 0..n {
-            let r = scene.balls[i].radius;
-            if i + 1 < n {
-                min = min.min(s.x(i + 1)[k] - scene.balls[i + 1].radius - s.x(i)[k] - r);
-            }
-            if let Some(c) = scene.container {
-                if i == 0 {
-                    min = min.min(s.x(0)[k] - r - s.xs()[k]);
-                }
-                if i + 1 == n {
-                    min = min.min(s.xs()[k] + c.length - s.x(i)[k] - r);
-                }
+        for (i, xi) in x.iter_mut().enumerate() {
+            *xi = s.x(i)[k];
+        }
+        let walls = scene.container.map(|c| (s.xs()[k], c.length));
+        for p in pairs.range() {
+            if let Some(g) = pairs.gap(&scene.balls, &x, walls, p) {
+                min = min.min(g);
             }
         }
     }
