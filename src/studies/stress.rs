@@ -63,6 +63,18 @@ pub struct Draws {
     pub extreme: bool,
     /// Seconds of computing each run may take, if limited.
     pub max_wall_s: Option<f64>,
+    /// Each scene as 1 to 4 copies of its chain side by side ([`with_chains`]).
+    pub chains: bool,
+}
+
+/// `file` with its arrangement as 1 to 4 chains side by side, drawn from a stream of its own
+/// (seeded from `seed` alone), so that the rest of the scene is the one drawn without chains.
+pub fn with_chains(mut file: SceneFile, seed: u64) -> SceneFile {
+    let mut rng = Pcg64::seed_from_u64(seed ^ 0xc4a1_5000_0000_0000);
+    if let Some(balls) = file.balls.as_mut() {
+        balls.chains = Some(rng.random_range(1..=4));
+    }
+    file
 }
 
 /// A random scene at the extremes the scene format accepts: 1 to 10 000 balls, frame periods
@@ -296,7 +308,10 @@ pub fn judge(model: Model, scene: &Scene, run: &Run) -> Result<(), Failure> {
                 if lo < -tol || hi < -tol {
                     return fail("outside", format!("ball{} outside the container by {:e} m at t = {}", i + 1, -lo.min(hi), s.t()[k]));
                 }
-                if let (Some(tol), true) = (checks.ball_overlap, i > 0) {
+                // A chain's first ball has no left neighbour (the last ball of the chain
+                // before it is in another channel).
+                let first_of_chain = scene.space.chain_starts.binary_search(&i).is_ok();
+                if let (Some(tol), true) = (checks.ball_overlap, i > 0 && !first_of_chain) {
                     // Balls never pass each other (docs/MODEL.md §1).
                     let g = (s.x(i)[k] - b.radius) - (s.x(i - 1)[k] + scene.balls[i - 1].radius);
                     if g < -tol {
@@ -361,6 +376,7 @@ fn simplifications(f: &SceneFile) -> Vec<SceneFile> {
     tweak(&|g| g.balls.as_mut().unwrap().gap = Length::Rr(0.25));
     tweak(&|g| g.balls.as_mut().unwrap().clearance = Some(Length::Rr(1.0)));
     tweak(&|g| g.frame.as_mut().unwrap().damping = 0.0);
+    tweak(&|g| g.balls.as_mut().unwrap().chains = None);
     out
 }
 
@@ -394,6 +410,7 @@ pub fn stress(model: Model, seed: u64, count: u64, draws: Draws, progress: &(dyn
             } else {
                 random_scene_file(s, draws.max_horizon, draws.forced)
             };
+            let file = if draws.chains { with_chains(file, s) } else { file };
             let start = std::time::Instant::now();
             let outcome = |failure: Option<Failure>, minimal_scene, refused, refused_during_run, stopped, wall_s| Outcome {
                 seed: s,

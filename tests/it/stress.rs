@@ -22,7 +22,21 @@ fn assert_all_pass(outcomes: &[Outcome]) {
 
 #[test]
 fn three_hundred_random_scenes_pass_every_check() {
-    assert_all_pass(&stress(Model::Reference, 1, 300, Draws { max_horizon: 2.0, forced: false, extreme: false, max_wall_s: None }, &|| {}));
+    assert_all_pass(&stress(
+        Model::Reference,
+        1,
+        300,
+        Draws { max_horizon: 2.0, forced: false, extreme: false, max_wall_s: None, chains: false },
+        &|| {},
+    ));
+    // The same scenes as 1 to 4 chains side by side.
+    assert_all_pass(&stress(
+        Model::Reference,
+        1,
+        100,
+        Draws { max_horizon: 2.0, forced: false, extreme: false, max_wall_s: None, chains: true },
+        &|| {},
+    ));
 }
 
 /// The same under a random harmonic force or base motion (`lpc stress --forced`): besides the
@@ -31,7 +45,13 @@ fn three_hundred_random_scenes_pass_every_check() {
 /// up to 10 s, all pass) is a documented command.
 #[test]
 fn forced_random_scenes_pass_every_check() {
-    assert_all_pass(&stress(Model::Reference, 1, 100, Draws { max_horizon: 2.0, forced: true, extreme: false, max_wall_s: None }, &|| {}));
+    assert_all_pass(&stress(
+        Model::Reference,
+        1,
+        100,
+        Draws { max_horizon: 2.0, forced: true, extreme: false, max_wall_s: None, chains: false },
+        &|| {},
+    ));
 }
 
 #[test]
@@ -48,7 +68,13 @@ fn generated_scenes_are_reproducible_from_their_seed() {
 /// --count 1000` passes all 1000, 235 of them refused; docs/BENCHMARKS.md "Stress runs").
 #[test]
 fn contact_model_passes_the_first_seeded_scenes() {
-    assert_all_pass(&stress(Model::Rapier, 1, 25, Draws { max_horizon: 1.0, forced: false, extreme: false, max_wall_s: None }, &|| {}));
+    assert_all_pass(&stress(
+        Model::Rapier,
+        1,
+        25,
+        Draws { max_horizon: 1.0, forced: false, extreme: false, max_wall_s: None, chains: false },
+        &|| {},
+    ));
 }
 
 /// Issue 19: scenes at the extremes a user can type (`lpc stress --extreme`: 1-10 000 balls,
@@ -58,7 +84,7 @@ fn contact_model_passes_the_first_seeded_scenes() {
 /// (Whether a run finishes within its budget depends on the machine; what is asserted does not.)
 #[test]
 fn extreme_scenes_pass_refuse_or_stop_never_panic() {
-    let draws = |max_wall_s| Draws { max_horizon: 100.0, forced: false, extreme: true, max_wall_s: Some(max_wall_s) };
+    let draws = |max_wall_s| Draws { max_horizon: 100.0, forced: false, extreme: true, max_wall_s: Some(max_wall_s), chains: false };
     assert_all_pass(&stress(Model::Reference, 1, 24, draws(1.0), &|| {}));
     for model in [Model::Rapier, Model::Compliant] {
         for o in stress(model, 1, 6, draws(0.5), &|| {}) {

@@ -31,6 +31,10 @@ pub struct Args {
     /// displacements from 0 to far beyond the container, horizons up to 1e4 s.
     #[arg(long, conflicts_with = "forced")]
     extreme: bool,
+    /// Draw each plausible scene as 1 to 4 copies of its chain side by side (the rest of the
+    /// scene as without the flag).
+    #[arg(long, conflicts_with = "extreme")]
+    chains: bool,
     /// Seconds of computing each run may take; a run that takes longer stops (a typed stop,
     /// counted apart from passes and failures). Default: none, 10 s with --extreme.
     #[arg(long, value_name = "S")]
@@ -62,6 +66,7 @@ pub fn run(a: Args) -> Result<ExitStatus> {
         max_horizon: a.max_horizon,
         forced: a.forced,
         extreme: a.extreme,
+        chains: a.chains,
         max_wall_s: a.max_wall_time.or(a.extreme.then_some(10.0)),
     };
     let mut outcomes = Vec::new();
