@@ -36,6 +36,10 @@ pub struct Layout {
     pub ball_y: f32,
     /// Overhang of the platform beyond the container on each side, m.
     pub overhang: f32,
+    /// The container's inner width (across the motion, drawn along the picture's depth), m.
+    pub depth: f32,
+    /// The container's inner height, m.
+    pub height: f32,
 }
 
 impl Layout {
@@ -57,20 +61,28 @@ impl Layout {
         let wall = 0.2 * radius;
         let column_height = 0.7 * length.max(6.0 * radius);
         let platform = 0.5 * radius;
+        // A line of balls gets a box a little wider and higher than its balls; a scene with a
+        // cross-section gets that.
+        let [width, high] = scene.space.section.map(|a| a as f32);
+        let depth = (3.0 * radius).max(width);
+        let height = (2.4 * radius).max(high);
         Layout {
             length,
             radius,
             wall,
             column_height,
             platform,
-            ball_y: column_height + platform + wall + 1.2 * radius,
+            ball_y: column_height + platform + wall + 0.5 * height,
             overhang: 0.25 * length.max(6.0 * radius),
+            depth,
+            height,
         }
     }
 
-    /// World position of a ball centre at `x` (the models' coordinate).
-    pub fn ball(&self, x: f64) -> Vec3 {
-        Vec3::new(x as f32, self.ball_y, 0.0)
+    /// World position of a ball centre at `x` (the models' coordinate) and `[y, z]` across
+    /// the motion (the scene's `y` is the picture's depth, its `z` the picture's up).
+    pub fn ball(&self, x: f64, across: [f64; 2]) -> Vec3 {
+        Vec3::new(x as f32, self.ball_y + across[1] as f32, across[0] as f32)
     }
 
     /// The point the camera looks at: mid-container, a little below the balls.
@@ -144,7 +156,7 @@ impl Playback {
 
 /// A ball's mesh (index left to right).
 #[derive(Component, Debug, Clone, Copy)]
-pub struct BallMesh(pub usize);
+pub struct BallMesh(pub usize, pub [f64; 2]);
 /// A part that moves with the frame: offset of its centre from the frame's displacement.
 #[derive(Component, Debug, Clone, Copy)]
 pub struct FramePart(pub Vec3);
@@ -187,7 +199,7 @@ pub fn spawn_stage(
         MeshMaterial3d(ground),
         Transform::from_xyz(0.5 * l.length, 0.0, 0.0),
     ));
-    let depth = 3.0 * l.radius;
+    let depth = l.depth;
     // Columns stand under the platform's ends; their feet stay, their tops follow the frame.
     let col = 0.35 * l.radius;
     for foot_x in [-0.6 * l.overhang, l.length + 0.6 * l.overhang] {
@@ -210,7 +222,7 @@ pub fn spawn_stage(
         steel.clone(),
         Vec3::new(0.5 * l.length, floor_y, 0.0),
     );
-    let height = 2.4 * l.radius;
+    let height = l.height;
     let wall_y = l.column_height + l.platform + l.wall + 0.5 * height;
     for (body, x) in [(Body::LeftWall, -0.5 * l.wall), (Body::RightWall, l.length + 0.5 * l.wall)] {
         let m = materials.add(StandardMaterial { base_color: Color::srgb(0.5, 0.52, 0.56), ..default() });
@@ -233,19 +245,30 @@ pub fn spawn_stage(
     frame_part(
         commands,
         meshes.add(Cuboid::new(l.length, 0.02 * l.radius, depth)),
-        glass,
+        glass.clone(),
         Vec3::new(0.5 * l.length, wall_y + 0.5 * height, 0.0),
     );
 
+    // The dividers between chains.
+    for k in 1..scene.space.chains() {
+        let y = k as f32 * scene.space.channel as f32 - 0.5 * depth;
+        frame_part(
+            commands,
+            meshes.add(Cuboid::new(l.length, height, 0.02 * l.radius)),
+            glass.clone(),
+            Vec3::new(0.5 * l.length, wall_y, y),
+        );
+    }
     let sphere = meshes.add(Sphere::new(1.0).mesh().uv(48, 24));
     for (i, b) in scene.balls.iter().enumerate() {
         let colour = if b.kind == BallKind::Small { SMALL_BALL } else { LARGE_BALL };
         let m = materials.add(StandardMaterial { base_color: srgb(colour), perceptual_roughness: 0.35, metallic: 0.1, ..default() });
         commands.spawn((
-            BallMesh(i),
+            BallMesh(i, scene.space.lateral_of(i)),
             Mesh3d(sphere.clone()),
             MeshMaterial3d(m),
-            Transform::from_translation(l.ball(scene.initial_positions[i])).with_scale(Vec3::splat(b.radius as f32)),
+            Transform::from_translation(l.ball(scene.initial_positions[i], scene.space.lateral_of(i)))
+                .with_scale(Vec3::splat(b.radius as f32)),
         ));
     }
     commands.spawn((
@@ -295,7 +318,7 @@ pub fn pose(
     };
     for (b, mut t, m) in &mut balls {
         if let Some(&xi) = x.get(b.0) {
-            t.translation = layout.ball(xi);
+            t.translation = layout.ball(xi, b.1);
         }
         glow(m, playback.flashing(Body::Ball(b.0)));
     }

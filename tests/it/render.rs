@@ -64,7 +64,7 @@ fn balls_are_drawn_where_the_physics_puts_them() {
         assert!((series.t()[sample] - k as f64 / FPS).abs() < 1e-9, "frame {k} falls on a sample");
         let mut centres = vec![];
         for (i, ball) in scene.balls.iter().enumerate() {
-            let centre = layout.ball(series.x(i)[sample]);
+            let centre = layout.ball(series.x(i)[sample], scene.space.lateral_of(i));
             let p = layout.project(SIZE, centre);
             let r_px = layout.projected_radius(SIZE, centre, ball.radius as f32);
             assert!(r_px > 3.0, "ball{} is {r_px} px across: too small to check", i + 1);
