@@ -7,12 +7,15 @@
 //!
 //! The plug-in group (`plugin`) runs the phases of a step (`phases`) in one order; `spawn`
 //! makes the bodies, `resources` holds what the phases share, `settings` the stepping rules.
+//! Scenes beyond one line (several chains, balls across the axis, gravity, friction) go to
+//! `spatial`, the same model with balls free in 3D, in a lean loop of its own.
 
 mod contacts;
 mod phases;
 mod plugin;
 mod resources;
 mod settings;
+pub mod spatial;
 mod spawn;
 
 use bevy::prelude::*;
@@ -56,20 +59,24 @@ impl Simulator for Rapier {
     }
 
     fn supports(&self, scene: &Scene) -> Result<(), String> {
-        if scene.space.chains() > 1 {
-            return Err(format!(
-                "the scene has {} chains; this model moves one chain of balls along the container's axis",
-                scene.space.chains()
-            ));
+        // Several chains, or balls beyond lines, go to the spatial path (`spatial`).
+        if spatial::needs_spatial(scene) {
+            return spatial::refusal(scene).map_or(Ok(()), Err);
         }
-        scene.space.beyond_lines(&scene.initial_positions).map_or(Ok(()), Err)
+        Ok(())
     }
 
     fn simulate(&self, scene: &Scene, options: &RunOptions) -> Result<Run, ModelError> {
+        if spatial::needs_spatial(scene) {
+            return spatial::simulate_spatial(scene, options);
+        }
         simulate_with(scene, settings(scene), options)
     }
 
-    fn checks(&self, _scene: &Scene, _run: &Run) -> Checks {
+    fn checks(&self, scene: &Scene, run: &Run) -> Checks {
+        if spatial::needs_spatial(scene) {
+            return spatial::checks(scene, run);
+        }
         // f32 velocities, one rounding per impulse; Rapier's contacts sink by up to its allowed
         // overlap before it corrects them, and balls deform nothing it could bound otherwise.
         Checks {
@@ -89,6 +96,9 @@ impl Simulator for Rapier {
     }
 
     fn stepping(&self, scene: &Scene) -> &'static str {
+        if spatial::needs_spatial(scene) {
+            return Stepping::Fixed.name();
+        }
         settings(scene).stepping.name()
     }
 }

@@ -23,6 +23,7 @@ mod fuzz_scene_files;
 mod impact_properties;
 mod masri_caughey;
 mod rapier_model;
+mod rapier_space;
 mod render;
 mod stability_map;
 mod sticking;

@@ -1,0 +1,526 @@
+//! The contact model beyond one line (docs/MODEL.md §9, "Rapier"): balls free in 3D under the
+//! scene's gravity and friction, in a container of six walls (and dividers between chains)
+//! carried by the kinematic frame. The frame moves in x only, by the same closed-form
+//! oscillator step as the one-line path, and is fed back the x impulse the walls give the
+//! balls. Rapier solves every contact plastically; `contacts` gives the bounces by Eq. 9-10
+//! along the normal of each contact whose approach Rapier stopped in the step.
+//!
+//! This path is a lean loop over Rapier's own `PhysicsWorld`, not Bevy systems: one step has
+//! four phases (drive the frame, Rapier's step, feedback and impacts, samples) that read and
+//! write the same few arrays, and the Bevy schedule would add its ECS synchronisation (a copy
+//! of every body per step) and nothing the headless run needs. The one-line path is untouched.
+
+mod contacts;
+mod geometry;
+mod world;
+
+use bevy_rapier3d::rapier::prelude::{RigidBodyHandle, RigidBodySet, Vector};
+
+pub use contacts::closing_speed;
+pub use geometry::{Geometry, Wall};
+pub use world::SolverSettings;
+
+use crate::model::{Checks, Meter, Model, ModelError, OverBudget, RunOptions};
+use crate::oscillator::{gauss_legendre, Driven, Oscillator};
+use crate::run::{EnergyAccount, Impact, Recorder, Run};
+use crate::scene::{Body, Scene};
+use contacts::{Balls, Contact, FrameBody, Other};
+
+/// Default step of the spatial path, s: Rapier's steps are plastic and the bounces come from
+/// the impact law, so a millisecond resolves the flights between impacts of centimetre balls.
+pub const DEFAULT_SPATIAL_DT: f64 = 1e-3;
+/// Default solver iterations of the spatial path (Rapier's default).
+pub const DEFAULT_SPATIAL_ITERATIONS: usize = 4;
+/// Natural frequency of Rapier's contact springs, as a fraction of the step rate: with
+/// Rapier's default (30 Hz) the bed of scenes/particle-box.toml sinks by half a radius (2.4 mm
+/// deepest overlap over 0.5 s at a millisecond), at 60 Hz by a fifth; a quarter of the step
+/// rate (250 Hz at a millisecond) stays stable and keeps it to 2.4 % (0.12 mm).
+pub const CONTACT_FREQUENCY_PER_STEP_RATE: f64 = 0.25;
+/// Damping ratio of Rapier's contact springs (Rapier's default: overdamped, no rebound).
+pub const CONTACT_DAMPING_RATIO: f64 = 10.0;
+/// Pairs closer than this fraction of Rapier's length unit (the largest diameter) touch: the
+/// impacts of a step set touching pairs approaching, which then strike in turn.
+pub const TOUCHING_FRACTION: f64 = 2e-3;
+/// Energy the spatial path may gain, relative to the energy put in, besides what gravity does
+/// in Rapier's resting contacts (see [`energy_gain_allowance`]).
+pub const SPATIAL_ENERGY_GAIN: f64 = 1e-3;
+/// How deep Rapier's resting contacts may sink, as a fraction of a ball's radius: Rapier pushes
+/// sunk balls back out, lifting them by up to this much, which gravity turns into energy.
+pub const RESTING_SINK_FRACTION: f64 = 0.05;
+/// Steps between two looks at the budgets.
+const BUDGET_STEPS: u64 = 256;
+
+/// Whether `scene` goes to the spatial path: several chains, or anything a line cannot hold
+/// (balls off their chain's line, motion across, gravity, friction).
+pub fn needs_spatial(scene: &Scene) -> bool {
+    scene.space.chains() > 1 || scene.space.beyond_lines(&scene.initial_positions).is_some()
+}
+
+/// Why the spatial path cannot run `scene`, or `None` when it can.
+pub fn refusal(scene: &Scene) -> Option<String> {
+    if scene.frame.is_none() {
+        return Some("the scene has no frame; the spatial contact model needs a container on a frame".into());
+    }
+    if let Err(reason) = Geometry::new(scene) {
+        return Some(reason);
+    }
+    if scene.balls.is_empty() {
+        return Some("the scene has no balls".into());
+    }
+    if scene.rapier.stepping == Some(crate::scene::Stepping::Aligned) {
+        return Some(
+            "aligned stepping follows contacts on one line; the spatial contact model takes fixed steps (`rapier.stepping = \"fixed\"`)"
+                .into(),
+        );
+    }
+    if scene.rapier.ccd == Some(true) {
+        return Some("the spatial contact model finds contacts with Rapier's speculative margin and has no swept CCD".into());
+    }
+    None
+}
+
+/// Rapier's settings for `scene` on the spatial path: the scene's `[rapier] dt` (default
+/// [`DEFAULT_SPATIAL_DT`]) within the one-line path's bounds on the frame's motion, the
+/// largest ball's diameter as length unit, and contact springs stiffened to the step.
+pub fn solver_settings(scene: &Scene) -> SolverSettings {
+    let bounded = crate::rapier::settings(scene);
+    let dt = if scene.rapier.dt.is_some() { bounded.dt } else { bounded.dt.min(DEFAULT_SPATIAL_DT) };
+    let largest = scene.balls.iter().map(|b| b.radius).fold(0.0, f64::max);
+    SolverSettings {
+        dt,
+        length_unit: (2.0 * largest).max(1e-6),
+        solver_iterations: scene.rapier.solver_iterations.map_or(DEFAULT_SPATIAL_ITERATIONS, |i| i as usize),
+        contact_frequency: CONTACT_FREQUENCY_PER_STEP_RATE / dt,
+        contact_damping: CONTACT_DAMPING_RATIO,
+    }
+}
+
+/// Energy the spatial path may gain over a run of `scene`, J: [`SPATIAL_ENERGY_GAIN`] of the
+/// energy put in, plus every ball lifted by [`RESTING_SINK_FRACTION`] of its radius against
+/// gravity (Rapier pushing resting balls back out of the contacts they sank into).
+pub fn energy_gain_allowance(scene: &Scene, energy_in: f64) -> f64 {
+    let g = scene.space.gravity.iter().map(|c| c * c).sum::<f64>().sqrt();
+    let lift: f64 = scene.balls.iter().map(|b| b.mass * g * RESTING_SINK_FRACTION * b.radius).sum();
+    SPATIAL_ENERGY_GAIN * energy_in.abs() + lift
+}
+
+/// The tolerances a spatial run is checked with: its energy allowance, Rapier's resting sink
+/// as the overlap a ball may have with a wall, and the one-line path's momentum bound.
+pub fn checks(scene: &Scene, run: &Run) -> Checks {
+    let put_in = (run.energy.initial.abs() + run.energy.forcing_work.abs()).max(f64::MIN_POSITIVE);
+    let largest = scene.balls.iter().map(|b| b.radius).fold(0.0, f64::max);
+    let energy_gain = energy_gain_allowance(scene, put_in) / put_in;
+    Checks {
+        energy_gain,
+        // Rapier's contact losses (friction, plastic resting contacts) stay out of the
+        // account (see `SpatialReport::contact_loss`): the balance is not closed.
+        balance: None,
+        impact_gain: energy_gain,
+        exact_impacts: false,
+        momentum: 1e-5,
+        wall_overlap: RESTING_SINK_FRACTION * largest + 1e-6,
+        ball_overlap: None,
+        stall_by_rate: true,
+    }
+}
+
+/// What a spatial run measured besides its [`Run`].
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct SpatialReport {
+    /// Energy Rapier's contacts took beyond the impact law's losses, J: per step, the drop in
+    /// the balls' kinetic energy (rotation included) and the frame's energy jump, less
+    /// gravity's work on the balls' displacement and the impact law's losses of the step.
+    /// Friction, Rapier's plastic resting contacts and the explicit coupling of the frame end
+    /// up here. It is not in the run's `impact_loss`: the energy balance shows it.
+    pub contact_loss: f64,
+    /// The largest energy Rapier's contacts made in one step (the most negative per-step
+    /// contact loss, as a positive number), J.
+    pub worst_step_gain: f64,
+    /// The deepest a ball sank into a wall or another ball at a step's end, m.
+    pub deepest_overlap: f64,
+    /// Steps taken.
+    pub steps: u64,
+    /// Impacts found as new contacts.
+    pub new_contact_impacts: u64,
+    /// Impacts of touching pairs the new ones set approaching.
+    pub knock_on_impacts: u64,
+}
+
+/// Runs the spatial path on `scene` with its default settings.
+pub fn simulate_spatial(scene: &Scene, options: &RunOptions) -> Result<Run, ModelError> {
+    simulate_spatial_with(scene, solver_settings(scene), options).map(|(run, _)| run)
+}
+
+/// The balls' state as `f64` arrays, read from Rapier.
+struct BallState {
+    x: Vec<[f64; 3]>,
+    v: Vec<[f64; 3]>,
+    w: Vec<[f64; 3]>,
+}
+
+impl BallState {
+    fn read(&mut self, bodies: &RigidBodySet, handles: &[RigidBodyHandle]) {
+        for (k, &h) in handles.iter().enumerate() {
+            let b = &bodies[h];
+            let (p, v, w) = (b.translation(), b.linvel(), b.angvel());
+            self.x[k] = [p.x as f64, p.y as f64, p.z as f64];
+            self.v[k] = [v.x as f64, v.y as f64, v.z as f64];
+            self.w[k] = [w.x as f64, w.y as f64, w.z as f64];
+        }
+    }
+}
+
+/// The spatial path with given solver settings: the run and what it measured.
+pub fn simulate_spatial_with(scene: &Scene, solver: SolverSettings, options: &RunOptions) -> Result<(Run, SpatialReport), ModelError> {
+    if let Some(reason) = refusal(scene) {
+        return Err(ModelError::Refused(reason));
+    }
+    let geometry = Geometry::new(scene).map_err(ModelError::Refused)?;
+    let Some(f) = scene.frame else { return Err(ModelError::Refused("the scene has no frame".into())) };
+    let meter = Meter::new(options, BUDGET_STEPS);
+    let mut world = world::build(scene, &geometry, solver);
+    let n = scene.balls.len();
+    let mass: Vec<f64> = scene.balls.iter().map(|b| b.mass).collect();
+    let radius: Vec<f64> = scene.balls.iter().map(|b| b.radius).collect();
+    let inertia: Vec<f64> = scene.balls.iter().map(|b| 0.4 * b.mass * b.radius * b.radius).collect();
+    let g = scene.space.gravity;
+    let e = scene.restitution;
+    let motion = Driven::new(Oscillator::new(f.mass, f.damping, f.stiffness), scene.harmonic_load());
+    let mut now = BallState { x: vec![[0.0; 3]; n], v: vec![[0.0; 3]; n], w: vec![[0.0; 3]; n] };
+    now.read(&world.physics.bodies, &world.balls);
+    let start_positions = now.x.clone();
+    let mut before = BallState { x: now.x.clone(), v: now.v.clone(), w: now.w.clone() };
+    let (mut xs, mut vs) = (scene.initial_displacement, 0.0);
+    let (mut damping_loss, mut forcing_work, mut impact_loss) = (0.0, 0.0, 0.0);
+    let mut report = SpatialReport::default();
+    let mut impacts: Vec<Impact> = Vec::new();
+    let mut recorder = Recorder::new(scene, options.record);
+    let sample_count = scene.sample_count();
+    recorder.sample(scene, 0.0, xs, vs, |i| (scene.initial_positions[i], scene.initial_velocities[i]));
+    let mut next_sample = 1;
+    let touching = TOUCHING_FRACTION * solver.length_unit;
+    // Closings slower than gravity and the frame's acceleration build along a contact's
+    // normal in two steps are resting contacts, left to Rapier's plastic solve.
+    let frame_acceleration = crate::rapier::peak_frame_acceleration(scene);
+    let speed_floor = 1e-9 * geometry.speed;
+    let resting_speed =
+        |normal: [f64; 3]| 2.0 * (contacts_dot(g, normal).abs() + normal[0].abs() * frame_acceleration) * solver.dt + speed_floor;
+    let mut order = Vec::new();
+    // How fast pairs may close, m/s: twice the fastest expected speed.
+    let reach = 2.0 * geometry.speed;
+    let mut found: Vec<Contact> = Vec::new();
+    let mut kicked = vec![false; n];
+    // The knock-on cascade's scratch: each ball's touching contacts, the candidates, which are listed.
+    let mut by_ball: Vec<Vec<usize>> = vec![Vec::new(); n];
+    let (mut candidate, mut listed): (Vec<usize>, Vec<bool>) = (Vec::new(), Vec::new());
+    let energy_of = |state: &BallState, t: f64, xs: f64, vs: f64| -> f64 {
+        let mut e = scene.frame_energy(t, xs, vs);
+        for i in 0..n {
+            let (v, w, x, x0) = (state.v[i], state.w[i], state.x[i], start_positions[i]);
+            e += 0.5 * mass[i] * contacts_dot(v, v) + 0.5 * inertia[i] * contacts_dot(w, w);
+            // Gravity's potential energy, from the start: m g . (r0 - r).
+            e += mass[i] * contacts_dot(g, std::array::from_fn(|a| x0[a] - x[a]));
+        }
+        e
+    };
+    let initial_energy = scene.initial_energy();
+    let mut t = 0.0;
+    let mut steps: u64 = 0;
+    let finish = |t: f64,
+                  xs: f64,
+                  vs: f64,
+                  state: &BallState,
+                  recorder: Recorder,
+                  impacts: Vec<Impact>,
+                  damping_loss: f64,
+                  impact_loss: f64,
+                  forcing_work: f64,
+                  steps: u64| {
+        let final_ = energy_of(state, t, xs, vs);
+        let (series, motion) = recorder.finish();
+        Run {
+            scene: scene.name.clone(),
+            model: Model::Rapier,
+            horizon: t,
+            sample_dt: scene.sample_dt,
+            initial_displacement: scene.initial_displacement,
+            damped_period: f.damped_period(),
+            series,
+            motion,
+            impacts,
+            energy: EnergyAccount::forced(initial_energy, final_, damping_loss, impact_loss, forcing_work),
+            events: steps,
+            final_velocities: state.v.iter().map(|v| v[0]).collect(),
+            peak_true_acceleration: None,
+            wall_time_s: 0.0,
+        }
+    };
+    while t < scene.horizon * (1.0 - 1e-12) {
+        if let Some(budget) = meter.look(t, steps) {
+            let wall_s = meter.elapsed();
+            let cost = format!("{} impacts so far; {} balls in 3D at steps of {} s", impacts.len(), n, crate::scene::human(solver.dt));
+            let mut partial = finish(t, xs, vs, &now, recorder, impacts, damping_loss, impact_loss, forcing_work, steps);
+            partial.wall_time_s = wall_s;
+            return Err(ModelError::OverBudget(Box::new(OverBudget {
+                scene: scene.name.clone(),
+                model: Model::Rapier,
+                t,
+                horizon: scene.horizon,
+                steps,
+                wall_s,
+                budget,
+                limit: meter.limit(budget),
+                cost,
+                partial,
+            })));
+        }
+        let h = solver.dt.min(scene.horizon - t);
+        world.physics.integration_parameters.dt = h as f32;
+        // The frame to where its closed form is at the step's end; Rapier moves the walls
+        // there in a straight line.
+        let (t0, t1) = (t, t + h);
+        let (x1, v1) = motion.state(xs, vs, t0, t1);
+        if motion.xp.is_none() {
+            damping_loss += motion.osc.dissipated(xs, vs, h);
+        } else {
+            let (xa, va) = (xs, vs);
+            let [damping, work] = gauss_legendre(t0, t1, h, |tq| {
+                let (xq, vq) = motion.state(xa, va, t0, tq);
+                [scene.damping_power(tq, vq), scene.forcing_power(tq, xq, vq)]
+            });
+            damping_loss += damping;
+            forcing_work += work;
+        }
+        world.physics.bodies[world.frame].set_next_kinematic_translation(Vector::new(x1 as f32, 0.0, 0.0));
+        std::mem::swap(&mut before, &mut now);
+        world.physics.step();
+        now.read(&world.physics.bodies, &world.balls);
+        // Rapier's walls are infinitely heavy: the frame takes the opposite of the x momentum
+        // they gave the balls (ball-ball impulses cancel in the sum; gravity's is not theirs).
+        let dpx: f64 = (0..n).map(|i| mass[i] * (now.v[i][0] - before.v[i][0] - g[0] * h)).sum();
+        let mut frame = FrameBody { vs: v1 - dpx / f.mass, mass: f.mass };
+        // Pairs Rapier may have stopped: its speculative contacts slow a pair a little before
+        // it touches, within what it closes in a step or two.
+        contacts::find(&geometry, &now.x, &radius, x1, touching + reach * h, &mut order, &mut found);
+        // Contacts whose approach Rapier stopped, the fastest first.
+        let mean_vs = (x1 - xs) / h;
+        let mut new: Vec<Closing> = Vec::new();
+        for (k, c) in found.iter().enumerate() {
+            report.deepest_overlap = report.deepest_overlap.max(-c.gap);
+            let (gap0, w0, w_end, g_n) = match c.other {
+                Other::Ball(j) => {
+                    let d: [f64; 3] = std::array::from_fn(|a| before.x[j][a] - before.x[c.ball][a]);
+                    let dv: [f64; 3] = std::array::from_fn(|a| before.v[j][a] - before.v[c.ball][a]);
+                    let dv_end: [f64; 3] = std::array::from_fn(|a| now.v[j][a] - now.v[c.ball][a]);
+                    (
+                        contacts_dot(d, d).sqrt() - radius[c.ball] - radius[j],
+                        contacts_dot(dv, c.normal),
+                        contacts_dot(dv_end, c.normal),
+                        0.0,
+                    )
+                }
+                Other::Wall(wall) => {
+                    let p = before.x[c.ball];
+                    let (gap0, _) = geometry.gap(wall, [p[0] - xs, p[1], p[2]], radius[c.ball]);
+                    let wall_n = c.normal[0] * mean_vs;
+                    (
+                        gap0,
+                        wall_n - contacts_dot(before.v[c.ball], c.normal),
+                        wall_n - contacts_dot(now.v[c.ball], c.normal),
+                        contacts_dot(g, c.normal),
+                    )
+                }
+            };
+            // An impact is a contact Rapier's plastic solve stopped in this step: it was
+            // approaching faster than a resting contact, and the step took its approach.
+            let resting = resting_speed(c.normal);
+            let approach = closing_speed(gap0, w0, g_n, h);
+            let stopped = w_end - (w0 - g_n * h) > resting;
+            if approach > resting && stopped && c.gap <= touching + 2.0 * (-w0).max(0.0) * h {
+                new.push(Closing { approach, k, gap0, w0, g_n });
+            }
+        }
+        new.sort_by(|a, b| b.approach.total_cmp(&a.approach));
+        kicked.iter_mut().for_each(|k| *k = false);
+        let mut step_impact_loss = 0.0;
+        {
+            let mut balls = Balls { v: &mut now.v, mass: &mass };
+            // The frame's velocity as the impacts leave it one after the other (§3): each
+            // wall impact meets the frame as the impacts before it left it.
+            let mut frame_in_turn = mean_vs;
+            for closing in &new {
+                let c = found[closing.k];
+                let (approach, lost) = match c.other {
+                    Other::Ball(_) => (closing.approach, contacts::strike(&c, closing.approach, e, &mut balls, &mut frame)),
+                    Other::Wall(_) => {
+                        let n = c.normal;
+                        let w0 = closing.w0 + n[0] * (frame_in_turn - mean_vs);
+                        let approach = closing_speed(closing.gap0, w0, closing.g_n, h);
+                        if approach <= 0.0 {
+                            continue;
+                        }
+                        // Eq. 9-10 with the frame as it is at this impact's turn: the ball
+                        // leaves at the frame's normal velocity then, less `e` times the
+                        // approach, less the frame's share of the recoil.
+                        let (m, inv_frame) = (mass[c.ball], n[0] * n[0] / f.mass);
+                        let mu = 1.0 / (1.0 / m + inv_frame);
+                        let ball_after = n[0] * frame_in_turn + approach - (1.0 + e) * approach * mu / m;
+                        let ball_now = contacts_dot(balls.v[c.ball], n);
+                        contacts::push_apart(&c, m * (ball_now - ball_after), &mut balls, &mut frame);
+                        frame_in_turn += (1.0 + e) * approach * mu * n[0] / f.mass;
+                        (approach, 0.5 * (1.0 - e * e) * mu * approach * approach)
+                    }
+                };
+                step_impact_loss += lost;
+                impacts.push(impact_record(t1, &c, approach, lost));
+                report.new_contact_impacts += 1;
+                kicked[c.ball] = true;
+                if let Other::Ball(j) = c.other {
+                    kicked[j] = true;
+                }
+            }
+            // Touching pairs the impacts set approaching strike in turn, the fastest first (at
+            // a tie the first found). Only contacts of a struck ball can have been set
+            // approaching, so those are the candidates, added as their balls are struck: a
+            // cascade costs what it reaches, not every contact of the bed each time.
+            let cap = 4 * found.len() + 16;
+            if !new.is_empty() {
+                by_ball.iter_mut().for_each(|list| list.clear());
+                for (k, c) in found.iter().enumerate() {
+                    if c.gap <= touching {
+                        by_ball[c.ball].push(k);
+                        if let Other::Ball(j) = c.other {
+                            by_ball[j].push(k);
+                        }
+                    }
+                }
+                candidate.clear();
+                listed.clear();
+                listed.resize(found.len(), false);
+                let add = |i: usize, candidate: &mut Vec<usize>, listed: &mut Vec<bool>| {
+                    for &k in &by_ball[i] {
+                        if !listed[k] {
+                            listed[k] = true;
+                            candidate.push(k);
+                        }
+                    }
+                };
+                for i in 0..n {
+                    if kicked[i] {
+                        add(i, &mut candidate, &mut listed);
+                    }
+                }
+                for _ in 0..cap {
+                    let fastest = candidate
+                        .iter()
+                        .map(|&k| (contacts::relative(&found[k], &balls, &frame).0, k))
+                        .filter(|&(w, k)| w < -resting_speed(found[k].normal))
+                        .min_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
+                    let Some((w, k)) = fastest else { break };
+                    let c = found[k];
+                    let lost = contacts::strike(&c, -w, e, &mut balls, &mut frame);
+                    step_impact_loss += lost;
+                    impacts.push(impact_record(t1, &c, -w, lost));
+                    report.knock_on_impacts += 1;
+                    kicked[c.ball] = true;
+                    add(c.ball, &mut candidate, &mut listed);
+                    if let Other::Ball(j) = c.other {
+                        kicked[j] = true;
+                        add(j, &mut candidate, &mut listed);
+                    }
+                }
+            }
+        }
+        for (i, &h_ball) in world.balls.iter().enumerate() {
+            if kicked[i] {
+                let v = now.v[i];
+                world.physics.bodies[h_ball].set_linvel(Vector::new(v[0] as f32, v[1] as f32, v[2] as f32), true);
+                // What Rapier will read back: the f32 velocity.
+                let r = world.physics.bodies[h_ball].linvel();
+                now.v[i] = [r.x as f64, r.y as f64, r.z as f64];
+            }
+        }
+        impact_loss += step_impact_loss;
+        // Rapier's own contact loss this step (see `SpatialReport::contact_loss`).
+        let kinetic = |s: &BallState| -> f64 {
+            (0..n).map(|i| 0.5 * mass[i] * contacts_dot(s.v[i], s.v[i]) + 0.5 * inertia[i] * contacts_dot(s.w[i], s.w[i])).sum()
+        };
+        let gravity_work: f64 = (0..n).map(|i| mass[i] * contacts_dot(g, std::array::from_fn(|a| now.x[i][a] - before.x[i][a]))).sum();
+        let frame_jump = 0.5 * f.mass * (frame.vs * frame.vs - v1 * v1);
+        let step_loss = -(kinetic(&now) - kinetic(&before) - gravity_work + frame_jump) - step_impact_loss;
+        report.contact_loss += step_loss;
+        report.worst_step_gain = report.worst_step_gain.max(-step_loss);
+        // Samples in the step: the frame in closed form (impulses land at the step's end),
+        // the balls along their straight path with their old velocity.
+        while next_sample < sample_count {
+            let ts = next_sample as f64 * scene.sample_dt;
+            let at_end = (ts - t1).abs() <= 1e-9 * h;
+            if ts > t1 && !at_end {
+                break;
+            }
+            let (sx, sv) = if at_end { (x1, frame.vs) } else { motion.state(xs, vs, t0, ts.max(t0)) };
+            let wgt = ((ts - t0) / h).clamp(0.0, 1.0);
+            let (b, a) = (&before, &now);
+            recorder.sample(scene, ts, sx, sv, |i| {
+                if at_end {
+                    (a.x[i][0], a.v[i][0])
+                } else {
+                    (b.x[i][0] + wgt * (a.x[i][0] - b.x[i][0]), b.v[i][0])
+                }
+            });
+            next_sample += 1;
+        }
+        xs = x1;
+        vs = frame.vs;
+        t = t1;
+        steps += 1;
+        let energy = energy_of(&now, t, xs, vs);
+        let energy_in = initial_energy + forcing_work;
+        if energy > energy_in + energy_gain_allowance(scene, energy_in) {
+            return Err(ModelError::Unstable {
+                scene: scene.name.clone(),
+                model: Model::Rapier,
+                t,
+                reason: format!(
+                    "at t = {t:.6e} s the system holds {energy:.6e} J, more than the {energy_in:.6e} J put in and what Rapier's resting contacts may lift"
+                ),
+            });
+        }
+    }
+    meter.finish(scene.horizon, steps);
+    report.steps = steps;
+    let mut run = finish(t, xs, vs, &now, recorder, impacts, damping_loss, impact_loss, forcing_work, steps);
+    // The steps' sum ends within a relative 1e-12 of the horizon; the run covered it.
+    run.horizon = scene.horizon;
+    run.wall_time_s = meter.elapsed();
+    Ok((run, report))
+}
+
+/// A contact Rapier stopped in the step: its closing speed and what it was computed from.
+struct Closing {
+    /// Approach speed at closing, m/s.
+    approach: f64,
+    /// Index of the contact.
+    k: usize,
+    /// Gap at the step's start, m.
+    gap0: f64,
+    /// Relative normal velocity at the step's start, m/s.
+    w0: f64,
+    /// Gravity along the normal (towards a wall), m/s^2.
+    g_n: f64,
+}
+
+fn contacts_dot(a: [f64; 3], b: [f64; 3]) -> f64 {
+    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
+}
+
+/// The impact of contact `c` at time `t`, named as the run lists its pairs: the left wall
+/// before the ball, the right wall and the side walls after it.
+fn impact_record(t: f64, c: &Contact, approach: f64, lost: f64) -> Impact {
+    let (a, b) = match c.other {
+        Other::Ball(j) => (Body::Ball(c.ball), Body::Ball(j)),
+        Other::Wall(Wall::Left) => (Body::LeftWall, Body::Ball(c.ball)),
+        Other::Wall(wall) => (Body::Ball(c.ball), wall.body()),
+    };
+    Impact { t, a, b, approach_speed: approach, energy_lost: lost, impulses: 1, peak_force: None, contact_duration: None }
+}
