@@ -93,6 +93,12 @@ impl std::str::FromStr for Parameter {
 }
 
 impl Parameter {
+    /// Whether its values are whole numbers (a count, as the number of chains): a study
+    /// refines it over the whole numbers, never between them.
+    pub fn is_count(self) -> bool {
+        self == Parameter::Chains
+    }
+
     /// The parameter whose value a scene file's field holds (`balls.container_length` holds
     /// the clearance through Eq. 11).
     pub fn of_field(field: &str) -> Option<Parameter> {

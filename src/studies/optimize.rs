@@ -144,10 +144,15 @@ pub fn optimize(
             grid = grid
                 .iter()
                 .zip(&best.values)
-                .map(|(values, (_, v))| {
+                .zip(axes)
+                .map(|((values, (_, v)), axis)| {
                     let k = values.iter().position(|x| x.raw() == *v).unwrap_or(0);
                     let lo = values[k.saturating_sub(1)];
                     let hi = values[(k + 1).min(values.len() - 1)];
+                    // A count (the number of chains) is refined over the whole numbers between.
+                    if axis.parameter.is_count() {
+                        return (lo.raw().round() as i64..=hi.raw().round() as i64).map(|c| Length::Metres(c as f64)).collect();
+                    }
                     (0..REFINE_POINTS)
                         .map(|i| {
                             let x = crate::studies::sweep::tidy(lo.raw() + (hi.raw() - lo.raw()) * i as f64 / (REFINE_POINTS - 1) as f64);

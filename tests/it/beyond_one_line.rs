@@ -160,3 +160,16 @@ fn one_dimensional_models_refuse_what_they_cannot_represent() {
     let swapped = scene_from_toml(&line.replace("[0.02,", "[first,").replace("[0.07,", "[0.02,").replace("[first,", "[0.07,"));
     assert!(Model::Reference.supports(&swapped).unwrap_err().contains("left to right"));
 }
+
+#[test]
+fn optimize_chooses_the_number_of_chains_among_whole_numbers() {
+    // Refinement between 1 and 3 chains visits 2, never 1.5 (which is no scene).
+    let o = lpc(["optimize", "scenes/lpc-lsl.toml", "--vary", "chains=1,3", "--format", "json"]);
+    assert_eq!(o.status.code(), Some(0), "{}", String::from_utf8_lossy(&o.stderr));
+    let report: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    let chains: Vec<f64> = report["ranking"].as_array().unwrap().iter().map(|d| d["values"][0][1].as_f64().unwrap()).collect();
+    assert!(chains.iter().all(|c| c.fract() == 0.0), "{chains:?}");
+    let mut seen = chains.clone();
+    seen.sort_by(f64::total_cmp);
+    assert_eq!(seen, vec![1.0, 2.0, 3.0]);
+}
