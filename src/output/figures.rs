@@ -289,29 +289,45 @@ pub fn time_histories(with: &Run, without: Option<&Run>) -> Vec<Figure> {
 }
 
 /// Fig. 12: each ball's centre relative to the container's left wall, with the walls' inner
-/// faces when the container length is known.
-pub fn ball_positions(run: &Run, container_length: Option<f64>) -> Figure {
+/// faces when the container length is known; one figure per chain (`chains` the balls of each,
+/// in order), named `positions` for one chain and `positions-chainK` for several.
+pub fn ball_positions(run: &Run, container_length: Option<f64>, chains: &[std::ops::Range<usize>]) -> Vec<Figure> {
     let s = &run.series;
-    let mut curves: Vec<Curve> = (0..s.balls())
-        .map(|i| Curve {
-            label: format!("ball{}", i + 1),
-            x: s.t().to_vec(),
-            y: s.x(i).iter().zip(s.xs()).map(|(x, xs)| (x - xs) * 1e3).collect(),
+    // Without several chains, every ball in one figure.
+    let all: Vec<std::ops::Range<usize>> = std::iter::once(0..s.balls()).collect();
+    let chains = if chains.len() > 1 { chains } else { &all[..] };
+    chains
+        .iter()
+        .enumerate()
+        .map(|(k, chain)| {
+            let mut curves: Vec<Curve> = chain
+                .clone()
+                .map(|i| Curve {
+                    label: format!("ball{}", i + 1),
+                    x: s.t().to_vec(),
+                    y: s.x(i).iter().zip(s.xs()).map(|(x, xs)| (x - xs) * 1e3).collect(),
+                })
+                .collect();
+            if let Some(l) = container_length {
+                let ends = vec![s.t().first().copied().unwrap_or(0.0), s.t().last().copied().unwrap_or(0.0)];
+                curves.push(Curve { label: "left wall".into(), x: ends.clone(), y: vec![0.0, 0.0] });
+                curves.push(Curve { label: "right wall".into(), x: ends, y: vec![l * 1e3, l * 1e3] });
+            }
+            let several = chains.len() > 1;
+            Figure {
+                name: if several { format!("positions-chain{}", k + 1) } else { "positions".into() },
+                title: if several {
+                    format!("{}: chain {}'s ball centres in the container ({})", run.scene, k + 1, run.model)
+                } else {
+                    format!("{}: ball centres in the container ({})", run.scene, run.model)
+                },
+                x_desc: "t (s)".into(),
+                y_desc: "x - xs (mm)".into(),
+                curves,
+                points: false,
+            }
         })
-        .collect();
-    if let Some(l) = container_length {
-        let ends = vec![s.t().first().copied().unwrap_or(0.0), s.t().last().copied().unwrap_or(0.0)];
-        curves.push(Curve { label: "left wall".into(), x: ends.clone(), y: vec![0.0, 0.0] });
-        curves.push(Curve { label: "right wall".into(), x: ends, y: vec![l * 1e3, l * 1e3] });
-    }
-    Figure {
-        name: "positions".into(),
-        title: format!("{}: ball centres in the container ({})", run.scene, run.model),
-        x_desc: "t (s)".into(),
-        y_desc: "x - xs (mm)".into(),
-        curves,
-        points: false,
-    }
+        .collect()
 }
 
 /// Figs. 13-16: the frame displacement for each value of a swept parameter.

@@ -173,3 +173,14 @@ fn optimize_chooses_the_number_of_chains_among_whole_numbers() {
     seen.sort_by(f64::total_cmp);
     assert_eq!(seen, vec![1.0, 2.0, 3.0]);
 }
+
+#[test]
+fn plots_show_each_chain_on_its_own() {
+    let dir = tempfile::tempdir().unwrap();
+    let o = lpc(["plot".as_ref(), "scenes/lpc-lsl-3chains.toml".as_ref(), "--out".as_ref(), dir.path().as_os_str()]);
+    assert_eq!(o.status.code(), Some(0), "{}", String::from_utf8_lossy(&o.stderr));
+    for k in 1..=3 {
+        assert!(dir.path().join(format!("positions-chain{k}.png")).is_file(), "no figure of chain {k}");
+    }
+    assert!(!dir.path().join("positions.png").exists());
+}

@@ -50,7 +50,7 @@ pub fn run(a: Args) -> Result<ExitStatus> {
             let mut run = lpc_damper::run::Run::empty(&name_of(&a.input, "scene").unwrap_or_else(|| "run".into()), model);
             run.series = s;
             figs.extend(figures::time_histories(&run, None));
-            figs.push(figures::ball_positions(&run, None));
+            figs.extend(figures::ball_positions(&run, None, &[]));
             // `lpc run --ensemble --out`: the members' band over the nominal run.
             let band = a.input.join("band.csv");
             if band.is_file() {
@@ -110,7 +110,8 @@ pub fn run(a: Args) -> Result<ExitStatus> {
             let bare = crate::watch::watched(lpc_damper::Model::Reference, &s.without_damper(), RunOptions::limited(limits), None)?;
             figs.extend(figures::time_histories(&run, (!s.balls.is_empty()).then_some(&bare)));
             if !s.balls.is_empty() {
-                figs.push(figures::ball_positions(&run, s.container.map(|c| c.length)));
+                let chains: Vec<_> = (0..s.space.chains()).map(|k| s.space.chain(k, s.balls.len())).collect();
+                figs.extend(figures::ball_positions(&run, s.container.map(|c| c.length), &chains));
             }
         }
     }
