@@ -24,6 +24,11 @@ pub fn write_series_csv(run: &Run, out: &mut dyn Write) -> std::io::Result<()> {
         header.push(format!("x{}", i + 1));
         header.push(format!("v{}", i + 1));
     }
+    // Balls moving across the motion: their `y` and `z` after every ball's `x` and `v`.
+    for i in 0..s.balls() * s.has_across() as usize {
+        header.push(format!("y{}", i + 1));
+        header.push(format!("z{}", i + 1));
+    }
     w.write_record(&header)?;
     let mut row = Vec::with_capacity(header.len());
     for k in 0..s.len() {
@@ -32,6 +37,9 @@ pub fn write_series_csv(run: &Run, out: &mut dyn Write) -> std::io::Result<()> {
         for i in 0..s.balls() {
             row.push(s.x(i)[k].to_string());
             row.push(s.v(i)[k].to_string());
+        }
+        for i in 0..s.balls() * s.has_across() as usize {
+            row.extend(s.across(i, k).iter().map(|x| x.to_string()));
         }
         w.write_record(&row)?;
     }

@@ -316,9 +316,14 @@ pub fn pose(
             }
         }
     };
+    let series = &playback.run.series;
+    let k = playback.sample.min(series.len().saturating_sub(1));
     for (b, mut t, m) in &mut balls {
         if let Some(&xi) = x.get(b.0) {
-            t.translation = layout.ball(xi, b.1);
+            // Balls that move across the motion are where the series has them; balls on lines
+            // stay at their place across.
+            let across = if series.has_across() { series.across(b.0, k) } else { b.1 };
+            t.translation = layout.ball(xi, across);
         }
         glow(m, playback.flashing(Body::Ball(b.0)));
     }

@@ -5,10 +5,17 @@
 use crate::scene::Scene;
 
 /// Bytes the series of a run of `scene` take in memory (and, as text, several times that in
-/// `series.csv`): each sample holds `t`, `xs`, `vs`, `a` and every ball's `x` and `v`, eight
-/// bytes each. Impacts add about 80 bytes each, which no scene's series comes near.
+/// `series.csv`): each sample holds `t`, `xs`, `vs`, `a` and every ball's `x` and `v` (and its
+/// `y` and `z` in a scene beyond one line), eight bytes each. Impacts add about 80 bytes each,
+/// which no scene's series comes near.
 pub fn series_bytes(scene: &Scene) -> f64 {
-    scene.sample_count() as f64 * (4.0 + 2.0 * scene.balls.len() as f64) * 8.0
+    scene.sample_count() as f64 * sample_bytes(scene) as f64
+}
+
+/// Bytes one sample of `scene`'s series takes.
+fn sample_bytes(scene: &Scene) -> usize {
+    let per_ball = if scene.space.is_spatial() { 4 } else { 2 };
+    (4 + per_ball * scene.balls.len()) * 8
 }
 
 /// Share of the memory available that a run's series may take: the rest is the model's own
@@ -95,7 +102,7 @@ pub fn check_memory(scene: &Scene) -> Result<(), String> {
             scene.name,
             crate::scene::human(scene.sample_count() as f64),
             scene.balls.len(),
-            (4 + 2 * scene.balls.len()) * 8,
+            sample_bytes(scene),
         );
         beyond_memory(need, available, &what, "raise run.sample_dt, shorten the horizon or use fewer balls")
     })

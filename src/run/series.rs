@@ -24,6 +24,10 @@ pub struct Series {
     /// hand: all of them): more when the whole series would not fit in memory
     /// ([`series_every`]). The metrics always see every sample.
     pub every: usize,
+    /// Each kept sample's balls' centres across the motion, `y1, z1, y2, z2, ...` sample after
+    /// sample; empty unless the model moves balls across the motion (the Rapier model's
+    /// spatial path).
+    across: Vec<f64>,
 }
 
 /// Columns before the balls': `t`, `xs`, `vs`, `a`.
@@ -35,13 +39,14 @@ impl PartialEq for Series {
             && self.balls == other.balls
             && self.every == other.every
             && (0..self.columns()).all(|c| self.column(c) == other.column(c))
+            && self.across == other.across
     }
 }
 
 impl Series {
     /// An empty series with room for `samples` samples of `balls` balls.
     pub fn with_capacity(balls: usize, samples: usize) -> Self {
-        Series { data: vec![0.0; (FRAME_COLUMNS + 2 * balls) * samples], capacity: samples, len: 0, balls, every: 1 }
+        Series { data: vec![0.0; (FRAME_COLUMNS + 2 * balls) * samples], capacity: samples, len: 0, balls, every: 1, across: vec![] }
     }
     /// A series of the given columns (all of one length): times, the frame's displacement,
     /// velocity and acceleration, and each ball's centre and velocity.
@@ -108,6 +113,19 @@ impl Series {
     /// Ball `i`'s velocity, m/s.
     pub fn v(&self, i: usize) -> &[f64] {
         self.column(self.v_column(i))
+    }
+    /// Whether the series has the balls' centres across the motion ([`Series::across`]).
+    pub fn has_across(&self) -> bool {
+        !self.across.is_empty()
+    }
+    /// Ball `i`'s centre across the motion at sample `k`, `[y, z]`, m (the container's axis at
+    /// 0); `[0, 0]` when the series has none.
+    pub fn across(&self, i: usize, k: usize) -> [f64; 2] {
+        let at = 2 * (k * self.balls + i);
+        match self.across.get(at..at + 2) {
+            Some(yz) => [yz[0], yz[1]],
+            None => [0.0; 2],
+        }
     }
     /// Every column, as vectors: `t`, `xs`, `vs`, `a`, then every ball's `x`, then every ball's `v`.
     pub fn into_columns(self) -> Vec<Vec<f64>> {
@@ -249,6 +267,8 @@ pub struct Recorder {
     taken: usize,
     /// `None` when the model computes the metrics itself ([`Recorder::untallied`]).
     tally: Option<SampleTally>,
+    /// Whether the series kept the last sample taken (for [`Recorder::sample_across`]).
+    kept_last: bool,
     masses: Vec<f64>,
     /// Scratch: the frame's acceleration at each sample of an interval.
     accelerations: Vec<f64>,
@@ -268,6 +288,7 @@ impl Recorder {
             series,
             taken: 0,
             tally: Some(SampleTally::new(scene)),
+            kept_last: false,
             masses: scene.balls.iter().map(|b| b.mass).collect(),
             accelerations: Vec::new(),
         }
@@ -289,6 +310,7 @@ impl Recorder {
         let wants_energy = self.tally.as_ref().is_some_and(|t| t.wants_energy());
         let mut kinetic = 0.0;
         let kept = self.series.as_mut().filter(|s| self.taken.is_multiple_of(s.every.max(1)));
+        self.kept_last = kept.is_some();
         self.taken += 1;
         if let Some(s) = kept {
             s.push(t, xs, vs, a, |i| {
@@ -305,6 +327,13 @@ impl Recorder {
         let energy = if wants_energy { scene.frame_energy(t, xs, vs) + kinetic } else { 0.0 };
         if let Some(tally) = &mut self.tally {
             tally.add(t, xs, a, energy);
+        }
+    }
+    /// The balls' centres across the motion, `[y, z]` from `across(i)`, at the sample
+    /// [`Recorder::sample`] has just taken (kept with it, or not at all).
+    pub fn sample_across(&mut self, across: impl Fn(usize) -> [f64; 2]) {
+        if let (true, Some(s)) = (self.kept_last, &mut self.series) {
+            s.across.extend((0..s.balls).flat_map(across));
         }
     }
     /// Samples `first, first + 1, ...` (at `k sample_dt`) of an interval in which the frame is

@@ -184,3 +184,32 @@ fn plots_show_each_chain_on_its_own() {
     }
     assert!(!dir.path().join("positions.png").exists());
 }
+
+#[test]
+fn balls_moving_across_the_motion_write_where_they_are() {
+    // A ball dropped in a box: the series carries its height, falling as gravity says until
+    // it first meets the floor, and series.csv writes it after every ball's x and v.
+    let text = bed_scene(
+        "gravity = [0.0, 0.0, -9.81]\n[[ball]]\nposition = [0.05, 0.005, 0.008]\nmass = 0.004\nradius = 0.005\n[rapier]\ndt = 0.0001\n",
+    );
+    let scene = scene_from_toml(&text);
+    let run = Model::Rapier.simulate(&scene, &lpc_damper::model::RunOptions::default()).unwrap();
+    let s = &run.series;
+    assert!(s.has_across());
+    // Free fall from z0 = 8 mm to the floor's contact at z = -15 + 5 = -10 mm takes
+    // sqrt(2 x 0.018 / 9.81) = 60.6 ms; at 40 ms the ball has fallen g t^2 / 2 = 7.85 mm.
+    let k = s.t().iter().position(|t| (t - 0.04).abs() < 1e-9).unwrap();
+    let [y, z] = s.across(0, k);
+    assert!((y - 0.005).abs() <= 1e-6, "y {y}");
+    // Rapier integrates gravity with symplectic Euler: the position lags by g h t / 2 at most.
+    let expect = 0.008 - 0.5 * 9.81 * 0.04f64.powi(2);
+    assert!((z - expect).abs() <= 0.5 * 9.81 * 1e-4 * 0.04 + 1e-6, "z {z} vs {expect}");
+    let dir = tempfile::tempdir().unwrap();
+    let file = dir.path().join("drop.toml");
+    std::fs::write(&file, text.replace("horizon = 0.1", "horizon = 0.01")).unwrap();
+    let out = dir.path().join("out");
+    let o = lpc(["run".as_ref(), file.as_os_str(), "--model".as_ref(), "rapier".as_ref(), "--out".as_ref(), out.as_os_str()]);
+    assert_eq!(o.status.code(), Some(0), "{}", String::from_utf8_lossy(&o.stderr));
+    let csv = std::fs::read_to_string(out.join("series.csv")).unwrap();
+    assert!(csv.lines().next().unwrap().ends_with("x1,v1,y1,z1"), "{}", csv.lines().next().unwrap());
+}

@@ -197,6 +197,7 @@ pub fn simulate_spatial_with(scene: &Scene, solver: SolverSettings, options: &Ru
     let mut recorder = Recorder::new(scene, options.record);
     let sample_count = scene.sample_count();
     recorder.sample(scene, 0.0, xs, vs, |i| (scene.initial_positions[i], scene.initial_velocities[i]));
+    recorder.sample_across(|i| scene.space.lateral_of(i));
     let mut next_sample = 1;
     let touching = TOUCHING_FRACTION * solver.length_unit;
     // Closings slower than gravity and the frame's acceleration build along a contact's
@@ -467,6 +468,10 @@ pub fn simulate_spatial_with(scene: &Scene, solver: SolverSettings, options: &Ru
                 } else {
                     (b.x[i][0] + wgt * (a.x[i][0] - b.x[i][0]), b.v[i][0])
                 }
+            });
+            recorder.sample_across(|i| {
+                let at = |k: usize| if at_end { a.x[i][k] } else { b.x[i][k] + wgt * (a.x[i][k] - b.x[i][k]) };
+                [at(1), at(2)]
             });
             next_sample += 1;
         }
