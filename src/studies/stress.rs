@@ -11,7 +11,7 @@ use serde::Serialize;
 
 use crate::model::{Limits, Model, ModelError, RunOptions};
 use crate::run::Run;
-use crate::scene::format::{BallsFile, ForcingFile, FrameFile, RunFile};
+use crate::scene::format::{BallsFile, BedFile, ContainerFile, ForcingFile, FrameFile, Placement, RunFile, WorldFile};
 use crate::scene::{self, Arrangement, ForcingKind, Length, Scene, SceneFile};
 
 /// Most events (reference) or steps (Rapier) per simulated second before a run counts as
@@ -65,6 +65,41 @@ pub struct Draws {
     pub max_wall_s: Option<f64>,
     /// Each scene as 1 to 4 copies of its chain side by side ([`with_chains`]).
     pub chains: bool,
+    /// Each scene's balls as a bed in a box, under gravity and friction ([`with_bed`]).
+    pub beds: bool,
+}
+
+/// `file` with its balls as a bed, drawn from a stream of its own (seeded from `seed` alone):
+/// 2 to 200 balls of one or two sizes (radii 2 to 8 mm) filling 20 to 70 % of the cells of a
+/// lattice in a box sized to hold them (up to twice as long), on the lattice or (at most 40 %
+/// of the cells) at random; gravity along -z three times in four; friction 0 to 0.5 (none a
+/// quarter of the time); the drawn restitution, frame and forcing.
+pub fn with_bed(mut file: SceneFile, seed: u64) -> SceneFile {
+    let mut rng = Pcg64::seed_from_u64(seed ^ 0xbed0_0000_0000_0000);
+    let Some(balls) = file.balls.take() else { return file };
+    let count = (rng.random_range(2f64.ln()..200f64.ln())).exp().round() as u32;
+    let radius = rng.random_range(0.002..0.008);
+    let radii = if rng.random_bool(0.5) { vec![radius] } else { vec![radius, radius * rng.random_range(0.4..0.9)] };
+    let fill = rng.random_range(0.2..0.7);
+    let side = (count as f64 / fill).cbrt().ceil();
+    let pitch = 2.0 * radius * 1.01;
+    let length = side * pitch * rng.random_range(1.0..2.0);
+    let gravity = if rng.random_bool(0.75) { [0.0, 0.0, -9.81] } else { [0.0; 3] };
+    let friction = if rng.random_bool(0.25) { 0.0 } else { rng.random_range(0.0..0.5) };
+    let placement = if fill <= 0.4 && rng.random_bool(0.5) { Placement::Random } else { Placement::Lattice };
+    file.container = Some(ContainerFile {
+        length: Some(Length::Metres(length)),
+        width: Some(Length::Metres(side * pitch)),
+        height: Some(Length::Metres(side * pitch)),
+    });
+    file.world = Some(WorldFile { gravity: Some(gravity), friction: Some(friction), restitution: Some(balls.restitution) });
+    file.bed =
+        Some(BedFile { count: Some(count), fill_fraction: None, radii, proportions: None, density: 7800.0, placement, seed: Some(seed) });
+    // A bed has no reference radius: the displacement drawn in Rr is put in metres.
+    if let Some(frame) = file.frame.as_mut() {
+        frame.initial_displacement = Length::Metres(frame.initial_displacement.metres(crate::scene::ball_radius(0.11, 8000.0)));
+    }
+    file
 }
 
 /// `file` with its arrangement as 1 to 4 chains side by side, drawn from a stream of its own
@@ -300,6 +335,8 @@ pub fn judge(model: Model, scene: &Scene, run: &Run) -> Result<(), Failure> {
             }
         }
     }
+    // Balls on lines can be checked pair by pair along x; a bed's balls only against the walls.
+    let on_lines = scene.space.beyond_lines(&scene.initial_positions).is_none();
     if let Some(c) = scene.container {
         let tol = checks.wall_overlap;
         for k in 0..s.len() {
@@ -311,7 +348,7 @@ pub fn judge(model: Model, scene: &Scene, run: &Run) -> Result<(), Failure> {
                 // A chain's first ball has no left neighbour (the last ball of the chain
                 // before it is in another channel).
                 let first_of_chain = scene.space.chain_starts.binary_search(&i).is_ok();
-                if let (Some(tol), true) = (checks.ball_overlap, i > 0 && !first_of_chain) {
+                if let (Some(tol), true) = (checks.ball_overlap, on_lines && i > 0 && !first_of_chain) {
                     // Balls never pass each other (docs/MODEL.md §1).
                     let g = (s.x(i)[k] - b.radius) - (s.x(i - 1)[k] + scene.balls[i - 1].radius);
                     if g < -tol {
@@ -345,6 +382,22 @@ fn validate(file: &SceneFile) -> Result<Scene, String> {
 /// Smaller and simpler variants of a scene file, for shrinking.
 fn simplifications(f: &SceneFile) -> Vec<SceneFile> {
     let mut out = vec![];
+    let horizon = f.run.horizon.unwrap_or(5.0);
+    if let Some(bed) = &f.bed {
+        // A bed: fewer balls, a shorter run.
+        if let Some(count) = bed.count.filter(|&c| c > 1) {
+            let mut g = f.clone();
+            g.bed.as_mut().unwrap().count = Some(count / 2);
+            out.push(g);
+        }
+        if horizon > 0.01 {
+            let mut g = f.clone();
+            g.run.horizon = Some(horizon / 2.0);
+            g.run.sample_dt = Some((horizon / 2.0 / 2000.0).max(1e-5));
+            out.push(g);
+        }
+        return out;
+    }
     let balls = f.balls.as_ref().expect("damper");
     if let Arrangement::Letters(l) = &balls.arrangement {
         for cut in [l.len() / 2, l.len() - 1] {
@@ -411,6 +464,7 @@ pub fn stress(model: Model, seed: u64, count: u64, draws: Draws, progress: &(dyn
                 random_scene_file(s, draws.max_horizon, draws.forced)
             };
             let file = if draws.chains { with_chains(file, s) } else { file };
+            let file = if draws.beds { with_bed(file, s) } else { file };
             let start = std::time::Instant::now();
             let outcome = |failure: Option<Failure>, minimal_scene, refused, refused_during_run, stopped, wall_s| Outcome {
                 seed: s,

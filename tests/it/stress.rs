@@ -26,7 +26,7 @@ fn three_hundred_random_scenes_pass_every_check() {
         Model::Reference,
         1,
         300,
-        Draws { max_horizon: 2.0, forced: false, extreme: false, max_wall_s: None, chains: false },
+        Draws { max_horizon: 2.0, forced: false, extreme: false, max_wall_s: None, chains: false, beds: false },
         &|| {},
     ));
     // The same scenes as 1 to 4 chains side by side.
@@ -34,7 +34,7 @@ fn three_hundred_random_scenes_pass_every_check() {
         Model::Reference,
         1,
         100,
-        Draws { max_horizon: 2.0, forced: false, extreme: false, max_wall_s: None, chains: true },
+        Draws { max_horizon: 2.0, forced: false, extreme: false, max_wall_s: None, chains: true, beds: false },
         &|| {},
     ));
 }
@@ -49,7 +49,7 @@ fn forced_random_scenes_pass_every_check() {
         Model::Reference,
         1,
         100,
-        Draws { max_horizon: 2.0, forced: true, extreme: false, max_wall_s: None, chains: false },
+        Draws { max_horizon: 2.0, forced: true, extreme: false, max_wall_s: None, chains: false, beds: false },
         &|| {},
     ));
 }
@@ -72,7 +72,20 @@ fn contact_model_passes_the_first_seeded_scenes() {
         Model::Rapier,
         1,
         25,
-        Draws { max_horizon: 1.0, forced: false, extreme: false, max_wall_s: None, chains: false },
+        Draws { max_horizon: 1.0, forced: false, extreme: false, max_wall_s: None, chains: false, beds: false },
+        &|| {},
+    ));
+}
+
+#[test]
+fn contact_model_passes_the_first_seeded_beds() {
+    // Beds in boxes, under gravity and friction, some shaken by frames swinging at hundreds of
+    // metres per second (seeds 1-10 of `lpc stress --beds`).
+    assert_all_pass(&stress(
+        Model::Rapier,
+        1,
+        10,
+        Draws { max_horizon: 1.0, forced: false, extreme: false, max_wall_s: None, chains: false, beds: true },
         &|| {},
     ));
 }
@@ -84,7 +97,8 @@ fn contact_model_passes_the_first_seeded_scenes() {
 /// (Whether a run finishes within its budget depends on the machine; what is asserted does not.)
 #[test]
 fn extreme_scenes_pass_refuse_or_stop_never_panic() {
-    let draws = |max_wall_s| Draws { max_horizon: 100.0, forced: false, extreme: true, max_wall_s: Some(max_wall_s), chains: false };
+    let draws =
+        |max_wall_s| Draws { max_horizon: 100.0, forced: false, extreme: true, max_wall_s: Some(max_wall_s), chains: false, beds: false };
     assert_all_pass(&stress(Model::Reference, 1, 24, draws(1.0), &|| {}));
     for model in [Model::Rapier, Model::Compliant] {
         for o in stress(model, 1, 6, draws(0.5), &|| {}) {

@@ -47,6 +47,9 @@ pub const SPATIAL_ENERGY_GAIN: f64 = 1e-3;
 /// How deep Rapier's resting contacts may sink, as a fraction of a ball's radius: Rapier pushes
 /// sunk balls back out, lifting them by up to this much, which gravity turns into energy.
 pub const RESTING_SINK_FRACTION: f64 = 0.05;
+/// The most the fastest motion of a scene may carry a body in one step, as a fraction of the
+/// smallest ball's radius.
+pub const STEP_TRAVEL: f64 = 0.2;
 /// Steps between two looks at the budgets.
 const BUDGET_STEPS: u64 = 256;
 
@@ -86,6 +89,11 @@ pub fn solver_settings(scene: &Scene) -> SolverSettings {
     let bounded = crate::rapier::settings(scene);
     let dt = if scene.rapier.dt.is_some() { bounded.dt } else { bounded.dt.min(DEFAULT_SPATIAL_DT) };
     let largest = scene.balls.iter().map(|b| b.radius).fold(0.0, f64::max);
+    // Nothing may cross more than a fraction of the smallest ball in a step at the scene's
+    // speed: Rapier's speculative contacts and stiffened springs catch that much, no more (a
+    // wall swung at hundreds of metres per second otherwise passes through balls).
+    let smallest = scene.balls.iter().map(|b| b.radius).fold(f64::INFINITY, f64::min);
+    let dt = if smallest.is_finite() { dt.min(STEP_TRAVEL * smallest / scene.speed_scale()) } else { dt };
     SolverSettings {
         dt,
         length_unit: (2.0 * largest).max(1e-6),

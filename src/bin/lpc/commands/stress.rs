@@ -35,6 +35,10 @@ pub struct Args {
     /// scene as without the flag).
     #[arg(long, conflicts_with = "extreme")]
     chains: bool,
+    /// Draw each plausible scene's balls as a bed in a box instead (2-200 balls of one or two
+    /// sizes, on a lattice or at random, gravity three times in four, friction 0-0.5).
+    #[arg(long, conflicts_with_all = ["extreme", "chains"])]
+    beds: bool,
     /// Seconds of computing each run may take; a run that takes longer stops (a typed stop,
     /// counted apart from passes and failures). Default: none, 10 s with --extreme.
     #[arg(long, value_name = "S")]
@@ -67,6 +71,7 @@ pub fn run(a: Args) -> Result<ExitStatus> {
         forced: a.forced,
         extreme: a.extreme,
         chains: a.chains,
+        beds: a.beds,
         max_wall_s: a.max_wall_time.or(a.extreme.then_some(10.0)),
     };
     let mut outcomes = Vec::new();
