@@ -210,7 +210,7 @@ impl Solver<'_> {
 
     /// What `resolve` needs of pair `p` now: the speed at which it approaches when it touches
     /// (`None` when it does not touch, does not approach, or drifts off a wall that
-    /// accelerates away, see [`Solver::reopens`]), and whether the frame presses it together.
+    /// accelerates away, see [`Limits::reopens`]), and whether the frame presses it together.
     #[inline(always)]
     pub(super) fn contact_now(&self, p: usize) -> Contact {
         self.contact_of(self.pair_now(p))
@@ -226,7 +226,7 @@ impl Solver<'_> {
         if g > tol {
             return Contact { approach: None, pressed: false, frame };
         }
-        let drifting_off = curvature.is_some_and(|c| self.reopens(rate, c));
+        let drifting_off = curvature.is_some_and(|c| self.limits.reopens(rate, c));
         Contact {
             approach: (rate < 0.0 && !drifting_off).then_some(-rate),
             pressed: curvature.is_some_and(|c| c < 0.0) && rate < self.limits.v_stick,

@@ -28,7 +28,7 @@ pub(super) struct Limits {
     pub(super) v_stick: f64,
     /// The scene's speed scale, raised to the fastest approach of any impact so far: the
     /// speed at which contacts can be placed no closer than two ulps of time (see
-    /// [`Solver::frame_gap_tolerance`]). It never falls, so bodies that met fast and move on
+    /// [`FrameGap::with_tolerance`]). It never falls, so bodies that met fast and move on
     /// together keep a tolerance their meeting needed.
     pub(super) fastest: f64,
     /// The largest contact tolerance a touching pair has had so far (see
@@ -36,6 +36,18 @@ pub(super) struct Limits {
     pub(super) accepted_overlap: f64,
     /// A ball whose bounce off an accelerating wall returns sooner sticks, s.
     pub(super) t_stick: f64,
+}
+
+impl Limits {
+    /// Whether a touching pair whose gap changes at `rate` with curvature `curvature` (the
+    /// wall accelerating away from the ball when positive) separates by itself: it approaches
+    /// slower than `v_stick` (round-off: a forced frame's velocity re-evaluated after a
+    /// release can differ from the ball's by an ulp) and turns within `t_stick`, sinking less
+    /// than `v_stick t_stick / 2`, far below the contact tolerance. `resolve` and the contact
+    /// search judge it alike, so they never disagree about a contact now.
+    pub(super) fn reopens(&self, rate: f64, curvature: f64) -> bool {
+        rate < 0.0 && -rate < self.v_stick && curvature > 0.0 && -rate < curvature * self.t_stick
+    }
 }
 
 /// What one instant's postcondition read of each pair, for `resolve` to judge the contacts by,
@@ -51,42 +63,24 @@ pub(super) struct Scratch {
 }
 
 impl Solver<'_> {
-    /// Gap and its rate for a ball-frame pair at time `t` (the ball flies from `self.t`).
+    /// Ball `ball` against the frame, the gap `s (x_ball - xs) + k`, from now.
     #[inline(always)]
-    pub(super) fn frame_gap_at(&self, ball: usize, s: f64, k: f64, t: f64) -> (f64, f64) {
-        let (xs, vs) = self.frame.state(t);
-        let xb = self.balls.x[ball] + self.balls.v[ball] * (t - self.t);
-        (s * (xb - xs) + k, s * (self.balls.v[ball] - vs))
-    }
-
-    /// A ball-frame pair's gap, its rate and its contact tolerance at `t`: the length
-    /// tolerance plus what the gap's value can err by (the rounding accumulated in the ball's
-    /// position, the round-off of the frame's closed form and of the gap's sum, and two ulps
-    /// of time at the gap's rate or the fastest speed of the run so far, whichever is faster: a
-    /// contact taken at that speed is placed no closer, and bodies that then move together
-    /// keep that overlap). The reference
-    /// takes no contact below minus this, and its postcondition checks it (docs/MODEL.md).
-    pub(super) fn frame_gap_tolerance(&self, ball: usize, s: f64, k: f64, t: f64) -> (f64, f64, f64) {
-        let (xs, vs) = self.frame.state(t);
-        let xb = self.balls.x[ball] + self.balls.v[ball] * (t - self.t);
-        let rate = s * (self.balls.v[ball] - vs);
-        (s * (xb - xs) + k, rate, self.frame_tolerance(ball, t, xb, xs, k, rate))
-    }
-
-    /// The contact tolerance of a ball-frame gap `s (xb - xs) + k` of rate `rate` at `t` (see
-    /// [`Solver::frame_gap_tolerance`]).
-    #[inline(always)]
-    pub(super) fn frame_tolerance(&self, ball: usize, t: f64, xb: f64, xs: f64, k: f64, rate: f64) -> f64 {
-        let eps = f64::EPSILON;
-        self.limits.tol
-            + self.balls.drift[ball]
-            + self.frame.seg.position_roundoff(t)
-            + 4.0 * eps * (xb.abs() + xs.abs() + k.abs())
-            + 2.0 * eps * t.abs() * rate.abs().max(self.limits.fastest)
+    pub(super) fn frame_gap(&self, ball: usize, s: f64, k: f64) -> FrameGap<'_> {
+        FrameGap {
+            frame: &self.frame,
+            limits: &self.limits,
+            horizon: self.horizon,
+            now: self.t,
+            x: self.balls.x[ball],
+            v: self.balls.v[ball],
+            drift: self.balls.drift[ball],
+            s,
+            k,
+        }
     }
 
     /// The contact tolerance of ball-ball pair `p` of rate `rate` now (see
-    /// [`Solver::frame_gap_tolerance`]).
+    /// [`FrameGap::with_tolerance`]).
     #[inline(always)]
     pub(super) fn ball_gap_tolerance(&self, p: usize, rate: f64) -> f64 {
         let (Some(i), Some(j)) = self.balls.pairs.balls(p) else { unreachable!("a ball-ball pair") };
@@ -114,7 +108,7 @@ impl Solver<'_> {
                 let (xs, vs, a) = self.frame.now(self.t);
                 let xb = self.balls.x[ball];
                 let rate = s * (self.balls.v[ball] - vs);
-                let tol = self.frame_tolerance(ball, self.t, xb, xs, k, rate);
+                let tol = self.frame_gap(ball, s, k).tolerance(self.t, xb, xs, rate);
                 Some(PairNow { g: s * (xb - xs) + k, rate, tol, curvature: Some(-s * a) })
             }
         }

@@ -15,6 +15,7 @@ mod balls;
 mod events;
 mod exact;
 mod frame;
+mod frame_gap;
 mod geometry;
 mod output;
 mod search;
@@ -24,6 +25,7 @@ use balls::{Balls, Gap, Hold};
 use events::Ledger;
 use exact::ExactTally;
 use frame::FrameMotion;
+use frame_gap::FrameGap;
 use geometry::{Contact, Limits, PairNow, Scratch};
 use output::Sampler;
 use search::Search;
@@ -52,7 +54,7 @@ const MAX_EVENTS_PER_INSTANT: u64 = 1000;
 /// Most impacts resolved at one instant before the touching run is merged.
 const MAX_IMPULSES_PER_INSTANT: usize = 10_000;
 /// Contact tolerance relative to the scene's length scale (to which the round-off of
-/// evaluating a gap is added, see [`Solver::frame_gap_tolerance`]).
+/// evaluating a gap is added, see [`FrameGap::with_tolerance`]).
 const LENGTH_TOLERANCE: f64 = 1e-12;
 /// Most iterations of one root search (Newton, bisection): bisection halves a bracket to an
 /// ulp in at most about 1100 halvings of the whole f64 range, Newton on these smooth gaps in a
