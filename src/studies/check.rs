@@ -21,7 +21,7 @@ use serde::{Deserialize, Serialize};
 
 use super::StudyError;
 use crate::metrics::{metrics, Headline, Metric, Metrics};
-use crate::model::{Limits, Model, RunOptions};
+use crate::model::{Limits, Model, ModelError, RunOptions};
 use crate::scene;
 use crate::studies::chain::{run_chain, KerRow};
 use crate::studies::sweep::sweep_scenes;
@@ -39,6 +39,10 @@ pub struct Golden {
     pub metrics: Option<Metrics>,
     /// KER rows, for a chain file.
     pub ker: Vec<KerRow>,
+    /// When the model stopped the run with a typed stall (a state it has no rule for yet, such
+    /// as the spatial reference's persistent contacts), s: the stop is the regression point.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub stopped_at: Option<f64>,
 }
 
 /// One compared value.
@@ -81,15 +85,22 @@ pub fn current(dir: &Path, models: &[Model], progress: &(dyn Fn() + Sync)) -> Re
         for &model in models {
             // A model that cannot represent a scene has no golden for it: it says so up front.
             for s in cases.iter().filter(|s| model.supports(s).is_ok()) {
-                let run = model.simulate(s, &RunOptions::default())?;
+                let golden = match model.simulate(s, &RunOptions::default()) {
+                    Ok(run) => Golden {
+                        case: s.name.clone(),
+                        model,
+                        impact_count: run.impacts.len(),
+                        metrics: Some(metrics(&run)),
+                        ker: vec![],
+                        stopped_at: None,
+                    },
+                    Err(ModelError::Stalled { t, .. }) => {
+                        Golden { case: s.name.clone(), model, impact_count: 0, metrics: None, ker: vec![], stopped_at: Some(t) }
+                    }
+                    Err(e) => return Err(e.into()),
+                };
                 progress();
-                out.push(Golden {
-                    case: s.name.clone(),
-                    model,
-                    impact_count: run.impacts.len(),
-                    metrics: Some(metrics(&run)),
-                    ker: vec![],
-                });
+                out.push(golden);
             }
             if let Some(chain) = &loaded.chain {
                 let name = loaded.file.name.clone().unwrap_or_else(|| "chain".into());
@@ -99,6 +110,7 @@ pub fn current(dir: &Path, models: &[Model], progress: &(dyn Fn() + Sync)) -> Re
                     impact_count: 0,
                     metrics: None,
                     ker: run_chain(chain, model, Limits::NONE, progress)?,
+                    stopped_at: None,
                 });
             }
         }
@@ -161,6 +173,9 @@ pub fn compare(now: &Golden, golden: Option<&Golden>) -> Vec<Row> {
         }
         for r in &g.ker {
             v.push((format!("ker {}L-{}S", r.large, r.small), None, Some(r.ker)));
+        }
+        if let Some(t) = g.stopped_at {
+            v.push(("stopped at (s)".to_string(), None, Some(t)));
         }
         v
     };
