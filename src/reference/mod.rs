@@ -20,6 +20,7 @@ mod geometry;
 mod output;
 mod search;
 mod segment;
+mod spatial;
 
 use balls::{Balls, Gap, Hold};
 use events::Ledger;
@@ -86,10 +87,16 @@ impl Simulator for Reference {
     }
 
     fn supports(&self, scene: &Scene) -> Result<(), String> {
-        scene.space.beyond_lines(&scene.initial_positions).map_or(Ok(()), Err)
+        match scene.space.beyond_lines(&scene.initial_positions) {
+            None => Ok(()),
+            Some(_) => spatial::refusal(scene).map_or(Ok(()), Err),
+        }
     }
 
     fn simulate(&self, scene: &Scene, options: &RunOptions) -> Result<Run, ModelError> {
+        if scene.space.beyond_lines(&scene.initial_positions).is_some() {
+            return spatial::simulate(scene, options);
+        }
         // Every event reads every pair: with many balls the meter looks more often, so that a
         // long run reports about once per a few hundred thousand pair readings.
         let every = (BUDGET_EVENTS * 16 / (scene.balls.len() as u64 + 1)).clamp(1, BUDGET_EVENTS);

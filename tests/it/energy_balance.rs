@@ -9,9 +9,15 @@ use crate::common::reference;
 fn every_paper_scene_balances_energy_and_keeps_balls_inside() {
     let scenes = common::all_paper_scenes();
     assert!(scenes.len() >= 5 + 14 + 10, "expected every paper scene, got {}", scenes.len());
-    // Scenes beyond lines (beds under gravity) are the contact model's; the reference refuses them.
+    // Rough beds are the contact model's: the reference refuses them. A smooth bed under gravity
+    // may stop at a persistent contact the spatial reference has no state for yet (a typed
+    // stall naming the balls, docs/MODEL.md §14): its balance is checked in
+    // tests/it/spatial_reference.rs on beds that run to the end.
     for scene in scenes.into_iter().filter(|s| lpc_damper::model::Model::Reference.supports(s).is_ok()) {
-        let run = reference(&scene).unwrap();
+        let run = match reference(&scene) {
+            Err(lpc_damper::model::ModelError::Stalled { why, .. }) if why.contains("persistent contact") => continue,
+            other => other.unwrap(),
+        };
         assert!(run.energy.balance_error.abs() <= 1e-12, "{}: balance error {:e}", scene.name, run.energy.balance_error);
         assert!(run.impacts.iter().all(|i| i.energy_lost >= 0.0), "{}", scene.name);
         // Contact tolerance is 1e-12 of the container length (< 1e-13 m).

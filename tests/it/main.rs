@@ -25,6 +25,7 @@ mod masri_caughey;
 mod rapier_model;
 mod rapier_space;
 mod render;
+mod spatial_reference;
 mod stability_map;
 mod sticking;
 mod stress;

@@ -1,0 +1,44 @@
+#!/bin/bash
+# The spatial reference's cost per impact against the number of balls: smooth 5 mm steel
+# balls without gravity, a gas at 0.5 m/s per component (seeded) in a cubic box on the
+# frame, a quarter of its volume filled; the frame's mass and stiffness in
+# proportion to the balls' mass, so that it keeps the particle box's frequency and mass ratio.
+#   bash benches/spatial_reference.sh [LPC] [N...]   (default: target/release/lpc, 100 1000 10000)
+set -euo pipefail
+lpc=${1:-target/release/lpc}
+shift || true
+counts=${*:-100 1000 10000}
+dir=$(mktemp -d)
+printf '| balls | horizon | impacts | computed in | impacts per second | per impact |\n|---|---|---|---|---|---|\n'
+for n in $counts; do
+  python3 - "$n" "$dir/box$n.toml" <<'PY'
+import random, sys
+n, path = int(sys.argv[1]), sys.argv[2]
+r, pitch = 0.005, 0.0125
+cells = 1
+while cells ** 3 < n:
+    cells += 1
+side = cells * pitch
+mass = 4.0 / 3.0 * 3.141592653589793 * r ** 3 * 7800.0
+rng = random.Random(1)
+lines = [f'name = "gas-box-{n}"', "[frame]", f"mass = {1.35 * n / 300:.6g}", f"stiffness = {865.0 * n / 300:.6g}",
+         "damping = 0.0", "initial_displacement = 0.0185", "[container]", f"length = {side:.6g}",
+         f"width = {side:.6g}", f"height = {side:.6g}", "[world]", "gravity = [0.0, 0.0, 0.0]", "friction = 0.0",
+         "restitution = 0.9", "[run]", "horizon = 0.1", "sample_dt = 0.001"]
+for i in range(n):
+    c = (i % cells, (i // cells) % cells, i // cells ** 2)
+    x, y, z = (c[0] + 0.5) * pitch, (c[1] + 0.5) * pitch - side / 2, (c[2] + 0.5) * pitch - side / 2
+    v = [rng.uniform(-0.5, 0.5) for _ in range(3)]
+    lines += ["[[ball]]", f"position = [{x:.6g}, {y:.6g}, {z:.6g}]", f"mass = {mass:.9g}", f"radius = {r}",
+              f"velocity = [{v[0]:.6g}, {v[1]:.6g}, {v[2]:.6g}]"]
+open(path, "w").write("\n".join(lines) + "\n")
+PY
+  "$lpc" run "$dir/box$n.toml" --format json > "$dir/out$n.json"
+  python3 - "$n" "$dir/out$n.json" <<'PY'
+import json, sys
+n, out = int(sys.argv[1]), json.load(open(sys.argv[2]))
+impacts, wall, horizon = out["impact_count"], out["wall_time_s"], out["horizon"]
+print(f"| {n:,} | {horizon:g} s | {impacts:,} | {wall:.3f} s | {impacts / wall:,.0f} | {1e6 * wall / impacts:.2f} µs |")
+PY
+done
+rm -rf "$dir"

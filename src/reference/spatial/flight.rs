@@ -1,0 +1,190 @@
+//! Closed-form flights between events (docs/MODEL.md §14): a ball moves as `p + v t + a t^2 / 2`,
+//! so a wall across the motion, a cell's face and a ball with the same acceleration are met at
+//! the root of a quadratic; a ball with another acceleration (one flies, the other rests on the
+//! floor) where a quartic first falls through zero, isolated between the sign changes of its
+//! derivatives.
+
+/// The first `t >= 0` at which `c + b t + a t^2 = 0` with `c > 0` before it, or `None`: the
+/// smaller non-negative root, computed in the form that does not cancel.
+pub(super) fn first_root(a: f64, b: f64, c: f64) -> Option<f64> {
+    if c <= 0.0 {
+        // At the plane already (a contact just resolved, or round-off): now if it is closing,
+        // else when the acceleration brings it back (the other root of `b t + a t^2`).
+        if b < 0.0 || (b == 0.0 && a < 0.0) {
+            return Some(0.0);
+        }
+        return (a < 0.0).then(|| -b / a);
+    }
+    if a == 0.0 {
+        return (b < 0.0).then(|| c / -b);
+    }
+    let disc = b * b - 4.0 * a * c;
+    if disc < 0.0 {
+        return None;
+    }
+    let q = -0.5 * (b + b.signum() * disc.sqrt());
+    if q == 0.0 {
+        return None;
+    }
+    // Roots q / a and c / q; with c > 0 both have the sign of q / a (when a > 0) or opposite
+    // signs (a < 0, the positive one is the root reached first from above).
+    let (r1, r2) = (q / a, c / q);
+    let mut best: Option<f64> = None;
+    for r in [r1, r2] {
+        if r >= 0.0 && r.is_finite() {
+            best = Some(best.map_or(r, |b: f64| b.min(r)));
+        }
+    }
+    best
+}
+
+/// When a gap `g0 - s (v t + acc t^2 / 2)` to a plane first closes (`s` the side of the plane:
+/// `+1` above the ball, `-1` below), or `None`.
+pub(super) fn plane_time(g0: f64, s: f64, v: f64, acc: f64) -> Option<f64> {
+    first_root(-0.5 * s * acc, -s * v, g0)
+}
+
+/// When two balls with relative position `dr`, velocity `dv` and acceleration `da` first touch
+/// at centre distance `reach`, looking no further than `limit`: where the squared distance less
+/// `reach^2`, a polynomial of degree two (equal accelerations) or four in time, first falls
+/// through zero. A pair touching now meets now if it closes, else at its next fall through
+/// zero (a ball bouncing on one that rests on the floor comes back).
+pub(super) fn pair_time(dr: [f64; 3], dv: [f64; 3], da: [f64; 3], reach: f64, limit: f64) -> Option<f64> {
+    let dot = |a: [f64; 3], b: [f64; 3]| a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
+    let c0 = dot(dr, dr) - reach * reach;
+    let c1 = 2.0 * dot(dr, dv);
+    if da == [0.0; 3] {
+        if c1 >= 0.0 {
+            return None;
+        }
+        return first_root(dot(dv, dv), c1, c0).filter(|&t| t <= limit);
+    }
+    // c0 + c1 t + c2 t^2 + c3 t^3 + c4 t^4.
+    let poly = [c0, c1, dot(dv, dv) + dot(dr, da), dot(dv, da), 0.25 * dot(da, da)];
+    first_fall(&poly, limit)
+}
+
+/// Value of the polynomial with coefficients `c` (constant first) at `t`.
+fn eval(c: &[f64], t: f64) -> f64 {
+    c.iter().rev().fold(0.0, |acc, &k| acc * t + k)
+}
+
+/// The polynomial's derivative.
+fn derivative(c: &[f64]) -> Vec<f64> {
+    c.iter().enumerate().skip(1).map(|(k, &v)| k as f64 * v).collect()
+}
+
+/// Every point of `[0, limit]` where the polynomial `c` changes sign, in order: the
+/// derivative's sign changes split the interval into pieces where `c` is monotone, and each
+/// piece holds at most one sign change, found by bisection to an ulp.
+fn sign_changes(c: &[f64], limit: f64) -> Vec<f64> {
+    let degree = c.iter().rposition(|&k| k != 0.0).unwrap_or(0);
+    if degree == 0 {
+        return Vec::new();
+    }
+    let mut ends = vec![0.0];
+    if degree > 1 {
+        ends.extend(sign_changes(&derivative(&c[..=degree]), limit));
+    }
+    ends.push(limit);
+    let mut roots = Vec::new();
+    for w in ends.windows(2) {
+        let (mut l, mut h) = (w[0], w[1]);
+        let (fl, fh) = (eval(c, l), eval(c, h));
+        if (fl > 0.0) == (fh > 0.0) || l >= h {
+            continue;
+        }
+        let rising = fh > 0.0;
+        for _ in 0..200 {
+            let m = 0.5 * (l + h);
+            if m <= l || m >= h {
+                break;
+            }
+            if (eval(c, m) > 0.0) == rising {
+                h = m;
+            } else {
+                l = m;
+            }
+        }
+        roots.push(h);
+    }
+    roots
+}
+
+/// The first time in `[0, limit]` at which the polynomial `c` falls to zero or below from
+/// above (or `0` when it is at or below zero and falling now, or the start of a falling piece
+/// that starts at or below zero), or `None`.
+fn first_fall(c: &[f64], limit: f64) -> Option<f64> {
+    let d = derivative(c);
+    if c[0] <= 0.0 && (d[0] < 0.0 || (d[0] == 0.0 && d[1] < 0.0)) {
+        return Some(0.0);
+    }
+    let mut ends = vec![0.0];
+    ends.extend(sign_changes(&d, limit));
+    ends.push(limit);
+    for w in ends.windows(2) {
+        let (mut l, mut h) = (w[0], w[1]);
+        let (fl, fh) = (eval(c, l), eval(c, h));
+        if !(fh <= 0.0 && fl > fh) {
+            continue;
+        }
+        if fl <= 0.0 {
+            // Falling from a rise that never cleared zero (a pair that touches and parts by
+            // less than round-off): in contact again from the top of the rise.
+            return Some(l);
+        }
+        for _ in 0..200 {
+            let m = 0.5 * (l + h);
+            if m <= l || m >= h {
+                break;
+            }
+            if eval(c, m) > 0.0 {
+                l = m;
+            } else {
+                h = m;
+            }
+        }
+        return Some(h);
+    }
+    None
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_falling_ball_meets_the_floor_at_the_closed_form_time() {
+        // A ball 0.1 m above the floor falling from rest: t = sqrt(2 h / g).
+        let t = plane_time(0.1, -1.0, 0.0, -9.81).unwrap();
+        assert!((t - (0.2f64 / 9.81).sqrt()).abs() < 1e-15);
+        // Thrown up at 1 m/s from 0.1 m: t = (v + sqrt(v^2 + 2 g h)) / g.
+        let t = plane_time(0.1, -1.0, 1.0, -9.81).unwrap();
+        assert!((t - (1.0 + (1.0f64 + 2.0 * 9.81 * 0.1).sqrt()) / 9.81).abs() < 1e-15);
+        // Towards a ceiling it never reaches: none.
+        assert_eq!(plane_time(1.0, 1.0, 1.0, -9.81), None);
+    }
+
+    #[test]
+    fn pairs_meet_at_the_closed_form_times_and_come_back() {
+        // Head-on at 1 m/s, 0.1 m of gap.
+        let t = pair_time([0.3, 0.0, 0.0], [-1.0, 0.0, 0.0], [0.0; 3], 0.2, 10.0).unwrap();
+        assert!((t - 0.1).abs() < 1e-15);
+        // A ball dropping onto one at rest below it, 0.05 m of gap: sqrt(2 * 0.05 / g).
+        let g = [0.0, 0.0, -9.81];
+        let t = pair_time([0.0, 0.0, 0.25], [0.0; 3], g, 0.2, 10.0).unwrap();
+        let expect = (0.1f64 / 9.81).sqrt();
+        assert!((t - expect).abs() < 1e-14, "{t} vs {expect}");
+        // Touching and bouncing up at 1 m/s: back after 2 v / g.
+        let t = pair_time([0.0, 0.0, 0.2], [0.0, 0.0, 1.0], g, 0.2, 10.0).unwrap();
+        assert!((t - 2.0 / 9.81).abs() < 1e-14, "{t}");
+        // Touching and closing: now. Passing by a metre aside: never.
+        assert_eq!(pair_time([0.0, 0.0, 0.2], [0.0, 0.0, -1.0], g, 0.2, 10.0), Some(0.0));
+        assert_eq!(pair_time([1.0, 0.0, 0.2], [0.0, 0.0, 1.0], g, 0.2, 10.0), None);
+        // Touching and parting by less than round-off before gravity brings them back (a
+        // regression: the rise never cleared zero, and the return was missed).
+        let dr = [-0.010430267903623017, 0.0, 0.0034942111353854];
+        let dv = [0.011975274207752518, 0.0, 0.0357463784770707];
+        assert!(pair_time(dr, dv, g, 0.011, 1.75e-4).is_some_and(|t| t < 1e-8));
+    }
+}

@@ -1,0 +1,787 @@
+//! The reference beyond one line (docs/MODEL.md §14): smooth balls flying in closed form in the
+//! plane or in space under gravity inside the container the frame carries, their impacts by
+//! Eq. 9-10 along the contact normal, found by an event calendar (a binary heap whose stale
+//! entries are dropped when they surface) over cells as wide as a ball. Ball-ball and
+//! ball-floor times are roots of quadratics; a ball against the walls that move with the frame
+//! is found by the one-line reference's sound root isolation ([`FrameGap`]).
+//!
+//! Inelastic collapse is kept from stalling by a stated rule: an impact within the contact
+//! duration of a ball's previous one is elastic (the TC model), and a ball whose bounce off a
+//! wall that gravity presses it against would return within the contact duration rests on it.
+
+mod cells;
+mod flight;
+
+use std::cmp::Ordering;
+use std::collections::BinaryHeap;
+
+use super::frame::FrameMotion;
+use super::frame_gap::FrameGap;
+use super::geometry::Limits;
+use super::{CONTACT_DURATION, LENGTH_TOLERANCE, MAX_EVENTS, STICK_SPEED, STICK_TIME};
+use crate::impact_law::impact_law;
+use crate::model::{Meter, Model, ModelError, OverBudget, RunOptions};
+use crate::run::{EnergyAccount, Impact, Recorder, Run};
+use crate::scene::{Body, Scene};
+use cells::Cells;
+use flight::{pair_time, plane_time};
+
+/// Most events at one instant before the run is declared stalled.
+const MAX_EVENTS_PER_INSTANT: u64 = 10_000;
+/// Events between two looks at the budgets.
+const BUDGET_EVENTS: u64 = 4096;
+/// Impacts of one ball in a row, each within the contact duration of the last, after which the
+/// ball is taken to be in persistent contact (pressed against a wall of the frame, or resting on
+/// other balls), which the spatial reference has no state for.
+const PERSISTENT_IMPACTS: u32 = 1000;
+
+/// Why the spatial reference cannot run `scene`, or `None` when it can.
+pub(super) fn refusal(scene: &Scene) -> Option<String> {
+    let space = &scene.space;
+    if space.friction != 0.0 {
+        return Some(format!(
+            "the scene has friction {}; the reference's impacts are frictionless (Eq. 9-10 along the normal): run it with the rapier model, or set `world.friction = 0`",
+            space.friction
+        ));
+    }
+    if space.gravity[0] != 0.0 {
+        return Some(format!(
+            "the scene has gravity {} m/s^2 along the frame's motion; the reference finds the walls on the frame for balls flying straight along it",
+            space.gravity[0]
+        ));
+    }
+    if scene.container.is_none() || space.section[0] <= 0.0 || space.section[1] <= 0.0 {
+        return Some("the scene's balls leave their lines but it gives the container no cross-section (width and height)".into());
+    }
+    if space.chains() > 1 {
+        return Some("the reference beyond one line has one chamber: it has no dividers between chains".into());
+    }
+    None
+}
+
+/// What an entry of the calendar is about.
+#[derive(Debug, Clone, Copy)]
+enum Kind {
+    /// Balls `i` and `j` touch.
+    Pair(u32),
+    /// Ball `i` meets the wall across the motion on `axis` (1 for y, 2 for z), on side `side`.
+    Across(u8, i8),
+    /// Ball `i` meets the frame's wall on side `side` (`+1` the left wall); at `t` when
+    /// `exact`, else "not before `t`".
+    Frame(i8, bool),
+    /// Ball `i` leaves its cell across `axis` on side `dir`.
+    Cell(u8, i8),
+}
+
+/// An entry of the calendar, valid while its balls' stamps (and for a wall of the frame, the
+/// frame's segment) are those it was predicted with.
+#[derive(Debug, Clone, Copy)]
+struct Entry {
+    t: f64,
+    ball: u32,
+    kind: Kind,
+    stamps: (u32, u32),
+    segment: u64,
+}
+
+impl PartialEq for Entry {
+    fn eq(&self, other: &Self) -> bool {
+        self.cmp(other) == Ordering::Equal
+    }
+}
+impl Eq for Entry {}
+impl PartialOrd for Entry {
+    fn partial_cmp(&self, other: &Self) -> Option<Ordering> {
+        Some(self.cmp(other))
+    }
+}
+impl Ord for Entry {
+    /// Earliest first (reversed for the max-heap); at a tie the lower ball, so the order never
+    /// depends on the heap's history.
+    fn cmp(&self, other: &Self) -> Ordering {
+        other.t.total_cmp(&self.t).then(other.ball.cmp(&self.ball))
+    }
+}
+
+/// One ball between its events.
+#[derive(Debug, Clone, Copy)]
+struct Ball {
+    /// Centre at `since` (x in the world, y and z in the container), m.
+    p: [f64; 3],
+    /// Velocity at `since`, m/s.
+    v: [f64; 3],
+    since: f64,
+    mass: f64,
+    radius: f64,
+    /// The wall across the motion it rests on (`(axis, side)`), if any.
+    rest: Option<(usize, f64)>,
+    /// Time of its last impact, s.
+    last_impact: f64,
+    /// Impacts in a row, each within the contact duration of the last.
+    quick_impacts: u32,
+    /// Changes at every event of the ball: entries with an older stamp are stale.
+    stamp: u32,
+    cell: [i64; 3],
+    /// A bound on the rounding gathered in `p[0]`, m.
+    drift: f64,
+}
+
+/// The spatial reference's run of one scene.
+struct Solver<'a> {
+    scene: &'a Scene,
+    balls: Vec<Ball>,
+    frame: FrameMotion,
+    limits: Limits,
+    cells: Cells,
+    calendar: BinaryHeap<Entry>,
+    gravity: [f64; 3],
+    e: f64,
+    length: f64,
+    t: f64,
+    horizon: f64,
+    events: u64,
+    impacts: Vec<Impact>,
+    impact_loss: f64,
+    damping_loss: f64,
+    forcing_work: f64,
+    start: Vec<[f64; 3]>,
+}
+
+fn dot(a: [f64; 3], b: [f64; 3]) -> f64 {
+    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
+}
+
+impl Ball {
+    fn acceleration(&self, g: [f64; 3]) -> [f64; 3] {
+        let mut a = g;
+        if let Some((axis, _)) = self.rest {
+            a[axis] = 0.0;
+        }
+        a
+    }
+
+    /// Centre and velocity at `t`.
+    fn at(&self, t: f64, g: [f64; 3]) -> ([f64; 3], [f64; 3]) {
+        let a = self.acceleration(g);
+        let dt = t - self.since;
+        (std::array::from_fn(|k| self.p[k] + self.v[k] * dt + 0.5 * a[k] * dt * dt), std::array::from_fn(|k| self.v[k] + a[k] * dt))
+    }
+}
+
+/// Runs the spatial reference on `scene` (which [`refusal`] accepts).
+pub(super) fn simulate(scene: &Scene, options: &RunOptions) -> Result<Run, ModelError> {
+    let meter = Meter::new(options, BUDGET_EVENTS);
+    let mut s = Solver::new(scene);
+    let mut recorder = Recorder::new(scene, options.record);
+    let outcome = s.run(&meter, &mut recorder);
+    let t = s.t;
+    meter.finish(t, s.events);
+    match outcome? {
+        None => {
+            let mut run = s.finish(recorder, scene.horizon);
+            run.wall_time_s = meter.elapsed();
+            Ok(run)
+        }
+        Some(budget) => {
+            let wall_s = meter.elapsed();
+            let steps = s.events;
+            let cost = format!("{} impacts so far; {} balls", s.impacts.len(), s.balls.len());
+            let mut partial = s.finish(recorder, t);
+            partial.wall_time_s = wall_s;
+            Err(ModelError::OverBudget(Box::new(OverBudget {
+                scene: scene.name.clone(),
+                model: Model::Reference,
+                t,
+                horizon: scene.horizon,
+                steps,
+                wall_s,
+                budget,
+                limit: meter.limit(budget),
+                cost,
+                partial,
+            })))
+        }
+    }
+}
+
+impl<'a> Solver<'a> {
+    fn new(scene: &'a Scene) -> Self {
+        let container = scene.container.expect("refusal checks the container");
+        let largest = scene.balls.iter().map(|b| b.radius).fold(0.0, f64::max);
+        let mut cells = Cells::new(largest, container.length, scene.space.section, scene.balls.len());
+        let frame = FrameMotion::new(scene);
+        let time_scale = scene.frame.map_or(scene.horizon, |f| {
+            let p = f.damped_period();
+            if p > 0.0 {
+                p
+            } else {
+                scene.horizon
+            }
+        });
+        let speed_scale = scene.speed_scale();
+        let balls: Vec<Ball> = scene
+            .balls
+            .iter()
+            .enumerate()
+            .map(|(i, b)| {
+                let [y, z] = scene.space.lateral_of(i);
+                let [vy, vz] = scene.space.lateral_velocity_of(i);
+                let p = [scene.initial_positions[i], y, z];
+                let cell = cells.cell_of(p);
+                cells.insert(cell, i as u32);
+                Ball {
+                    p,
+                    v: [scene.initial_velocities[i], vy, vz],
+                    since: 0.0,
+                    mass: b.mass,
+                    radius: b.radius,
+                    rest: None,
+                    last_impact: f64::NEG_INFINITY,
+                    quick_impacts: 0,
+                    stamp: 0,
+                    cell,
+                    drift: 0.0,
+                }
+            })
+            .collect();
+        let start = balls.iter().map(|b| b.p).collect();
+        Solver {
+            scene,
+            balls,
+            frame,
+            limits: Limits {
+                tol: LENGTH_TOLERANCE * scene.length_scale(),
+                v_stick: STICK_SPEED * speed_scale,
+                fastest: speed_scale,
+                accepted_overlap: 0.0,
+                t_stick: STICK_TIME * time_scale,
+            },
+            cells,
+            calendar: BinaryHeap::new(),
+            gravity: scene.space.gravity,
+            e: scene.restitution,
+            length: container.length,
+            t: 0.0,
+            horizon: scene.horizon,
+            events: 0,
+            impacts: Vec::new(),
+            impact_loss: 0.0,
+            damping_loss: 0.0,
+            forcing_work: 0.0,
+            start,
+        }
+    }
+
+    /// Moves ball `i` to the current time.
+    fn bring(&mut self, i: usize) {
+        let (p, v) = self.balls[i].at(self.t, self.gravity);
+        let b = &mut self.balls[i];
+        b.drift += f64::EPSILON * (p[0].abs() + (p[0] - b.p[0]).abs());
+        b.p = p;
+        b.v = v;
+        b.since = self.t;
+    }
+
+    /// Ball `i` (at the current time) against the frame's wall on side `side`.
+    fn frame_gap(&self, i: usize, side: f64) -> FrameGap<'_> {
+        let b = &self.balls[i];
+        let k = if side > 0.0 { -b.radius } else { self.length - b.radius };
+        FrameGap {
+            frame: &self.frame,
+            limits: &self.limits,
+            horizon: self.horizon,
+            now: b.since,
+            x: b.p[0],
+            v: b.v[0],
+            drift: b.drift,
+            s: side,
+            k,
+        }
+    }
+
+    fn push(&mut self, t: f64, ball: usize, kind: Kind, other: Option<usize>) {
+        if t <= self.horizon {
+            let stamps = (self.balls[ball].stamp, other.map_or(0, |j| self.balls[j].stamp));
+            self.calendar.push(Entry { t, ball: ball as u32, kind, stamps, segment: self.frame.segment });
+        }
+    }
+
+    /// Ball `i`'s next contact with the frame's wall on side `side`, searched from now.
+    fn predict_frame_wall(&mut self, i: usize, side: f64) {
+        let c = self.frame_gap(i, side).search(self.t, self.horizon);
+        if c.t.is_finite() {
+            self.push(c.t, i, Kind::Frame(side as i8, c.exact), None);
+        }
+    }
+
+    /// Everything ball `i` (brought to now) meets next: walls, its cell's faces, other balls.
+    fn predict(&mut self, i: usize) {
+        self.balls[i].stamp = self.balls[i].stamp.wrapping_add(1);
+        let b = self.balls[i];
+        let a = b.acceleration(self.gravity);
+        let t = self.t;
+        for axis in 1..3 {
+            let half = self.cells.half[axis - 1];
+            for side in [1.0, -1.0] {
+                if b.rest == Some((axis, side)) {
+                    continue;
+                }
+                let g0 = half - side * b.p[axis] - b.radius;
+                if let Some(dt) = plane_time(g0, side, b.v[axis], a[axis]) {
+                    self.push(t + dt, i, Kind::Across(axis as u8, side as i8), None);
+                }
+            }
+        }
+        for side in [1.0, -1.0] {
+            self.predict_frame_wall(i, side);
+        }
+        let mut crossing: Option<(f64, usize, i64)> = None;
+        for axis in 0..3 {
+            for dir in [1i64, -1] {
+                if !self.cells.has_neighbour(b.cell, axis, dir) {
+                    continue;
+                }
+                let lower = self.cells.face(b.cell, axis);
+                let (g0, side) = if dir > 0 { (lower + self.cells.size - b.p[axis], 1.0) } else { (b.p[axis] - lower, -1.0) };
+                if let Some(dt) = plane_time(g0.max(0.0), side, b.v[axis], a[axis]) {
+                    if crossing.is_none_or(|c| dt < c.0) {
+                        crossing = Some((dt, axis, dir));
+                    }
+                }
+            }
+        }
+        if let Some((dt, axis, dir)) = crossing {
+            self.push(t + dt, i, Kind::Cell(axis as u8, dir as i8), None);
+        }
+        let mut others = Vec::new();
+        self.cells.around(b.cell, |j| others.push(j as usize));
+        for j in others {
+            if j != i {
+                self.predict_pair(i, j, t);
+            }
+        }
+    }
+
+    /// When balls `i` and `j` touch, searched from `from`.
+    fn predict_pair(&mut self, i: usize, j: usize, from: f64) {
+        let g = self.gravity;
+        let (pi, vi) = self.balls[i].at(from, g);
+        let (pj, vj) = self.balls[j].at(from, g);
+        let (ai, aj) = (self.balls[i].acceleration(g), self.balls[j].acceleration(g));
+        let dr = std::array::from_fn(|k| pj[k] - pi[k]);
+        let dv = std::array::from_fn(|k| vj[k] - vi[k]);
+        let da = std::array::from_fn(|k| aj[k] - ai[k]);
+        let reach = self.balls[i].radius + self.balls[j].radius;
+        let (lo, hi) = (i.min(j), i.max(j));
+        if let Some(dt) = pair_time(dr, dv, da, reach, self.horizon - from) {
+            self.push(from + dt, lo, Kind::Pair(hi as u32), Some(hi));
+        }
+    }
+
+    fn valid(&self, e: &Entry) -> bool {
+        let i = e.ball as usize;
+        if self.balls[i].stamp != e.stamps.0 {
+            return false;
+        }
+        match e.kind {
+            Kind::Pair(j) => self.balls[j as usize].stamp == e.stamps.1,
+            Kind::Frame(..) => self.frame.segment == e.segment,
+            _ => true,
+        }
+    }
+
+    fn run(&mut self, meter: &Meter, recorder: &mut Recorder) -> Result<Option<crate::model::Budget>, ModelError> {
+        for i in 0..self.balls.len() {
+            self.predict(i);
+        }
+        let sample_count = self.scene.sample_count();
+        let mut next_sample = 0;
+        let mut same_instant = 0u64;
+        while let Some(entry) = self.calendar.pop() {
+            if !self.valid(&entry) {
+                continue;
+            }
+            while next_sample < sample_count && (next_sample as f64) * self.scene.sample_dt <= entry.t {
+                self.sample(recorder, next_sample as f64 * self.scene.sample_dt);
+                next_sample += 1;
+            }
+            same_instant = if entry.t == self.t { same_instant + 1 } else { 0 };
+            if same_instant > MAX_EVENTS_PER_INSTANT {
+                let what = match entry.kind {
+                    Kind::Pair(j) => format!(
+                        "ball{} and ball{} stay in contact (a cluster, or a ball resting on others under gravity)",
+                        entry.ball + 1,
+                        j + 1
+                    ),
+                    Kind::Frame(side, _) => format!(
+                        "ball{} is pressed against the {} wall by the frame's acceleration",
+                        entry.ball + 1,
+                        if side > 0 { "left" } else { "right" }
+                    ),
+                    _ => format!("ball{} stays in contact with a wall", entry.ball + 1),
+                };
+                return Err(self.stalled(format!(
+                    "more than {MAX_EVENTS_PER_INSTANT} events at one instant: {what}; the reference beyond one line has no state for persistent contact yet"
+                )));
+            }
+            self.t = entry.t;
+            self.events += 1;
+            if let Some(budget) = meter.look(self.t, self.events) {
+                return Ok(Some(budget));
+            }
+            if self.events > MAX_EVENTS {
+                return Err(self.stalled(format!("more than {MAX_EVENTS} events")));
+            }
+            self.resolve(entry)?;
+            if self.calendar.len() > 64 * self.balls.len() + 4096 {
+                let kept: Vec<Entry> = std::mem::take(&mut self.calendar).into_iter().filter(|e| self.valid(e)).collect();
+                self.calendar = kept.into();
+            }
+        }
+        self.t = self.horizon;
+        while next_sample < sample_count {
+            self.sample(recorder, (next_sample as f64 * self.scene.sample_dt).min(self.horizon));
+            next_sample += 1;
+        }
+        for i in 0..self.balls.len() {
+            self.bring(i);
+            self.check_ball(i, None)?;
+        }
+        Ok(None)
+    }
+
+    fn sample(&self, recorder: &mut Recorder, ts: f64) {
+        let (xs, vs) = self.frame.state(ts);
+        let g = self.gravity;
+        recorder.sample(self.scene, ts, xs, vs, |i| {
+            let (p, v) = self.balls[i].at(ts, g);
+            (p[0], v[0])
+        });
+        recorder.sample_across(|i| {
+            let (p, _) = self.balls[i].at(ts, g);
+            [p[1], p[2]]
+        });
+    }
+
+    fn stalled(&self, why: String) -> ModelError {
+        ModelError::Stalled { scene: self.scene.name.clone(), model: Model::Reference, t: self.t, steps: self.events, why }
+    }
+
+    fn broken(&self, what: String) -> ModelError {
+        ModelError::Broken { scene: self.scene.name.clone(), model: Model::Reference, t: self.t, what }
+    }
+
+    /// The elastic rule of the TC model: `e`, or 1 within the contact duration of either
+    /// ball's previous impact.
+    fn restitution(&self, i: usize, j: Option<usize>) -> f64 {
+        let recent = |k: usize| self.t - self.balls[k].last_impact < CONTACT_DURATION;
+        if recent(i) || j.is_some_and(recent) {
+            1.0
+        } else {
+            self.e
+        }
+    }
+
+    fn record(&mut self, a: Body, b: Body, approach: f64, lost: f64) {
+        self.impact_loss += lost;
+        self.impacts.push(Impact {
+            t: self.t,
+            a,
+            b,
+            approach_speed: approach,
+            energy_lost: lost,
+            impulses: 1,
+            peak_force: None,
+            contact_duration: None,
+        });
+    }
+
+    /// A ball resting on a wall keeps none of its velocity into it (the wall takes it, a
+    /// plastic contact) and leaves it when it moves away.
+    fn settle_rest(&mut self, i: usize) -> f64 {
+        let b = &mut self.balls[i];
+        let Some((axis, side)) = b.rest else { return 0.0 };
+        let into = side * b.v[axis];
+        if into > 0.0 {
+            b.v[axis] = 0.0;
+            0.5 * b.mass * into * into
+        } else {
+            if into < 0.0 {
+                b.rest = None;
+            }
+            0.0
+        }
+    }
+
+    fn resolve(&mut self, entry: Entry) -> Result<(), ModelError> {
+        let i = entry.ball as usize;
+        match entry.kind {
+            Kind::Cell(axis, dir) => {
+                self.bring(i);
+                let b = &mut self.balls[i];
+                let old = b.cell;
+                b.cell[axis as usize] += dir as i64;
+                let new = b.cell;
+                self.cells.remove(old, i as u32);
+                self.cells.insert(new, i as u32);
+                self.predict(i);
+            }
+            Kind::Pair(j) => {
+                let j = j as usize;
+                self.bring(i);
+                self.bring(j);
+                let (bi, bj) = (self.balls[i], self.balls[j]);
+                let d: [f64; 3] = std::array::from_fn(|k| bj.p[k] - bi.p[k]);
+                let dist = dot(d, d).sqrt();
+                let gap = dist - bi.radius - bj.radius;
+                let n = d.map(|c| c / dist);
+                let (ui, uj) = (dot(bi.v, n), dot(bj.v, n));
+                if gap <= self.pair_tolerance(i, j, ui - uj) && ui > uj {
+                    for k in [i, j] {
+                        let b = &mut self.balls[k];
+                        b.quick_impacts = if self.t - b.last_impact < CONTACT_DURATION { b.quick_impacts + 1 } else { 0 };
+                        if b.quick_impacts > PERSISTENT_IMPACTS {
+                            return Err(self.stalled(format!(
+                                "ball{} stays in contact with ball{} (a cluster, or a ball resting on others under gravity: more than {PERSISTENT_IMPACTS} impacts each within {} s of the last); the reference beyond one line has no state for persistent contact between balls",
+                                i + 1,
+                                j + 1,
+                                CONTACT_DURATION
+                            )));
+                        }
+                    }
+                    let e = self.restitution(i, Some(j));
+                    let (wi, wj, lost) = impact_law(bi.mass, ui, bj.mass, uj, e);
+                    for k in 0..3 {
+                        self.balls[i].v[k] += (wi - ui) * n[k];
+                        self.balls[j].v[k] += (wj - uj) * n[k];
+                    }
+                    let rest_loss = self.settle_rest(i) + self.settle_rest(j);
+                    self.record(Body::Ball(i), Body::Ball(j), ui - uj, lost + rest_loss);
+                    self.balls[i].last_impact = self.t;
+                    self.balls[j].last_impact = self.t;
+                    self.check_ball(i, Some(j))?;
+                }
+                self.predict(i);
+                self.predict(j);
+            }
+            Kind::Across(axis, side) => {
+                self.bring(i);
+                let (axis, side) = (axis as usize, side as f64);
+                let b = self.balls[i];
+                let approach = side * b.v[axis];
+                let pressed = side * self.gravity[axis];
+                if approach > 0.0 || (approach == 0.0 && pressed > 0.0) {
+                    let e = self.restitution(i, None);
+                    let after = e * approach;
+                    let half = self.cells.half[axis - 1];
+                    let ball = &mut self.balls[i];
+                    let rests = pressed > 0.0 && 2.0 * after < pressed * CONTACT_DURATION;
+                    let lost = if rests {
+                        // Its next bounce would come back within a contact duration: it rests,
+                        // its centre on the wall's contact plane.
+                        ball.v[axis] = 0.0;
+                        ball.p[axis] = side * (half - ball.radius);
+                        ball.rest = Some((axis, side));
+                        0.5 * ball.mass * approach * approach
+                    } else {
+                        ball.v[axis] = -side * after;
+                        0.5 * ball.mass * (approach * approach - after * after)
+                    };
+                    self.record(Body::Ball(i), Body::SideWall, approach, lost);
+                    self.balls[i].last_impact = self.t;
+                    self.check_ball(i, None)?;
+                }
+                self.predict(i);
+            }
+            Kind::Frame(side, exact) => {
+                let side = side as f64;
+                if !exact {
+                    self.bring(i);
+                    let stamp = self.balls[i].stamp;
+                    let c = self.frame_gap(i, side).search(self.t, self.horizon);
+                    if c.t.is_finite() && c.t <= self.horizon {
+                        self.calendar.push(Entry {
+                            t: c.t,
+                            ball: i as u32,
+                            kind: Kind::Frame(side as i8, c.exact),
+                            stamps: (stamp, 0),
+                            segment: self.frame.segment,
+                        });
+                    }
+                    return Ok(());
+                }
+                self.bring(i);
+                let (xs, vs) = self.frame.state(self.t);
+                let b = self.balls[i];
+                let approach = side * (vs - b.v[0]);
+                if approach > 0.0 {
+                    let quick = self.t - b.last_impact < CONTACT_DURATION;
+                    let count = if quick { b.quick_impacts + 1 } else { 0 };
+                    if count > PERSISTENT_IMPACTS {
+                        return Err(self.stalled(format!(
+                            "ball{} is pressed against the {} wall by the frame's acceleration; the reference beyond one line has no state for a ball the frame holds",
+                            i + 1,
+                            if side > 0.0 { "left" } else { "right" }
+                        )));
+                    }
+                    let e = self.restitution(i, None);
+                    let (vb, vf, lost) = impact_law(b.mass, b.v[0], self.frame.mass, vs, e);
+                    let (damping, work) = self.frame.segment_energy(self.t, self.scene);
+                    self.damping_loss += damping;
+                    self.forcing_work += work;
+                    if self.frame.exists() {
+                        self.frame.restart(self.t, xs, vf);
+                    }
+                    self.balls[i].v[0] = vb;
+                    self.balls[i].last_impact = self.t;
+                    self.balls[i].quick_impacts = count;
+                    let (a, bb) = if side > 0.0 { (Body::LeftWall, Body::Ball(i)) } else { (Body::Ball(i), Body::RightWall) };
+                    self.record(a, bb, approach, lost);
+                    self.limits.fastest = self.limits.fastest.max(approach);
+                    self.check_ball(i, None)?;
+                    self.predict(i);
+                    if self.frame.exists() {
+                        // The walls move otherwise from now: every ball's search against them.
+                        for k in 0..self.balls.len() {
+                            if k != i {
+                                self.bring(k);
+                                for s in [1.0, -1.0] {
+                                    self.predict_frame_wall(k, s);
+                                }
+                            }
+                        }
+                    }
+                } else {
+                    self.predict(i);
+                }
+            }
+        }
+        Ok(())
+    }
+
+    /// The contact tolerance of balls `i` and `j` approaching at `rate`: the length tolerance,
+    /// the rounding in their positions and two ulps of time at the faster of `rate` and the
+    /// run's fastest speed.
+    fn pair_tolerance(&self, i: usize, j: usize, rate: f64) -> f64 {
+        let (a, b) = (&self.balls[i], &self.balls[j]);
+        let eps = f64::EPSILON;
+        let size = a.p.iter().chain(&b.p).fold(0.0, |m: f64, c| m.max(c.abs())) + a.radius + b.radius;
+        self.limits.tol + a.drift + b.drift + 8.0 * eps * size + 2.0 * eps * self.t.abs() * rate.abs().max(self.limits.fastest)
+    }
+
+    /// The postcondition at an impact of ball `i` (with `j`): neither overlaps a wall or a ball
+    /// near it beyond the contact tolerance (docs/MODEL.md §14).
+    fn check_ball(&mut self, i: usize, j: Option<usize>) -> Result<(), ModelError> {
+        for k in std::iter::once(i).chain(j) {
+            let b = self.balls[k];
+            let (xs, _) = self.frame.state(self.t);
+            let tol = self.pair_tolerance(k, k, 0.0) + self.frame.seg.position_roundoff(self.t);
+            let walls = [
+                ("left-wall", b.p[0] - b.radius - xs),
+                ("right-wall", xs + self.length - b.p[0] - b.radius),
+                ("front wall", b.p[1] + self.cells.half[0] - b.radius),
+                ("back wall", self.cells.half[0] - b.p[1] - b.radius),
+                ("floor", b.p[2] + self.cells.half[1] - b.radius),
+                ("ceiling", self.cells.half[1] - b.p[2] - b.radius),
+            ];
+            for (name, gap) in walls {
+                if gap < -tol {
+                    return Err(self.broken(format!(
+                        "its contact invariant at t = {} s: ball{} overlaps the {name} by {:.3e} m (tolerance {:.3e} m)",
+                        crate::scene::human(self.t),
+                        k + 1,
+                        -gap,
+                        tol
+                    )));
+                }
+            }
+            let mut near = Vec::new();
+            self.cells.around(b.cell, |o| near.push(o as usize));
+            for o in near {
+                if o == k {
+                    continue;
+                }
+                let (po, _) = self.balls[o].at(self.t, self.gravity);
+                let d: [f64; 3] = std::array::from_fn(|c| po[c] - b.p[c]);
+                let gap = dot(d, d).sqrt() - b.radius - self.balls[o].radius;
+                let tol = self.pair_tolerance(k, o, 0.0);
+                if gap < -tol {
+                    return Err(self.broken(format!(
+                        "its contact invariant at t = {} s: ball{} / ball{} overlap by {:.3e} m (tolerance {:.3e} m)",
+                        crate::scene::human(self.t),
+                        k + 1,
+                        o + 1,
+                        -gap,
+                        tol
+                    )));
+                }
+            }
+        }
+        Ok(())
+    }
+
+    fn finish(self, recorder: Recorder, t: f64) -> Run {
+        let scene = self.scene;
+        let (xs, vs) = self.frame.state(t);
+        let (damping, work) = self.frame.segment_energy(t, scene);
+        let mut final_ = scene.frame_energy(t, xs, vs);
+        let mut velocities = Vec::with_capacity(self.balls.len());
+        for (b, p0) in self.balls.iter().zip(&self.start) {
+            let (p, v) = b.at(t, self.gravity);
+            final_ += 0.5 * b.mass * dot(v, v) + b.mass * dot(self.gravity, std::array::from_fn(|k| p0[k] - p[k]));
+            velocities.push(v[0]);
+        }
+        let (series, motion) = recorder.finish();
+        Run {
+            scene: scene.name.clone(),
+            model: Model::Reference,
+            horizon: t,
+            sample_dt: scene.sample_dt,
+            initial_displacement: scene.initial_displacement,
+            damped_period: scene.frame.map_or(0.0, |f| f.damped_period()),
+            series,
+            motion,
+            impacts: self.impacts,
+            energy: EnergyAccount::forced(
+                scene.initial_energy(),
+                final_,
+                self.damping_loss + damping,
+                self.impact_loss,
+                self.forcing_work + work,
+            ),
+            events: self.events,
+            final_velocities: velocities,
+            peak_true_acceleration: None,
+            wall_time_s: 0.0,
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::model::Simulator;
+
+    /// Balls on one line with no gravity across it, run in a container with a cross-section,
+    /// meet at the one-line reference's impacts to round-off (the ball-ball times are roots of
+    /// the same distance, computed in three dimensions).
+    #[test]
+    fn balls_on_one_line_give_the_one_line_reference() {
+        let mut scene = crate::scene::load(crate::scene::scenes_dir().join("lpc-lsl.toml")).unwrap().scene.unwrap();
+        scene.horizon = 0.6;
+        let line = super::super::Reference.simulate(&scene, &RunOptions::default()).unwrap();
+        scene.space.section = [0.05, 0.05];
+        assert!(refusal(&scene).is_none());
+        let spatial = simulate(&scene, &RunOptions::default()).unwrap();
+        assert!(line.impacts.len() > 20, "{} impacts", line.impacts.len());
+        assert_eq!(spatial.impacts.len(), line.impacts.len());
+        for (a, b) in spatial.impacts.iter().zip(&line.impacts) {
+            assert_eq!((a.a, a.b), (b.a, b.b), "at {} s", b.t);
+            assert!((a.t - b.t).abs() <= 1e-12, "{} s against {} s", a.t, b.t);
+            assert!((a.approach_speed - b.approach_speed).abs() <= 1e-9 * b.approach_speed, "at {} s", b.t);
+        }
+        let (fa, fb) = (spatial.series.xs(), line.series.xs());
+        assert!(fa.iter().zip(fb).all(|(a, b)| (a - b).abs() <= 1e-12), "the frame moves alike");
+        assert!(spatial.energy.balance_error.abs() <= 1e-12, "{:?}", spatial.energy);
+    }
+}
