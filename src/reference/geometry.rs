@@ -39,6 +39,28 @@ pub(super) struct Limits {
 }
 
 impl Limits {
+    /// The limits a run of `scene` starts with: the length tolerance at [`LENGTH_TOLERANCE`] of
+    /// its length scale, sticking at [`STICK_SPEED`] of its speed scale and [`STICK_TIME`] of
+    /// its time scale (the frame's damped period, else the horizon).
+    pub(super) fn new(scene: &Scene) -> Limits {
+        let time_scale = scene.frame.map_or(scene.horizon, |f| {
+            let p = f.damped_period();
+            if p > 0.0 {
+                p
+            } else {
+                scene.horizon
+            }
+        });
+        let speed_scale = scene.speed_scale();
+        Limits {
+            tol: LENGTH_TOLERANCE * scene.length_scale(),
+            v_stick: STICK_SPEED * speed_scale,
+            fastest: speed_scale,
+            accepted_overlap: 0.0,
+            t_stick: STICK_TIME * time_scale,
+        }
+    }
+
     /// Whether a touching pair whose gap changes at `rate` with curvature `curvature` (the
     /// wall accelerating away from the ball when positive) separates by itself: it approaches
     /// slower than `v_stick` (round-off: a forced frame's velocity re-evaluated after a

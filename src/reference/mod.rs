@@ -183,27 +183,12 @@ impl<'a> Solver<'a> {
     fn new(scene: &'a Scene, record: Record) -> Self {
         let balls = Balls::new(scene);
         let pairs = balls.pairs.count();
-        let time_scale = scene.frame.map_or(scene.horizon, |f| {
-            let p = f.damped_period();
-            if p > 0.0 {
-                p
-            } else {
-                scene.horizon
-            }
-        });
-        let speed_scale = scene.speed_scale();
         Solver {
             scene,
             balls,
             frame: FrameMotion::new(scene),
             search: Search::new(pairs),
-            limits: Limits {
-                tol: LENGTH_TOLERANCE * scene.length_scale(),
-                v_stick: STICK_SPEED * speed_scale,
-                fastest: speed_scale,
-                accepted_overlap: 0.0,
-                t_stick: STICK_TIME * time_scale,
-            },
+            limits: Limits::new(scene),
             ledger: Ledger::new(pairs),
             sampler: Sampler::new(scene, record),
             scratch: Scratch::default(),

@@ -18,7 +18,7 @@ use std::collections::BinaryHeap;
 use super::frame::FrameMotion;
 use super::frame_gap::FrameGap;
 use super::geometry::Limits;
-use super::{CONTACT_DURATION, LENGTH_TOLERANCE, MAX_EVENTS, STICK_SPEED, STICK_TIME};
+use super::{CONTACT_DURATION, MAX_EVENTS};
 use crate::impact_law::impact_law;
 use crate::model::{Meter, Model, ModelError, OverBudget, RunOptions};
 use crate::run::{EnergyAccount, Impact, Recorder, Run};
@@ -210,15 +210,6 @@ impl<'a> Solver<'a> {
         let largest = scene.balls.iter().map(|b| b.radius).fold(0.0, f64::max);
         let mut cells = Cells::new(largest, container.length, scene.space.section, scene.balls.len());
         let frame = FrameMotion::new(scene);
-        let time_scale = scene.frame.map_or(scene.horizon, |f| {
-            let p = f.damped_period();
-            if p > 0.0 {
-                p
-            } else {
-                scene.horizon
-            }
-        });
-        let speed_scale = scene.speed_scale();
         let balls: Vec<Ball> = scene
             .balls
             .iter()
@@ -249,13 +240,7 @@ impl<'a> Solver<'a> {
             scene,
             balls,
             frame,
-            limits: Limits {
-                tol: LENGTH_TOLERANCE * scene.length_scale(),
-                v_stick: STICK_SPEED * speed_scale,
-                fastest: speed_scale,
-                accepted_overlap: 0.0,
-                t_stick: STICK_TIME * time_scale,
-            },
+            limits: Limits::new(scene),
             cells,
             calendar: BinaryHeap::new(),
             gravity: scene.space.gravity,
