@@ -51,6 +51,8 @@ class Run:
     a: npt.NDArray[np.float64]
     x: npt.NDArray[np.float64]
     v: npt.NDArray[np.float64]
+    y: npt.NDArray[np.float64] | None
+    z: npt.NDArray[np.float64] | None
     impacts: Columns
     metrics: dict[str, float | None]
     energy: dict[str, float]

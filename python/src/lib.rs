@@ -10,7 +10,7 @@
 
 use std::path::PathBuf;
 
-use numpy::ndarray::Array2;
+use numpy::ndarray::{Array2, Array3};
 use numpy::{IntoPyArray, PyArray1};
 use pyo3::create_exception;
 use pyo3::exceptions::{PyRuntimeError, PyValueError};
@@ -302,10 +302,21 @@ impl Run {
                 return Ok((table.clone_ref(py), columns, len));
             }
         }
+        let balls = run.series.balls();
+        let across = run.series.take_across();
         let (data, capacity, len, columns) = std::mem::take(&mut run.series).into_buffer();
         let array = Array2::from_shape_vec((columns, capacity), data).map_err(|e| PyRuntimeError::new_err(e.to_string()))?;
         let table = array.into_pyarray(py).into_any().unbind();
+        // The centres across the motion, `(samples, balls, 2)`; `None` for balls on lines.
+        let across = if across.is_empty() || balls == 0 {
+            py.None()
+        } else {
+            let samples = across.len() / (2 * balls);
+            let array = Array3::from_shape_vec((samples, balls, 2), across).map_err(|e| PyRuntimeError::new_err(e.to_string()))?;
+            array.into_pyarray(py).into_any().unbind()
+        };
         let mut made = self.made.lock_py_attached(py).expect("not poisoned");
+        made.insert("across", across);
         made.insert("table", table.clone_ref(py));
         made.insert("table_shape", (columns, len).into_pyobject(py)?.into_any().unbind());
         Ok((table, columns, len))
@@ -326,6 +337,18 @@ impl Run {
                 table.bind(py).get_item((rows, samples))?
             }
         };
+        Ok(py.import("numpy")?.call_method1("ascontiguousarray", (view,))?.unbind())
+    }
+
+    /// Coordinate `k` (0 for `y`, 1 for `z`) of the balls' centres across the motion,
+    /// `(balls, samples)`, C-contiguous; `None` when the balls stay on lines.
+    fn across(&self, py: Python<'_>, run: &mut lpc_damper::run::Run, k: usize) -> PyResult<Py<PyAny>> {
+        self.table(py, run)?;
+        let across = self.made.lock_py_attached(py).expect("not poisoned").get("across").map(|a| a.clone_ref(py));
+        let Some(across) = across.filter(|a| !a.is_none(py)) else { return Ok(py.None()) };
+        use pyo3::types::PySlice;
+        let all = PySlice::full(py);
+        let view = across.bind(py).get_item((all.clone(), all, k))?.getattr("T")?;
         Ok(py.import("numpy")?.call_method1("ascontiguousarray", (view,))?.unbind())
     }
 
@@ -365,6 +388,18 @@ impl Run {
     #[getter]
     fn v(&self, py: Python<'_>) -> PyResult<Py<PyAny>> {
         self.cached(py, "v", |py, r| self.columns(py, r, 4, Some(1)))
+    }
+    /// Ball centres across the motion, `y` (the container's axis at 0), `(balls, samples)`, m;
+    /// `None` when the balls stay on lines.
+    #[getter]
+    fn y(&self, py: Python<'_>) -> PyResult<Py<PyAny>> {
+        self.cached(py, "y", |py, r| self.across(py, r, 0))
+    }
+    /// Ball centres across the motion, `z` (the container's axis at 0), `(balls, samples)`, m;
+    /// `None` when the balls stay on lines.
+    #[getter]
+    fn z(&self, py: Python<'_>) -> PyResult<Py<PyAny>> {
+        self.cached(py, "z", |py, r| self.across(py, r, 1))
     }
     /// Impacts: `t`, `body_a`, `body_b`, `approach_speed`, `energy_lost`, `peak_force`,
     /// `contact_duration` (NaN for impulse models).

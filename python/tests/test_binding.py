@@ -58,6 +58,49 @@ def test_series_arrays_are_float64_and_owned_by_numpy(scenes):
     assert run.t[0] == 0.0 and run.t[-1] == pytest.approx(5.0)
 
 
+DROPPED_BALL = """
+name = "dropped"
+[frame]
+mass = 1.35
+stiffness = 865.0
+damping = 1.092
+initial_displacement = 0.0
+[container]
+length = 0.1
+width = 0.06
+height = 0.1
+[world]
+gravity = [0.0, 0.0, -9.81]
+restitution = 0.8
+[[ball]]
+position = [0.05, 0.0, -0.005]
+mass = 0.004
+radius = 0.005
+[run]
+horizon = 1.5
+"""
+
+
+def test_balls_across_the_motion_are_arrays_equal_to_the_cli_series(lpc_bin, tmp_path):
+    # A ball dropped 40 mm onto the floor (z = -0.05 m) of a container at rest comes to rest on it.
+    path = tmp_path / "dropped.toml"
+    path.write_text(DROPPED_BALL)
+    subprocess.run([lpc_bin, "run", path, "--out", tmp_path / "out"], check=True, capture_output=True)
+    header, rows = read_csv(tmp_path / "out" / "series.csv")
+    run = lpc.run(lpc.load_scene(path))
+    assert run.y.shape == run.x.shape == (1, len(rows)) and run.z.shape == run.x.shape
+    assert run.y.dtype == np.float64 and run.z.flags["C_CONTIGUOUS"]
+    assert np.array_equal(column(header, rows, "y1"), run.y[0])
+    assert np.array_equal(column(header, rows, "z1"), run.z[0])
+    assert run.z[0, 0] == -0.005 and run.z[0, -1] == pytest.approx(-0.045, abs=1e-15)
+    assert np.all(run.z[0] >= -0.045 - 1e-12)
+
+
+def test_balls_on_lines_have_no_coordinates_across(scenes):
+    run = lpc.run(lpc.load_scene(scenes / "lpc-lsl.toml"))
+    assert run.y is None and run.z is None
+
+
 def test_a_bad_field_raises_scene_error_with_the_cli_message(lpc_bin, scenes, tmp_path):
     text = (scenes / "lpc-lsl.toml").read_text().replace("mass = 1.35", "mass = -1.35")
     bad = tmp_path / "bad.toml"

@@ -25,8 +25,8 @@ pub struct Series {
     /// ([`series_every`]). The metrics always see every sample.
     pub every: usize,
     /// Each kept sample's balls' centres across the motion, `y1, z1, y2, z2, ...` sample after
-    /// sample; empty unless the model moves balls across the motion (the Rapier model's
-    /// spatial path).
+    /// sample; empty unless the model moves balls across the motion (the spatial paths of
+    /// the Rapier model and the reference).
     across: Vec<f64>,
 }
 
@@ -126,6 +126,11 @@ impl Series {
             Some(yz) => [yz[0], yz[1]],
             None => [0.0; 2],
         }
+    }
+    /// The balls' centres across the motion, moved out: `y1, z1, y2, z2, ...` for each kept
+    /// sample in turn (empty when the series has none).
+    pub fn take_across(&mut self) -> Vec<f64> {
+        std::mem::take(&mut self.across)
     }
     /// Every column, as vectors: `t`, `xs`, `vs`, `a`, then every ball's `x`, then every ball's `v`.
     pub fn into_columns(self) -> Vec<Vec<f64>> {
