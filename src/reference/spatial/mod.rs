@@ -133,6 +133,8 @@ struct Solver<'a> {
     frame: FrameMotion,
     limits: Limits,
     cells: Cells,
+    /// Scratch: the balls of the cells around one ball (kept to spare an allocation an event).
+    neighbours: Vec<usize>,
     calendar: BinaryHeap<Entry>,
     gravity: [f64; 3],
     e: f64,
@@ -242,6 +244,7 @@ impl<'a> Solver<'a> {
             frame,
             limits: Limits::new(scene),
             cells,
+            neighbours: Vec::new(),
             calendar: BinaryHeap::new(),
             gravity: scene.space.gravity,
             e: scene.restitution,
@@ -338,13 +341,15 @@ impl<'a> Solver<'a> {
         if let Some((dt, axis, dir)) = crossing {
             self.push(t + dt, i, Kind::Cell(axis as u8, dir as i8), None);
         }
-        let mut others = Vec::new();
+        let mut others = std::mem::take(&mut self.neighbours);
+        others.clear();
         self.cells.around(b.cell, |j| others.push(j as usize));
-        for j in others {
+        for &j in &others {
             if j != i {
                 self.predict_pair(i, j, t);
             }
         }
+        self.neighbours = others;
     }
 
     /// When balls `i` and `j` touch, searched from `from`.
@@ -581,18 +586,9 @@ impl<'a> Solver<'a> {
             Kind::Frame(side, exact) => {
                 let side = side as f64;
                 if !exact {
+                    // No contact before now: the search goes on from here.
                     self.bring(i);
-                    let stamp = self.balls[i].stamp;
-                    let c = self.frame_gap(i, side).search(self.t, self.horizon);
-                    if c.t.is_finite() && c.t <= self.horizon {
-                        self.calendar.push(Entry {
-                            t: c.t,
-                            ball: i as u32,
-                            kind: Kind::Frame(side as i8, c.exact),
-                            stamps: (stamp, 0),
-                            segment: self.frame.segment,
-                        });
-                    }
+                    self.predict_frame_wall(i, side);
                     return Ok(());
                 }
                 self.bring(i);
@@ -657,9 +653,10 @@ impl<'a> Solver<'a> {
     /// The postcondition at an impact of ball `i` (with `j`): neither overlaps a wall or a ball
     /// near it beyond the contact tolerance (docs/MODEL.md §14).
     fn check_ball(&mut self, i: usize, j: Option<usize>) -> Result<(), ModelError> {
+        let (xs, _) = self.frame.state(self.t);
+        let mut near = std::mem::take(&mut self.neighbours);
         for k in std::iter::once(i).chain(j) {
             let b = self.balls[k];
-            let (xs, _) = self.frame.state(self.t);
             let tol = self.pair_tolerance(k, k, 0.0) + self.frame.seg.position_roundoff(self.t);
             let walls = [
                 ("left-wall", b.p[0] - b.radius - xs),
@@ -680,9 +677,9 @@ impl<'a> Solver<'a> {
                     )));
                 }
             }
-            let mut near = Vec::new();
+            near.clear();
             self.cells.around(b.cell, |o| near.push(o as usize));
-            for o in near {
+            for &o in &near {
                 if o == k {
                     continue;
                 }
@@ -702,6 +699,7 @@ impl<'a> Solver<'a> {
                 }
             }
         }
+        self.neighbours = near;
         Ok(())
     }
 
