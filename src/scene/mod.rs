@@ -1,6 +1,7 @@
 //! Scene description and validation: the only place where a scene file is parsed and checked.
 //! Every model receives a [`Scene`] that is already known to be valid (docs/MODEL.md §1-2, §8).
 
+mod chamber;
 mod excitation;
 pub mod format;
 mod geometry;
@@ -14,6 +15,7 @@ mod structure;
 
 use std::path::{Path, PathBuf};
 
+pub use chamber::{Chamber, Wall};
 pub use excitation::Forcing;
 pub use format::{Arrangement, Distribution, ForcingKind, Length, SceneFile, Stepping};
 pub use geometry::{ball_radius, pair_bodies, pair_gap, pair_range, Ball, BallKind, Body, Container, Pairs};

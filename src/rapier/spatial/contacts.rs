@@ -6,7 +6,7 @@
 //! the normal). Tangential velocities stay Rapier's (friction). Touching pairs that the
 //! impacts set approaching are then struck in turn, the fastest first, as in §3.
 
-use super::geometry::{Geometry, Wall};
+use crate::scene::{Chamber, Wall};
 
 /// What a ball touches.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
@@ -40,7 +40,7 @@ pub struct Balls<'a> {
 
 /// Finds every pair closer than `touching` (balls and walls), sweeping along x in `order`
 /// (kept between steps: nearly sorted already, so the insertion sort is linear).
-pub fn find(geometry: &Geometry, x: &[[f64; 3]], radius: &[f64], xs: f64, touching: f64, order: &mut Vec<usize>, out: &mut Vec<Contact>) {
+pub fn find(geometry: &Chamber, x: &[[f64; 3]], radius: &[f64], xs: f64, touching: f64, order: &mut Vec<usize>, out: &mut Vec<Contact>) {
     out.clear();
     let n = x.len();
     if order.len() != n {

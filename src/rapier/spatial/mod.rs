@@ -11,19 +11,17 @@
 //! of every body per step) and nothing the headless run needs. The one-line path is untouched.
 
 mod contacts;
-mod geometry;
 mod world;
 
 use bevy_rapier3d::rapier::prelude::{RigidBodyHandle, RigidBodySet, Vector};
 
 pub use contacts::closing_speed;
-pub use geometry::{Geometry, Wall};
 pub use world::SolverSettings;
 
 use crate::model::{Checks, Meter, Model, ModelError, OverBudget, RunOptions};
 use crate::oscillator::{gauss_legendre, Driven, Oscillator};
 use crate::run::{EnergyAccount, Impact, Recorder, Run};
-use crate::scene::{Body, Scene};
+use crate::scene::{Body, Chamber, Scene, Wall};
 use contacts::{Balls, Contact, FrameBody, Other};
 
 /// Default step of the spatial path, s: Rapier's steps are plastic and the bounces come from
@@ -64,7 +62,7 @@ pub fn refusal(scene: &Scene) -> Option<String> {
     if scene.frame.is_none() {
         return Some("the scene has no frame; the spatial contact model needs a container on a frame".into());
     }
-    if let Err(reason) = Geometry::new(scene) {
+    if let Err(reason) = Chamber::new(scene) {
         return Some(reason);
     }
     if scene.balls.is_empty() {
@@ -183,7 +181,8 @@ pub fn simulate_spatial_with(scene: &Scene, solver: SolverSettings, options: &Ru
     if let Some(reason) = refusal(scene) {
         return Err(ModelError::Refused(reason));
     }
-    let geometry = Geometry::new(scene).map_err(ModelError::Refused)?;
+    let geometry = Chamber::new(scene).map_err(ModelError::Refused)?;
+    let speed = crate::rapier::resources::speed_scale(scene);
     let Some(f) = scene.frame else { return Err(ModelError::Refused("the scene has no frame".into())) };
     let meter = Meter::new(options, BUDGET_STEPS);
     let mut world = world::build(scene, &geometry, solver);
@@ -211,12 +210,12 @@ pub fn simulate_spatial_with(scene: &Scene, solver: SolverSettings, options: &Ru
     // Closings slower than gravity and the frame's acceleration build along a contact's
     // normal in two steps are resting contacts, left to Rapier's plastic solve.
     let frame_acceleration = crate::rapier::peak_frame_acceleration(scene);
-    let speed_floor = 1e-9 * geometry.speed;
+    let speed_floor = 1e-9 * speed;
     let resting_speed =
         |normal: [f64; 3]| 2.0 * (contacts_dot(g, normal).abs() + normal[0].abs() * frame_acceleration) * solver.dt + speed_floor;
     let mut order = Vec::new();
     // How fast pairs may close, m/s: twice the fastest expected speed.
-    let reach = 2.0 * geometry.speed;
+    let reach = 2.0 * speed;
     let mut found: Vec<Contact> = Vec::new();
     let mut kicked = vec![false; n];
     // The knock-on cascade's scratch: each ball's touching contacts, the candidates, which are listed.

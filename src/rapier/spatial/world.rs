@@ -4,8 +4,7 @@
 
 use bevy_rapier3d::rapier::prelude::*;
 
-use super::geometry::{Geometry, Wall};
-use crate::scene::Scene;
+use crate::scene::{Chamber, Scene, Wall};
 
 /// The Rapier world of a scene and the handles the stepper reads.
 pub struct SpatialWorld {
@@ -36,7 +35,7 @@ pub struct SolverSettings {
 const WALL_THICKNESS_RADII: f64 = 4.0;
 
 /// Builds the world of `scene` (validated for the spatial path by `super::refusal`).
-pub fn build(scene: &Scene, geometry: &Geometry, solver: SolverSettings) -> SpatialWorld {
+pub fn build(scene: &Scene, geometry: &Chamber, solver: SolverSettings) -> SpatialWorld {
     let mut physics = PhysicsWorld::new();
     let [gx, gy, gz] = scene.space.gravity;
     physics.gravity = Vector::new(gx as f32, gy as f32, gz as f32);
@@ -51,7 +50,7 @@ pub fn build(scene: &Scene, geometry: &Geometry, solver: SolverSettings) -> Spat
         // The default clamps every body at 400 length units per second.
         normalized_max_linear_velocity: f32::MAX,
         // Contacts are found as far ahead as the fastest expected pair closes in a step.
-        normalized_prediction_distance: ((geometry.speed * solver.dt) as f32 / lu).max(0.02),
+        normalized_prediction_distance: ((super::super::resources::speed_scale(scene) * solver.dt) as f32 / lu).max(0.02),
         // Coulomb's law at each contact point: a sphere touches at one point, so Rapier's
         // default (one friction constraint per manifold plus a "twist" constraint that stops
         // spin about the normal) would add a torque Coulomb friction has not.
@@ -94,7 +93,7 @@ pub fn build(scene: &Scene, geometry: &Geometry, solver: SolverSettings) -> Spat
 /// The box of a wall in the frame's coordinates (origin at the left wall's inner face on the
 /// axis): its centre and half-extents. The six walls overlap at the edges so that no corner
 /// is open; dividers span the container's inside.
-fn wall_box(g: &Geometry, wall: Wall, t: f64) -> ([f64; 3], [f64; 3]) {
+fn wall_box(g: &Chamber, wall: Wall, t: f64) -> ([f64; 3], [f64; 3]) {
     let [l, w, h] = [g.length, g.width, g.height];
     let (hl, hw, hh) = (0.5 * l + 2.0 * t, 0.5 * w + 2.0 * t, 0.5 * h + 2.0 * t);
     match wall {

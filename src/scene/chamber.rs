@@ -1,7 +1,8 @@
 //! The container's inside in the frame's coordinates (origin at the left wall's inner face on
-//! the container's axis): its walls, and the gap and normal from a ball to each of them.
+//! the container's axis): its walls and the dividers between chains, and the gap and normal
+//! from a ball to each of them, stated once for every model that moves balls off their lines.
 
-use crate::scene::{Body, Scene};
+use super::{Body, Scene};
 
 /// A wall of the container, or a divider between chains `k - 1` and `k`.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
@@ -33,9 +34,9 @@ impl Wall {
     }
 }
 
-/// The container's inside and the scales the stepper needs.
+/// The container's inside: its size, its chains' channels and the dividers between them.
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub struct Geometry {
+pub struct Chamber {
     /// Inner length along x, m.
     pub length: f64,
     /// Inner width along y, m.
@@ -50,16 +51,14 @@ pub struct Geometry {
     pub divider_half_thickness: f64,
     /// Largest ball radius, m.
     pub largest_radius: f64,
-    /// The fastest speed expected, m/s (twice the scene's speed scale, for what impacts add).
-    pub speed: f64,
 }
 
 /// Dividers take this fraction of a channel at most: they are thin.
 const DIVIDER_FRACTION: f64 = 0.01;
 
-impl Geometry {
-    /// The geometry of `scene`, or why the spatial path cannot build it.
-    pub fn new(scene: &Scene) -> Result<Geometry, String> {
+impl Chamber {
+    /// The inside of `scene`'s container, or why it has none beyond a line.
+    pub fn new(scene: &Scene) -> Result<Chamber, String> {
         let Some(c) = scene.container else { return Err("the scene has no container".into()) };
         let [width, height] = scene.space.section;
         if !(width > 0.0 && height > 0.0) {
@@ -73,19 +72,10 @@ impl Geometry {
         if chains > 1 && divider_half_thickness <= 1e-6 * channel {
             return Err(format!(
                 "its channels ({} m) are as narrow as its largest ball: no room for the dividers between the chains; widen the container",
-                crate::scene::human(channel)
+                super::human(channel)
             ));
         }
-        Ok(Geometry {
-            length: c.length,
-            width,
-            height,
-            chains,
-            channel,
-            divider_half_thickness,
-            largest_radius,
-            speed: crate::rapier::resources::speed_scale(scene),
-        })
+        Ok(Chamber { length: c.length, width, height, chains, channel, divider_half_thickness, largest_radius })
     }
 
     /// Every wall and divider.
