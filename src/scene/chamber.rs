@@ -78,6 +78,11 @@ impl Chamber {
         Ok(Chamber { length: c.length, width, height, chains, channel, divider_half_thickness, largest_radius })
     }
 
+    /// The length of the inside's diagonal, m: the farthest a ball can fall or be thrown in it.
+    pub fn diagonal(&self) -> f64 {
+        (self.length * self.length + self.width * self.width + self.height * self.height).sqrt()
+    }
+
     /// Every wall and divider.
     pub fn walls(&self) -> impl Iterator<Item = Wall> + use<> {
         [Wall::Left, Wall::Right, Wall::Front, Wall::Back, Wall::Floor, Wall::Ceiling]
