@@ -15,6 +15,7 @@ mod integrator;
 mod jacobian;
 mod output;
 mod rosenbrock;
+pub mod spatial;
 mod stepper;
 mod system;
 
@@ -58,10 +59,16 @@ impl Simulator for Compliant {
         if !(tolerance > 0.0 && tolerance <= 1e-2) {
             return Err(format!("its error tolerance must lie in (0, 1e-2] (got {})", crate::scene::human(tolerance)));
         }
-        scene.space.beyond_lines(&scene.initial_positions).map_or(Ok(()), Err)
+        match scene.space.beyond_lines(&scene.initial_positions) {
+            Some(_) => spatial::refusal(scene).map_or(Ok(()), Err),
+            None => Ok(()),
+        }
     }
 
     fn simulate(&self, scene: &Scene, options: &RunOptions) -> Result<Run, ModelError> {
+        if beyond_lines(scene) {
+            return spatial::simulate(scene, options);
+        }
         // Without a step budget the model still stops at MAX_STEPS rather than run for ever.
         let limits = Limits { max_steps: Some(options.limits.max_steps.unwrap_or(MAX_STEPS)), ..options.limits };
         let meter = Meter::new(&RunOptions { limits, ..*options }, PROGRESS_STEPS);
@@ -72,6 +79,9 @@ impl Simulator for Compliant {
     }
 
     fn checks(&self, scene: &Scene, run: &Run) -> Checks {
+        if beyond_lines(scene) {
+            return spatial::checks(scene, run);
+        }
         // Each step errs by at most the tolerance of the contact's scales; they add up at
         // worst. Contact forces are equal and opposite and Runge-Kutta keeps linear invariants.
         let balance = (run.events as f64 * scene.compliant.tolerance).max(1e-9);
@@ -91,9 +101,19 @@ impl Simulator for Compliant {
         &[Setting::Tolerance]
     }
 
-    fn stepping(&self, _scene: &Scene) -> &'static str {
-        "adaptive"
+    fn stepping(&self, scene: &Scene) -> &'static str {
+        if beyond_lines(scene) {
+            "velocity Verlet at the fastest contact's Hertz time"
+        } else {
+            "adaptive"
+        }
     }
+}
+
+/// Whether `scene` goes to the spatial path: balls off their lines, motion across them,
+/// gravity or friction (several chains on lines stay on the one-line path, exactly).
+fn beyond_lines(scene: &Scene) -> bool {
+    scene.space.beyond_lines(&scene.initial_positions).is_some()
 }
 
 /// How far the compliant model's balls may legitimately overlap a wall: twice the elastic

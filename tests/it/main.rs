@@ -13,6 +13,7 @@ mod budgets;
 mod check_goldens;
 mod closed_form;
 mod compliant_model;
+mod compliant_space;
 mod design_maps;
 mod determinism;
 mod energy_balance;

@@ -90,6 +90,20 @@ fn contact_model_passes_the_first_seeded_beds() {
     ));
 }
 
+#[test]
+fn compliant_model_passes_the_first_seeded_beds() {
+    // The same beds for the compliant model's spatial path: every run it finishes passes every
+    // check (its energy balance to the integration error); a run may stop at its 3 s budget,
+    // a typed stop (whether it does depends on the machine; what is asserted does not).
+    assert_all_pass(&stress(
+        Model::Compliant,
+        1,
+        10,
+        Draws { max_horizon: 1.0, forced: false, extreme: false, max_wall_s: Some(3.0), chains: false, beds: true },
+        &|| {},
+    ));
+}
+
 /// Issue 19: scenes at the extremes a user can type (`lpc stress --extreme`: 1-10 000 balls,
 /// frame periods 1 us-1000 s, mass ratios up to 1e9, densities 1e-3-1e6, gaps, clearances and
 /// displacements far beyond the container) end in a pass, a typed refusal or a typed stop at

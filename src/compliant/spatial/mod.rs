@@ -1,0 +1,741 @@
+//! The compliant model beyond one line (docs/MODEL.md §15): balls free in the plane or in space
+//! under the scene's gravity, every contact (ball-ball, ball-wall, ball-divider) a Hertz spring
+//! along its normal with the one-line model's Hunt-Crossley damping ([`contact`]), and a
+//! tangential force capped by Coulomb friction that spins the balls. The frame moves along x
+//! and takes the walls' contact forces.
+//!
+//! Everything moves by velocity Verlet at a step set by the Hertz contact time of the fastest
+//! impact the run can have ([`step_for`]). A grid of cells (`cells`) lists the pairs closer
+//! than a skin in O(n), again only when a ball has moved half the skin: every step then costs
+//! what its candidate pairs do.
+
+mod cells;
+
+use super::{contact, FLOOR_SPEED_FRACTION, MAX_STEPS};
+use crate::model::{Budget, Checks, Limits, Meter, Model, ModelError, OverBudget, RunOptions};
+use crate::run::{EnergyAccount, Impact, Recorder, Run};
+use crate::scene::{Body, Chamber, Scene, Wall};
+use cells::Cells;
+
+/// Steps per elastic Hertz contact of the fastest impact the run can have: the restitution of
+/// an isolated impact then errs by about 1e-3 (velocity Verlet errs as the square of the step).
+pub const STEPS_PER_CONTACT: f64 = 50.0;
+/// Steps over which a slip relaxes to rolling while friction allows (the tangential force is
+/// viscous up to the Coulomb cap, a regularised Coulomb law).
+pub const SLIP_RELAXATION_STEPS: f64 = 10.0;
+/// Longest step in an open contact, times `1 / omega` of its linearised stiffness (an
+/// impact at the design speed takes shorter steps already; a pile's loaded contacts may not).
+pub const CONTACT_STEP: f64 = 0.1;
+/// Longest step times the fastest damping rate of an open contact (velocity Verlet damps
+/// stably below 2).
+pub const DAMPING_STEP: f64 = 0.2;
+/// Candidate pairs are those closer than this many of the smallest radius: they are listed
+/// again when a ball has moved half as far (relative to the container).
+pub const SKIN_RADII: f64 = 0.2;
+/// Longest step as a fraction of the frame's natural period and of the forcing period.
+pub const FRAME_PERIOD_FRACTION: f64 = 1e-3;
+/// Share of the energies that flow by which the balance may be off before the run is taken to
+/// have gone unstable (far beyond the integration error, `(pi / STEPS_PER_CONTACT)^2`).
+pub const UNSTABLE_BALANCE: f64 = 0.1;
+/// Steps between two looks at the budgets.
+const BUDGET_STEPS: u64 = 1024;
+
+/// Why the spatial compliant model cannot run `scene`, or `None` when it can.
+pub(super) fn refusal(scene: &Scene) -> Option<String> {
+    if scene.container.is_none() {
+        return Some("the scene's balls leave their lines but it has no container".into());
+    }
+    Chamber::new(scene).err()
+}
+
+/// The longest step at which an impact at closing speed `speed` takes [`STEPS_PER_CONTACT`]
+/// steps, for the pair of largest `m* / K` bound below by `stiffest` (`m / (2 K(r))`, least
+/// over the balls): `ELASTIC_DURATION (m* / K)^(2/5) v^(-1/5) / STEPS_PER_CONTACT`.
+pub fn step_for(stiffest: f64, speed: f64) -> f64 {
+    contact::ELASTIC_DURATION * stiffest.powf(0.4) * speed.powf(-0.2) / STEPS_PER_CONTACT
+}
+
+/// Index of a wall among a ball's contacts: after the balls.
+fn wall_index(n: usize, wall: Wall) -> u32 {
+    let k = match wall {
+        Wall::Left => 0,
+        Wall::Right => 1,
+        Wall::Front => 2,
+        Wall::Back => 3,
+        Wall::Floor => 4,
+        Wall::Ceiling => 5,
+        Wall::Divider(k) => 5 + k,
+    };
+    (n + k) as u32
+}
+
+/// A contact that is open: what it started with, and what it has done so far.
+#[derive(Debug, Clone, Copy)]
+struct Open {
+    /// The other ball, or a wall ([`wall_index`]).
+    other: u32,
+    wall: Option<Wall>,
+    /// Hertz stiffness, N/m^(3/2).
+    k: f64,
+    /// Onset time, s (extrapolated back to zero overlap).
+    onset: f64,
+    /// Largest overlap rate so far (the approach speed of an isolated impact), m/s: it sets
+    /// the Hunt-Crossley damping `alpha = c / approach`.
+    approach: f64,
+    peak_force: f64,
+    /// Energy taken so far (normal damping and friction), J.
+    loss: f64,
+    /// Power taken at the last step, W.
+    power: f64,
+    /// Overlap and its rate at the last step.
+    overlap: f64,
+    rate: f64,
+    /// Whether the contact was found this step.
+    seen: bool,
+}
+
+/// The spatial compliant model's run of one scene.
+struct Solver<'a> {
+    scene: &'a Scene,
+    chamber: Chamber,
+    cells: Cells,
+    n: usize,
+    x: Vec<[f64; 3]>,
+    v: Vec<[f64; 3]>,
+    w: Vec<[f64; 3]>,
+    force: Vec<[f64; 3]>,
+    /// Scratch: velocities at the half step.
+    v_half: Vec<[f64; 3]>,
+    w_half: Vec<[f64; 3]>,
+    torque: Vec<[f64; 3]>,
+    mass: Vec<f64>,
+    radius: Vec<f64>,
+    inertia: Vec<f64>,
+    start: Vec<[f64; 3]>,
+    /// Pairs of balls and balls and walls closer than the skin when last listed.
+    ball_candidates: Vec<(u32, u32)>,
+    wall_candidates: Vec<(u32, Wall)>,
+    /// Where the balls and the frame were when the candidates were listed.
+    listed_at: Vec<[f64; 3]>,
+    listed_xs: f64,
+    /// How much closer than touching a pair must be to be listed, m.
+    skin: f64,
+    /// Open contacts, listed with the ball of lower index.
+    open: Vec<Vec<Open>>,
+    xs: f64,
+    vs: f64,
+    /// Force on the frame: its spring, damper and excitation, and the walls' contacts, N.
+    frame_force: f64,
+    frame_mass: f64,
+    gravity: [f64; 3],
+    e_star: f64,
+    friction: f64,
+    /// `c = alpha v0` that gives the scene's restitution.
+    c: f64,
+    /// Approach speeds below this set the damping as if they were this, m/s.
+    v_floor: f64,
+    /// `m / (2 K(r))`, least over the balls.
+    stiffest: f64,
+    /// Closing speed the step is always fit for, m/s.
+    design_speed: f64,
+    /// Longest step, s.
+    h_max: f64,
+    /// The largest `omega^2` (linearised stiffness over reduced mass) and damping rate of the
+    /// open contacts at the last evaluation of the forces, 1/s^2 and 1/s.
+    stiffness_rate: f64,
+    damping_rate: f64,
+    t: f64,
+    steps: u64,
+    impacts: Vec<Impact>,
+    contact_loss: f64,
+    damping_loss: f64,
+    forcing_work: f64,
+}
+
+fn dot(a: [f64; 3], b: [f64; 3]) -> f64 {
+    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
+}
+
+fn cross(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
+    [a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]]
+}
+
+/// Runs the spatial compliant model on `scene` (which [`refusal`] accepts).
+pub(super) fn simulate(scene: &Scene, options: &RunOptions) -> Result<Run, ModelError> {
+    let limits = Limits { max_steps: Some(options.limits.max_steps.unwrap_or(MAX_STEPS)), ..options.limits };
+    let meter = Meter::new(&RunOptions { limits, ..*options }, BUDGET_STEPS);
+    let mut s = Solver::new(scene).map_err(ModelError::Refused)?;
+    let mut recorder = Recorder::new(scene, options.record);
+    let outcome = s.run(&meter, &mut recorder);
+    meter.finish(s.t, s.steps);
+    match outcome? {
+        None => {
+            let mut run = s.finish(recorder);
+            run.horizon = scene.horizon;
+            run.wall_time_s = meter.elapsed();
+            Ok(run)
+        }
+        Some(budget) => {
+            let (t, steps, wall_s) = (s.t, s.steps, meter.elapsed());
+            let cost = format!("{} impacts so far; {} balls in 3D at steps of {} s", s.impacts.len(), s.n, crate::scene::human(s.step()));
+            let mut partial = s.finish(recorder);
+            partial.wall_time_s = wall_s;
+            Err(ModelError::OverBudget(Box::new(OverBudget {
+                scene: scene.name.clone(),
+                model: Model::Compliant,
+                t,
+                horizon: scene.horizon,
+                steps,
+                wall_s,
+                budget,
+                limit: meter.limit(budget),
+                cost,
+                partial,
+            })))
+        }
+    }
+}
+
+/// The tolerances a spatial compliant run is checked with.
+pub(super) fn checks(scene: &Scene, run: &Run) -> Checks {
+    // Velocity Verlet errs in what each contact exchanges by about the square of its phase
+    // step: `(pi / STEPS_PER_CONTACT)^2` for the stiffness, `DAMPING_STEP^2 / 12` for the
+    // damping, the larger 4e-3. What the contacts exchange is at most what is put in, what
+    // they lose and what gravity does on the balls' fall and rise (from the samples).
+    let per_contact = (std::f64::consts::PI / STEPS_PER_CONTACT).powi(2).max(DAMPING_STEP * DAMPING_STEP / 12.0);
+    // Relative to what was put in, as the stress checks measure it (at least a picojoule).
+    let put_in = run.energy.initial.abs().max(1e-12) + run.energy.forcing_work.abs();
+    let exchanged = put_in + 2.0 * run.energy.impact_loss.abs() + gravity_exchange(scene, run);
+    let balance = (per_contact * exchanged / put_in).max(1e-9);
+    let e_star = contact::effective_modulus(&scene.compliant);
+    let r_min = scene.balls.iter().map(|b| b.radius).fold(f64::INFINITY, f64::min);
+    let m_max = scene.balls.iter().map(|b| b.mass).fold(0.0, f64::max);
+    let m_all: f64 = scene.balls.iter().map(|b| b.mass).sum();
+    let k = contact::stiffness(e_star, contact::effective_radius(r_min.min(1.0), None));
+    let u_max = run.impacts.iter().map(|i| i.approach_speed).fold(0.0, f64::max);
+    let g = dot(scene.space.gravity, scene.space.gravity).sqrt();
+    let a_max = run.series.a().iter().fold(0.0f64, |m, a| m.max(a.abs())) + g;
+    let wall_overlap = 2.0 * (contact::max_overlap(m_max, u_max, k) + (m_all * a_max / k).powf(2.0 / 3.0)) + 1e-12;
+    Checks {
+        energy_gain: balance,
+        balance: Some(balance),
+        impact_gain: balance,
+        exact_impacts: false,
+        momentum: 1e-6,
+        wall_overlap,
+        ball_overlap: None,
+        stall_by_rate: false,
+    }
+}
+
+/// The work gravity can have done on the balls over `run`: each ball's weight times the span of
+/// its height along gravity over the samples (or across the container without samples), J.
+fn gravity_exchange(scene: &Scene, run: &Run) -> f64 {
+    let g = scene.space.gravity;
+    let g_norm = dot(g, g).sqrt();
+    if g_norm == 0.0 {
+        return 0.0;
+    }
+    let s = &run.series;
+    let across = Chamber::new(scene).map_or(0.0, |c| c.diagonal());
+    (0..scene.balls.len())
+        .map(|i| {
+            let span = if s.is_empty() {
+                across
+            } else {
+                let heights = (0..s.len()).map(|k| {
+                    let [y, z] = s.across(i, k);
+                    -(g[0] * s.x(i)[k] + g[1] * y + g[2] * z) / g_norm
+                });
+                let (lo, hi) = heights.fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), h| (lo.min(h), hi.max(h)));
+                hi - lo
+            };
+            scene.balls[i].mass * g_norm * span
+        })
+        .sum()
+}
+
+impl<'a> Solver<'a> {
+    fn new(scene: &'a Scene) -> Result<Self, String> {
+        let chamber = Chamber::new(scene)?;
+        let n = scene.balls.len();
+        let [width, height] = scene.space.section;
+        let largest = scene.balls.iter().map(|b| b.radius).fold(0.0, f64::max);
+        let smallest = scene.balls.iter().map(|b| b.radius).fold(f64::INFINITY, f64::min).min(largest);
+        let skin = SKIN_RADII * smallest;
+        // Listed pairs may be a skin apart: the cells are as wide as that reach.
+        let cells = Cells::new([0.0, -0.5 * width, -0.5 * height], [chamber.length, 0.5 * width, 0.5 * height], 2.0 * largest + skin, n);
+        let mass: Vec<f64> = scene.balls.iter().map(|b| b.mass).collect();
+        let radius: Vec<f64> = scene.balls.iter().map(|b| b.radius).collect();
+        let e_star = contact::effective_modulus(&scene.compliant);
+        let x: Vec<[f64; 3]> = (0..n)
+            .map(|i| {
+                let [y, z] = scene.space.lateral_of(i);
+                [scene.initial_positions[i], y, z]
+            })
+            .collect();
+        let v: Vec<[f64; 3]> = (0..n)
+            .map(|i| {
+                let [vy, vz] = scene.space.lateral_velocity_of(i);
+                [scene.initial_velocities[i], vy, vz]
+            })
+            .collect();
+        let stiffest = (0..n).map(|i| 0.5 * mass[i] / contact::stiffness(e_star, radius[i])).fold(f64::INFINITY, f64::min);
+        let g = dot(scene.space.gravity, scene.space.gravity).sqrt();
+        // The fastest closing the scene sets going, or gravity across the container's diagonal.
+        let diagonal = chamber.diagonal();
+        let design_speed = (2.0 * scene.speed_scale()).max((2.0 * g * diagonal).sqrt()).max(f64::MIN_POSITIVE);
+        let mut h_max = scene.horizon;
+        if let Some(f) = scene.frame.filter(|f| f.stiffness > 0.0) {
+            h_max = h_max.min(FRAME_PERIOD_FRACTION * 2.0 * std::f64::consts::PI * (f.mass / f.stiffness).sqrt());
+        }
+        if let Some(forcing) = scene.forcing {
+            h_max = h_max.min(FRAME_PERIOD_FRACTION / forcing.frequency);
+        }
+        let inertia = (0..n).map(|i| 0.4 * mass[i] * radius[i] * radius[i]).collect();
+        let mut solver = Solver {
+            scene,
+            chamber,
+            cells,
+            n,
+            start: x.clone(),
+            x,
+            v,
+            w: vec![[0.0; 3]; n],
+            force: vec![[0.0; 3]; n],
+            v_half: vec![[0.0; 3]; n],
+            w_half: vec![[0.0; 3]; n],
+            torque: vec![[0.0; 3]; n],
+            mass,
+            radius,
+            inertia,
+            ball_candidates: Vec::new(),
+            wall_candidates: Vec::new(),
+            listed_at: vec![[0.0; 3]; n],
+            listed_xs: 0.0,
+            skin,
+            open: vec![Vec::new(); n],
+            xs: scene.initial_displacement,
+            vs: 0.0,
+            frame_force: 0.0,
+            frame_mass: scene.frame.map_or(f64::INFINITY, |f| f.mass),
+            gravity: scene.space.gravity,
+            e_star,
+            friction: scene.space.friction,
+            c: contact::damping_for(scene.restitution),
+            v_floor: FLOOR_SPEED_FRACTION * scene.speed_scale(),
+            stiffest,
+            design_speed,
+            h_max,
+            stiffness_rate: 0.0,
+            damping_rate: 0.0,
+            t: 0.0,
+            steps: 0,
+            impacts: Vec::new(),
+            contact_loss: 0.0,
+            damping_loss: 0.0,
+            forcing_work: 0.0,
+        };
+        let h = solver.step();
+        solver.forces(h);
+        Ok(solver)
+    }
+
+    /// The step now: [`step_for`] the fastest closing the balls and the frame can have now, or
+    /// the design speed if faster; short enough for every open contact (a tenth of `1 / omega`
+    /// of its linearised stiffness and half the inverse of its damping rate, which a pile's
+    /// loaded contacts can exceed); within the frame's and the forcing's periods.
+    fn step(&self) -> f64 {
+        let fastest = self.v.iter().map(|v| dot(*v, *v)).fold(0.0, f64::max).sqrt();
+        let speed = self.design_speed.max(2.0 * (fastest + self.vs.abs()));
+        let mut h = self.h_max;
+        if self.stiffest.is_finite() {
+            h = h.min(step_for(self.stiffest, speed));
+        }
+        if self.stiffness_rate > 0.0 {
+            h = h.min(CONTACT_STEP / self.stiffness_rate.sqrt());
+        }
+        if self.damping_rate > 0.0 {
+            h = h.min(DAMPING_STEP / self.damping_rate);
+        }
+        h
+    }
+
+    fn wall_velocity(&self) -> [f64; 3] {
+        [if self.frame_mass.is_finite() { self.vs } else { 0.0 }, 0.0, 0.0]
+    }
+
+    /// Every force and torque at the current positions and (predicted) velocities; contacts
+    /// that ended are written as impacts. `h` is the step just taken (for the losses' sums).
+    fn forces(&mut self, h: f64) {
+        let n = self.n;
+        for i in 0..n {
+            self.force[i] = std::array::from_fn(|k| self.mass[i] * self.gravity[k]);
+            self.torque[i] = [0.0; 3];
+            self.open[i].iter_mut().for_each(|c| c.seen = false);
+        }
+        self.frame_force = self.scene.frame_force(self.t, self.xs, self.vs);
+        self.stiffness_rate = 0.0;
+        self.damping_rate = 0.0;
+        let xs = self.xs;
+        let moved = (0..n).any(|i| {
+            let d: [f64; 3] = std::array::from_fn(|k| self.x[i][k] - self.listed_at[i][k]);
+            (d[0] - (xs - self.listed_xs)).powi(2) + d[1] * d[1] + d[2] * d[2] > 0.25 * self.skin * self.skin
+        });
+        if moved || self.steps == 0 {
+            self.list_candidates();
+        }
+        for k in 0..self.ball_candidates.len() {
+            let (i, j) = self.ball_candidates[k];
+            let (i, j) = (i as usize, j as usize);
+            let d: [f64; 3] = std::array::from_fn(|a| self.x[j][a] - self.x[i][a]);
+            let reach = self.radius[i] + self.radius[j];
+            if dot(d, d) < reach * reach {
+                self.ball_contact(i, j, h);
+            }
+        }
+        for k in 0..self.wall_candidates.len() {
+            let (i, wall) = self.wall_candidates[k];
+            let i = i as usize;
+            let local = [self.x[i][0] - xs, self.x[i][1], self.x[i][2]];
+            let (gap, normal) = self.chamber.gap(wall, local, self.radius[i]);
+            if gap < 0.0 {
+                self.wall_contact(i, wall, -gap, normal, h);
+            }
+        }
+        for i in 0..n {
+            let mut k = 0;
+            while k < self.open[i].len() {
+                if self.open[i][k].seen {
+                    k += 1;
+                } else {
+                    let c = self.open[i].swap_remove(k);
+                    self.close(i, c, h);
+                }
+            }
+        }
+    }
+
+    /// Lists the pairs and walls that may touch before some ball moves half the skin from
+    /// where it is now (relative to the container): those closer than the skin now.
+    fn list_candidates(&mut self) {
+        let (xs, skin) = (self.xs, self.skin);
+        let x = &self.x;
+        self.cells.rebuild(|i| [x[i][0] - xs, x[i][1], x[i][2]]);
+        self.ball_candidates.clear();
+        self.wall_candidates.clear();
+        for i in 0..self.n {
+            let (xi, ri) = (self.x[i], self.radius[i]);
+            let (x, radius, list) = (&self.x, &self.radius, &mut self.ball_candidates);
+            self.cells.neighbours(i, |j| {
+                let d: [f64; 3] = std::array::from_fn(|k| x[j][k] - xi[k]);
+                let reach = ri + radius[j] + skin;
+                if dot(d, d) < reach * reach {
+                    list.push((i as u32, j as u32));
+                }
+            });
+            let local = [xi[0] - xs, xi[1], xi[2]];
+            for wall in self.chamber.walls_near(local) {
+                if self.chamber.gap(wall, local, ri).0 < skin {
+                    self.wall_candidates.push((i as u32, wall));
+                }
+            }
+        }
+        self.listed_at.copy_from_slice(&self.x);
+        self.listed_xs = xs;
+    }
+
+    /// The contact of balls `i < j` whose centres are closer than their radii's sum.
+    fn ball_contact(&mut self, i: usize, j: usize, h: f64) {
+        let d: [f64; 3] = std::array::from_fn(|k| self.x[j][k] - self.x[i][k]);
+        let dist = dot(d, d).sqrt();
+        if dist <= 0.0 {
+            return;
+        }
+        let normal: [f64; 3] = std::array::from_fn(|k| d[k] / dist);
+        let overlap = self.radius[i] + self.radius[j] - dist;
+        let (ri, rj) = (self.radius[i], self.radius[j]);
+        let dv: [f64; 3] = std::array::from_fn(|k| self.v[i][k] - self.v[j][k]);
+        let spin: [f64; 3] = std::array::from_fn(|k| ri * self.w[i][k] + rj * self.w[j][k]);
+        let slip_all: [f64; 3] = {
+            let s = cross(spin, normal);
+            std::array::from_fn(|k| dv[k] + s[k])
+        };
+        let m_star = self.mass[i] * self.mass[j] / (self.mass[i] + self.mass[j]);
+        let r_star = contact::effective_radius(ri, Some(rj));
+        let (f_n, f_t) = self.contact_force(i, j as u32, None, r_star, m_star, overlap, dot(dv, normal), slip_all, normal, h);
+        for k in 0..3 {
+            let f = -f_n * normal[k] + f_t[k];
+            self.force[i][k] += f;
+            self.force[j][k] -= f;
+        }
+        let ti = cross(std::array::from_fn(|k| ri * normal[k]), f_t);
+        let tj = cross(std::array::from_fn(|k| rj * normal[k]), f_t);
+        for k in 0..3 {
+            self.torque[i][k] += ti[k];
+            self.torque[j][k] += tj[k];
+        }
+    }
+
+    /// The contact of ball `i` with `wall`, overlapping it by `overlap` along `normal` (from
+    /// the ball towards the wall).
+    fn wall_contact(&mut self, i: usize, wall: Wall, overlap: f64, normal: [f64; 3], h: f64) {
+        let ri = self.radius[i];
+        let u = self.wall_velocity();
+        let dv: [f64; 3] = std::array::from_fn(|k| self.v[i][k] - u[k]);
+        let s = cross(std::array::from_fn(|k| ri * self.w[i][k]), normal);
+        let slip_all: [f64; 3] = std::array::from_fn(|k| dv[k] + s[k]);
+        let m = self.mass[i];
+        let m_star = if self.frame_mass.is_finite() { m * self.frame_mass / (m + self.frame_mass) } else { m };
+        let r_star = contact::effective_radius(ri, None);
+        let other = wall_index(self.n, wall);
+        let (f_n, f_t) = self.contact_force(i, other, Some(wall), r_star, m_star, overlap, dot(dv, normal), slip_all, normal, h);
+        for k in 0..3 {
+            self.force[i][k] += -f_n * normal[k] + f_t[k];
+        }
+        self.frame_force -= -f_n * normal[0] + f_t[0];
+        let ti = cross(std::array::from_fn(|k| ri * normal[k]), f_t);
+        for k in 0..3 {
+            self.torque[i][k] += ti[k];
+        }
+    }
+
+    /// The normal force (pushing the pair apart) and the tangential force on the first body of
+    /// an open contact with overlap `overlap` growing at `rate`, slipping at `slip_all` (the
+    /// contact point's relative velocity, normal part included); updates its record.
+    #[allow(clippy::too_many_arguments)]
+    fn contact_force(
+        &mut self,
+        i: usize,
+        other: u32,
+        wall: Option<Wall>,
+        r_star: f64,
+        m_star: f64,
+        overlap: f64,
+        rate: f64,
+        slip_all: [f64; 3],
+        normal: [f64; 3],
+        h: f64,
+    ) -> (f64, [f64; 3]) {
+        let t = self.t;
+        let slot = match self.open[i].iter().position(|c| c.other == other) {
+            Some(k) => k,
+            None => {
+                let approach = rate.max(0.0);
+                self.open[i].push(Open {
+                    other,
+                    wall,
+                    k: contact::stiffness(self.e_star, r_star),
+                    // Back along the approach to zero overlap.
+                    onset: if approach > 0.0 { (t - overlap / approach).max(t - h) } else { t },
+                    approach,
+                    peak_force: 0.0,
+                    loss: 0.0,
+                    power: 0.0,
+                    overlap,
+                    rate,
+                    seen: true,
+                });
+                self.open[i].len() - 1
+            }
+        };
+        let c = &mut self.open[i][slot];
+        c.approach = c.approach.max(rate);
+        let root = overlap.sqrt();
+        let elastic = c.k * overlap * root;
+        // The speed whose kinetic energy (at the reduced mass) is the contact's elastic energy:
+        // never above the approach speed in an isolated impact, so `e` is kept, but it grows
+        // with the load of a contact that neighbours squeeze, which keeps its damping rate
+        // within `c` times its stiffness rate.
+        let loaded = (0.8 * elastic * overlap / m_star).sqrt();
+        let alpha = self.c / c.approach.max(loaded).max(self.v_floor);
+        let f_n = contact::force(c.k, alpha, overlap, rate);
+        // The next step must follow this contact: its linearised stiffness and its damping rate.
+        self.stiffness_rate = self.stiffness_rate.max(1.5 * c.k * root / m_star);
+        self.damping_rate = self.damping_rate.max(elastic * alpha / m_star);
+        // What the normal force does beyond the elastic spring's work is lost.
+        let mut power = (elastic - f_n) * -rate;
+        let along = dot(slip_all, normal);
+        let slip: [f64; 3] = std::array::from_fn(|k| slip_all[k] - along * normal[k]);
+        let speed = dot(slip, slip).sqrt();
+        let mut f_t = [0.0; 3];
+        if self.friction > 0.0 && speed > 0.0 {
+            // A sphere's contact point slips against a tangential force with the mass 2/7 m*.
+            let viscous = (2.0 / 7.0) * m_star / (SLIP_RELAXATION_STEPS * h.max(f64::MIN_POSITIVE)) * speed;
+            let f = viscous.min(self.friction * f_n);
+            f_t = std::array::from_fn(|k| -f * slip[k] / speed);
+            power += f * speed;
+        }
+        c.loss += 0.5 * (c.power + power) * h;
+        self.contact_loss += 0.5 * (c.power + power) * h;
+        c.power = power;
+        c.peak_force = c.peak_force.max(f_n);
+        c.overlap = overlap;
+        c.rate = rate;
+        c.seen = true;
+        (f_n, f_t)
+    }
+
+    /// Contact `c` of ball `i` ended in the last step: its record becomes an impact.
+    fn close(&mut self, i: usize, c: Open, h: f64) {
+        let tail = 0.5 * c.power * h;
+        self.contact_loss += tail;
+        // Forward along the separation to zero overlap.
+        let end = if c.rate < 0.0 { (self.t - h - c.overlap / c.rate).min(self.t) } else { self.t };
+        if c.approach <= self.v_floor {
+            return;
+        }
+        let (a, b) = match c.wall {
+            None => (Body::Ball(i), Body::Ball(c.other as usize)),
+            Some(Wall::Left) => (Body::LeftWall, Body::Ball(i)),
+            Some(wall) => (Body::Ball(i), wall.body()),
+        };
+        self.impacts.push(Impact {
+            t: c.onset,
+            a,
+            b,
+            approach_speed: c.approach,
+            energy_lost: c.loss + tail,
+            impulses: 1,
+            peak_force: Some(c.peak_force),
+            contact_duration: Some(end - c.onset),
+        });
+    }
+
+    /// One velocity Verlet step of length `h`: a half kick, a drift, the forces at the new
+    /// positions (with the velocities predicted at the step's end for the damping and
+    /// friction), and the second half kick.
+    fn advance(&mut self, h: f64) {
+        let (t0, xs0, vs0) = (self.t, self.xs, self.vs);
+        let half = 0.5 * h;
+        let frame_a = if self.frame_mass.is_finite() { self.frame_force / self.frame_mass } else { 0.0 };
+        for i in 0..self.n {
+            let (im, ii) = (1.0 / self.mass[i], 1.0 / self.inertia[i]);
+            for k in 0..3 {
+                self.v_half[i][k] = self.v[i][k] + half * self.force[i][k] * im;
+                self.w_half[i][k] = self.w[i][k] + half * self.torque[i][k] * ii;
+                self.x[i][k] += h * self.v_half[i][k];
+                self.v[i][k] = self.v_half[i][k] + half * self.force[i][k] * im;
+                self.w[i][k] = self.w_half[i][k] + half * self.torque[i][k] * ii;
+            }
+        }
+        let vs_half = self.vs + half * frame_a;
+        self.xs += h * vs_half;
+        self.vs = vs_half + half * frame_a;
+        self.t = t0 + h;
+        self.forces(h);
+        for i in 0..self.n {
+            let (im, ii) = (1.0 / self.mass[i], 1.0 / self.inertia[i]);
+            for k in 0..3 {
+                self.v[i][k] = self.v_half[i][k] + half * self.force[i][k] * im;
+                self.w[i][k] = self.w_half[i][k] + half * self.torque[i][k] * ii;
+            }
+        }
+        if self.frame_mass.is_finite() {
+            self.vs = vs_half + half * self.frame_force / self.frame_mass;
+        }
+        let scene = self.scene;
+        self.damping_loss += half * (scene.damping_power(t0, vs0) + scene.damping_power(self.t, self.vs));
+        self.forcing_work += half * (scene.forcing_power(t0, xs0, vs0) + scene.forcing_power(self.t, self.xs, self.vs));
+        self.steps += 1;
+    }
+
+    /// The energy the system holds: the balls' kinetic and rotational energy, gravity's
+    /// potential from the start, the frame's energy and the open contacts' elastic energy, J.
+    fn energy(&self) -> f64 {
+        let mut e = self.scene.frame_energy(self.t, self.xs, self.vs);
+        for i in 0..self.n {
+            let (v, w) = (self.v[i], self.w[i]);
+            e += 0.5 * self.mass[i] * dot(v, v) + 0.5 * self.inertia[i] * dot(w, w);
+            e += self.mass[i] * dot(self.gravity, std::array::from_fn(|k| self.start[i][k] - self.x[i][k]));
+            e += self.open[i].iter().map(|c| contact::elastic_energy(c.k, c.overlap)).sum::<f64>();
+        }
+        e
+    }
+
+    /// Steps to the horizon, sampling on the way; `Some(budget)` when a budget ran out first.
+    fn run(&mut self, meter: &Meter, recorder: &mut Recorder) -> Result<Option<Budget>, ModelError> {
+        let scene = self.scene;
+        let sample_count = scene.sample_count();
+        recorder.sample(scene, 0.0, self.xs, self.vs, |i| (self.x[i][0], self.v[i][0]));
+        recorder.sample_across(|i| [self.x[i][1], self.x[i][2]]);
+        let mut next_sample = 1;
+        let energy_in = scene.initial_energy();
+        while self.t < scene.horizon * (1.0 - 1e-12) {
+            if let Some(budget) = meter.look(self.t, self.steps) {
+                return Ok(Some(budget));
+            }
+            let h = self.step().min(scene.horizon - self.t);
+            self.advance(h);
+            // Samples in the step, from the state at its end along the velocities (the step
+            // is far shorter than the sampling interval).
+            let mut sampled = false;
+            while next_sample < sample_count {
+                let ts = next_sample as f64 * scene.sample_dt;
+                if ts > self.t + 1e-9 * h {
+                    break;
+                }
+                let back = (self.t - ts).max(0.0);
+                let (x, v) = (&self.x, &self.v);
+                recorder.sample(scene, ts, self.xs - back * self.vs, self.vs, |i| (x[i][0] - back * v[i][0], v[i][0]));
+                recorder.sample_across(|i| [x[i][1] - back * v[i][1], x[i][2] - back * v[i][2]]);
+                next_sample += 1;
+                sampled = true;
+            }
+            if sampled {
+                self.watch_balance(energy_in, h)?;
+            }
+        }
+        Ok(None)
+    }
+
+    /// Stops the run when its energy balance is off by more than a tenth of the energies that
+    /// flow: the step (`h`, the last) has not resolved some contact.
+    fn watch_balance(&self, energy_in: f64, h: f64) -> Result<(), ModelError> {
+        let held = self.energy();
+        let residual = energy_in + self.forcing_work - held - self.damping_loss - self.contact_loss;
+        let flow = energy_in.abs() + self.forcing_work.abs() + self.contact_loss + self.gravity_allowance();
+        if held.is_finite() && residual.is_finite() && residual.abs() <= UNSTABLE_BALANCE * flow {
+            return Ok(());
+        }
+        Err(ModelError::Unstable {
+            scene: self.scene.name.clone(),
+            model: Model::Compliant,
+            t: self.t,
+            reason: format!(
+                "at t = {:.6e} s the energy balance is off by {residual:.6e} J of {flow:.6e} J that flowed: the step of {} s does not resolve its contacts",
+                self.t,
+                crate::scene::human(h)
+            ),
+        })
+    }
+
+    /// Energy gravity can give the balls falling across the container, J.
+    fn gravity_allowance(&self) -> f64 {
+        let g = dot(self.gravity, self.gravity).sqrt();
+        self.mass.iter().sum::<f64>() * g * self.chamber.diagonal()
+    }
+
+    /// The run so far, ended at the current time; open contacts stay out of the impacts.
+    fn finish(self, recorder: Recorder) -> Run {
+        let scene = self.scene;
+        let final_ = self.energy();
+        let (series, motion) = recorder.finish();
+        Run {
+            scene: scene.name.clone(),
+            model: Model::Compliant,
+            horizon: self.t,
+            sample_dt: scene.sample_dt,
+            initial_displacement: scene.initial_displacement,
+            damped_period: scene.frame.map_or(0.0, |f| f.damped_period()),
+            series,
+            motion,
+            impacts: self.impacts,
+            energy: EnergyAccount::forced(scene.initial_energy(), final_, self.damping_loss, self.contact_loss, self.forcing_work),
+            events: self.steps,
+            final_velocities: self.v.iter().map(|v| v[0]).collect(),
+            peak_true_acceleration: None,
+            wall_time_s: 0.0,
+        }
+    }
+}
