@@ -68,7 +68,9 @@ struct Failure {
 }
 
 /// Draws `count` members of `nominal` (built from `file`, perhaps with command-line
-/// overrides) under `tolerances`. Without tolerances every member is the nominal scene.
+/// overrides) under `tolerances`. A bed placed at random is placed anew in every member, from a
+/// seed drawn from `(seed, k)` (the members' last column, `bed_seed`). Without tolerances and
+/// without a random bed every member is the nominal scene.
 /// A tolerance so wide that a member finds no valid scene in [`MAX_DRAWS_PER_MEMBER`] draws,
 /// or that more draws fail than succeed, is an error naming it.
 pub fn draw(
@@ -107,14 +109,16 @@ pub fn draw_range(
     let normal = tolerances.is_some_and(|t| t.distribution == Distribution::Normal);
     let seed = seed.or(tolerances.map(|t| t.seed)).unwrap_or(DEFAULT_SEED);
     let n = nominal.balls.len();
-    let columns = spreads
-        .iter()
-        .flat_map(|&(p, _)| if p == Parameter::Gap { (1..=n).map(|i| format!("gap{i}")).collect() } else { vec![p.to_string()] })
-        .collect();
     let mut base = scene::with_settings_of(file, nominal);
     base.sweep = None;
     base.tolerances = None;
-    let drawer = Drawer { base, path, nominal, spreads, normal };
+    let random_bed = base.bed.as_ref().is_some_and(|b| b.placement == scene::format::Placement::Random);
+    let columns = spreads
+        .iter()
+        .flat_map(|&(p, _)| if p == Parameter::Gap { (1..=n).map(|i| format!("gap{i}")).collect() } else { vec![p.to_string()] })
+        .chain(random_bed.then(|| "bed_seed".to_string()))
+        .collect();
+    let drawer = Drawer { base, path, nominal, spreads, normal, random_bed };
     let drawn: Vec<(Member, Vec<Failure>)> = range.into_par_iter().map(|k| drawer.member(seed, k)).collect::<Result<_, _>>()?;
     let redraws: u64 = drawn.iter().map(|d| d.1.len() as u64).sum();
     if redraws > count as u64 {
@@ -218,6 +222,9 @@ struct Drawer<'a> {
     nominal: &'a Scene,
     spreads: &'a [(Parameter, f64)],
     normal: bool,
+    /// Whether the scene places a bed at random: each member then places its own, from a seed
+    /// of its own.
+    random_bed: bool,
 }
 
 impl Drawer<'_> {
@@ -260,7 +267,15 @@ impl Drawer<'_> {
             .iter()
             .map(|&(p, w)| (0..if p == Parameter::Gap { n } else { 1 }).map(|_| self.deviation(rng, w)).collect())
             .collect();
-        let mut file: Option<SceneFile> = None;
+        // Below 2^53, so that the members' table holds it exactly.
+        let bed_seed = self.random_bed.then(|| rng.random::<u64>() >> 11);
+        let mut file: Option<SceneFile> = bed_seed.map(|seed| {
+            let mut f = self.base.clone();
+            if let Some(bed) = f.bed.as_mut() {
+                bed.seed = Some(seed);
+            }
+            f
+        });
         let mut values = vec![];
         for (&(p, _), d) in self.spreads.iter().zip(&deviations) {
             if p == Parameter::Gap {
@@ -273,7 +288,7 @@ impl Drawer<'_> {
         }
         let name = format!("{}#{k}", self.nominal.name);
         // A failure the scene's rules cannot pin on a drawn parameter is blamed on the first.
-        let first = self.spreads.first().map_or(Parameter::Gap, |s| s.0);
+        let first = self.spreads.first().map_or(Parameter::FillFraction, |s| s.0);
         let mut scene = match file {
             None => self.nominal.clone(),
             Some(f) => scene::from_file(f, self.path, &name)
@@ -296,6 +311,7 @@ impl Drawer<'_> {
                 drawn.extend(values.next());
             }
         }
+        drawn.extend(bed_seed.map(|seed| seed as f64));
         Ok(Member { index: k, drawn, scene })
     }
 }

@@ -430,3 +430,31 @@ fn shards_merge_into_the_unsharded_table() {
     assert_eq!(o.status.code(), Some(2));
     assert!(String::from_utf8_lossy(&o.stderr).contains("--shard"));
 }
+
+/// A bed placed at random is placed anew in each member, from a seed of the member's own drawn
+/// from `(seed, k)`: the members differ, the same seed gives the same members, and each member
+/// is the scene file with that bed seed.
+#[test]
+fn members_of_a_random_bed_place_their_own_beds() {
+    let text = "[frame]\nmass = 1.35\nstiffness = 865.0\ndamping = 1.092\ninitial_displacement = 0.01\n\
+                [container]\nlength = 0.1\nwidth = 0.04\nheight = 0.03\n[world]\nrestitution = 0.6\n\
+                [bed]\ncount = 12\nradii = [0.004]\ndensity = 7800.0\nplacement = \"random\"\n";
+    let l = lpc_damper::scene::parse(text, "bed.toml", "bed").unwrap();
+    let nominal = l.scene.as_ref().unwrap();
+    let members = ensemble::draw(&l.file, &l.path, nominal, None, 3, Some(5)).unwrap();
+    assert_eq!(members.columns, vec!["bed_seed".to_string()]);
+    let again = ensemble::draw(&l.file, &l.path, nominal, None, 3, Some(5)).unwrap();
+    for (a, b) in members.members.iter().zip(&again.members) {
+        assert_eq!(a.scene, b.scene);
+    }
+    for (i, a) in members.members.iter().enumerate() {
+        for b in &members.members[i + 1..] {
+            assert_ne!(a.scene.space.lateral, b.scene.space.lateral);
+        }
+        let seed = a.drawn[0];
+        assert_eq!(seed, seed.trunc());
+        let placed = lpc_damper::scene::parse(&format!("{text}seed = {}\n", seed as u64), "bed.toml", "bed").unwrap();
+        let placed = placed.scene.unwrap();
+        assert_eq!((&placed.space, &placed.initial_positions), (&a.scene.space, &a.scene.initial_positions));
+    }
+}

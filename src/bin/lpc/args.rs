@@ -132,8 +132,15 @@ impl Nominal {
         e.ensemble
             .map(|n| {
                 static NOTED: std::sync::Once = std::sync::Once::new();
+                let random_bed = file.bed.as_ref().is_some_and(|b| b.placement == lpc_damper::scene::format::Placement::Random);
                 if self.tolerances.is_none() {
-                    NOTED.call_once(|| eprintln!("note: {} has no [tolerances]: every member is the nominal scene", self.path));
+                    NOTED.call_once(|| {
+                        if random_bed {
+                            eprintln!("note: {} has no [tolerances]: the members differ only in their beds' random placement", self.path)
+                        } else {
+                            eprintln!("note: {} has no [tolerances]: every member is the nominal scene", self.path)
+                        }
+                    });
                 }
                 ensemble::draw(file, &self.path, scene, self.tolerances.as_ref(), n, e.seed)
             })
