@@ -91,7 +91,7 @@ impl Simulator for Compliant {
             impact_gain: 1e-9,
             exact_impacts: false,
             momentum: 1e-9,
-            wall_overlap: overlap_bound(scene, run),
+            wall_overlap: overlap_bound(scene, run, 0.0),
             ball_overlap: None,
             stall_by_rate: false,
         }
@@ -119,15 +119,15 @@ fn beyond_lines(scene: &Scene) -> bool {
 /// How far the compliant model's balls may legitimately overlap a wall: twice the elastic
 /// overlap of the fastest impact (the heaviest ball on the stiffest-to-reach, i.e. softest,
 /// wall contact) plus the static overlap of all the balls pressed by the frame's largest
-/// acceleration.
-fn overlap_bound(scene: &Scene, run: &Run) -> f64 {
+/// acceleration and `pressing` (gravity beyond one line), m/s^2.
+fn overlap_bound(scene: &Scene, run: &Run, pressing: f64) -> f64 {
     let e_star = contact::effective_modulus(&scene.compliant);
     let r_min = scene.balls.iter().map(|b| b.radius).fold(f64::INFINITY, f64::min);
     let k = contact::stiffness(e_star, contact::effective_radius(r_min, None));
     let m_max = scene.balls.iter().map(|b| b.mass).fold(0.0, f64::max);
     let m_all: f64 = scene.balls.iter().map(|b| b.mass).sum();
     let u_max = run.impacts.iter().map(|i| i.approach_speed).fold(0.0, f64::max);
-    let a_max = run.series.a().iter().fold(0.0f64, |m, a| m.max(a.abs()));
+    let a_max = run.series.a().iter().fold(0.0f64, |m, a| m.max(a.abs())) + pressing;
     1e-9 * scene.container.map_or(1e-3, |c| c.length.max(1e-3))
         + 2.0 * (contact::max_overlap(m_max, u_max, k) + (m_all * a_max / k).powf(2.0 / 3.0))
 }

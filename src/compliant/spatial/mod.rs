@@ -140,6 +140,8 @@ struct Solver<'a> {
     design_speed: f64,
     /// Longest step, s.
     h_max: f64,
+    /// The fastest ball's speed, m/s (kept by each step's last kick).
+    fastest: f64,
     /// The largest `omega^2` (linearised stiffness over reduced mass) and damping rate of the
     /// open contacts at the last evaluation of the forces, 1/s^2 and 1/s.
     stiffness_rate: f64,
@@ -207,15 +209,8 @@ pub(super) fn checks(scene: &Scene, run: &Run) -> Checks {
     let put_in = run.energy.initial.abs().max(1e-12) + run.energy.forcing_work.abs();
     let exchanged = put_in + 2.0 * run.energy.impact_loss.abs() + gravity_exchange(scene, run);
     let balance = (per_contact * exchanged / put_in).max(1e-9);
-    let e_star = contact::effective_modulus(&scene.compliant);
-    let r_min = scene.balls.iter().map(|b| b.radius).fold(f64::INFINITY, f64::min);
-    let m_max = scene.balls.iter().map(|b| b.mass).fold(0.0, f64::max);
-    let m_all: f64 = scene.balls.iter().map(|b| b.mass).sum();
-    let k = contact::stiffness(e_star, contact::effective_radius(r_min.min(1.0), None));
-    let u_max = run.impacts.iter().map(|i| i.approach_speed).fold(0.0, f64::max);
     let g = dot(scene.space.gravity, scene.space.gravity).sqrt();
-    let a_max = run.series.a().iter().fold(0.0f64, |m, a| m.max(a.abs())) + g;
-    let wall_overlap = 2.0 * (contact::max_overlap(m_max, u_max, k) + (m_all * a_max / k).powf(2.0 / 3.0)) + 1e-12;
+    let wall_overlap = super::overlap_bound(scene, run, g);
     Checks {
         energy_gain: balance,
         balance: Some(balance),
@@ -327,6 +322,7 @@ impl<'a> Solver<'a> {
             stiffest,
             design_speed,
             h_max,
+            fastest: 0.0,
             stiffness_rate: 0.0,
             damping_rate: 0.0,
             t: 0.0,
@@ -336,6 +332,7 @@ impl<'a> Solver<'a> {
             damping_loss: 0.0,
             forcing_work: 0.0,
         };
+        solver.fastest = solver.v.iter().map(|v| dot(*v, *v)).fold(0.0, f64::max).sqrt();
         let h = solver.step();
         solver.forces(h);
         Ok(solver)
@@ -346,8 +343,7 @@ impl<'a> Solver<'a> {
     /// of its linearised stiffness and half the inverse of its damping rate, which a pile's
     /// loaded contacts can exceed); within the frame's and the forcing's periods.
     fn step(&self) -> f64 {
-        let fastest = self.v.iter().map(|v| dot(*v, *v)).fold(0.0, f64::max).sqrt();
-        let speed = self.design_speed.max(2.0 * (fastest + self.vs.abs()));
+        let speed = self.design_speed.max(2.0 * (self.fastest + self.vs.abs()));
         let mut h = self.h_max;
         if self.stiffest.is_finite() {
             h = h.min(step_for(self.stiffest, speed));
@@ -624,13 +620,16 @@ impl<'a> Solver<'a> {
         self.vs = vs_half + half * frame_a;
         self.t = t0 + h;
         self.forces(h);
+        let mut fastest_squared = 0.0f64;
         for i in 0..self.n {
             let (im, ii) = (1.0 / self.mass[i], 1.0 / self.inertia[i]);
             for k in 0..3 {
                 self.v[i][k] = self.v_half[i][k] + half * self.force[i][k] * im;
                 self.w[i][k] = self.w_half[i][k] + half * self.torque[i][k] * ii;
             }
+            fastest_squared = fastest_squared.max(dot(self.v[i], self.v[i]));
         }
+        self.fastest = fastest_squared.sqrt();
         if self.frame_mass.is_finite() {
             self.vs = vs_half + half * self.frame_force / self.frame_mass;
         }
