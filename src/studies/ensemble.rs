@@ -61,6 +61,11 @@ pub fn member_rng(seed: u64, k: usize) -> Pcg64 {
     Pcg64::seed_from_u64(Pcg64::seed_from_u64(seed).random::<u64>() ^ k as u64)
 }
 
+/// Whether `file` places a bed at random: its members then each place their own.
+pub fn places_bed_at_random(file: &SceneFile) -> bool {
+    file.bed.as_ref().is_some_and(|b| b.placement == scene::format::Placement::Random)
+}
+
 /// A draw that made no valid scene: the parameter to blame and why.
 struct Failure {
     parameter: Parameter,
@@ -112,7 +117,7 @@ pub fn draw_range(
     let mut base = scene::with_settings_of(file, nominal);
     base.sweep = None;
     base.tolerances = None;
-    let random_bed = base.bed.as_ref().is_some_and(|b| b.placement == scene::format::Placement::Random);
+    let random_bed = places_bed_at_random(&base);
     let columns = spreads
         .iter()
         .flat_map(|&(p, _)| if p == Parameter::Gap { (1..=n).map(|i| format!("gap{i}")).collect() } else { vec![p.to_string()] })

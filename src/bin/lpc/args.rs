@@ -132,7 +132,7 @@ impl Nominal {
         e.ensemble
             .map(|n| {
                 static NOTED: std::sync::Once = std::sync::Once::new();
-                let random_bed = file.bed.as_ref().is_some_and(|b| b.placement == lpc_damper::scene::format::Placement::Random);
+                let random_bed = ensemble::places_bed_at_random(file);
                 if self.tolerances.is_none() {
                     NOTED.call_once(|| {
                         if random_bed {
