@@ -6,20 +6,39 @@
 #[inline]
 pub fn impact_law(m1: f64, v1: f64, m2: f64, v2: f64, e: f64) -> (f64, f64, f64) {
     let rel = v1 - v2;
+    let (v1p, v2p) = separate(m1, v1, m2, v2, e * rel);
+    (v1p, v2p, 0.5 * (1.0 - e * e) * reduced_mass(m1, m2) * rel * rel)
+}
+
+/// The reduced mass `m1 m2 / (m1 + m2)` of two bodies, either of which may be infinite.
+#[inline]
+pub fn reduced_mass(m1: f64, m2: f64) -> f64 {
     if m2.is_infinite() {
-        return (v2 - e * rel, v2, 0.5 * (1.0 - e * e) * m1 * rel * rel);
+        m1
+    } else if m1.is_infinite() {
+        m2
+    } else {
+        m1 * m2 / (m1 + m2)
+    }
+}
+
+/// Velocities of body 1 (mass `m1`, velocity `v1`) and body 2 after an impulse between them
+/// that leaves them separating at `separation` (`v2 - v1`), momentum kept. Eq. 9-10 are the
+/// case `separation = e (v1 - v2)`; the spatial reference's collapse rule sets it otherwise.
+/// Either mass may be infinite (a rigid wall), not both.
+#[inline]
+pub fn separate(m1: f64, v1: f64, m2: f64, v2: f64, separation: f64) -> (f64, f64) {
+    if m2.is_infinite() {
+        return (v2 - separation, v2);
     }
     if m1.is_infinite() {
-        return (v1, v1 + e * rel, 0.5 * (1.0 - e * e) * m2 * rel * rel);
+        return (v1, v1 + separation);
     }
     let total = m1 + m2;
-    // Written as the centre-of-mass velocity minus e times each body's share of the relative
-    // velocity: the same as Eq. 9-10, with one rounding less.
+    // Written as the centre-of-mass velocity minus each body's share of the separation: the
+    // same as Eq. 9-10, with one rounding less.
     let vcm = (m1 * v1 + m2 * v2) / total;
-    let v1p = vcm - e * rel * m2 / total;
-    let v2p = vcm + e * rel * m1 / total;
-    let mu = m1 * m2 / total;
-    (v1p, v2p, 0.5 * (1.0 - e * e) * mu * rel * rel)
+    (vcm - separation * m2 / total, vcm + separation * m1 / total)
 }
 
 #[cfg(test)]
