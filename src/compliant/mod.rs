@@ -93,7 +93,7 @@ impl Simulator for Compliant {
             momentum: 1e-9,
             wall_overlap: overlap_bound(scene, run, 0.0),
             ball_overlap: None,
-            stall_by_rate: false,
+            stall_rate: None,
         }
     }
 

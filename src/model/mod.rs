@@ -72,7 +72,12 @@ pub struct Checks {
     /// How far two balls may overlap, m; `None` for a model whose balls deform (bounded by
     /// `wall_overlap` already).
     pub ball_overlap: Option<f64>,
-    /// Whether a high rate of steps per simulated second means the run stalled (a model whose
-    /// steps follow its contacts guards against stalling with its step budget instead).
-    pub stall_by_rate: bool,
+    /// Most events or steps per simulated second before the run counts as stalled; `None` for
+    /// a model whose steps follow its contacts (it guards against stalling with its step
+    /// budget instead).
+    pub stall_rate: Option<f64>,
 }
+
+/// Most events (reference) or steps (Rapier) per simulated second before a run counts as
+/// stalled. The densest valid scenes on lines reach a few 10^5 (see docs/BENCHMARKS.md).
+pub const STALL_EVENTS_PER_SIM_S: f64 = 2e6;

@@ -20,7 +20,7 @@ mod spawn;
 
 use bevy::prelude::*;
 
-use crate::model::{Checks, Meter, Model, ModelError, OverBudget, RunOptions, Setting, Simulator};
+use crate::model::{Checks, Meter, Model, ModelError, OverBudget, RunOptions, Setting, Simulator, STALL_EVENTS_PER_SIM_S};
 use crate::run::{EnergyAccount, Record, Run};
 use crate::scene::Scene;
 pub use crate::scene::Stepping;
@@ -87,7 +87,7 @@ impl Simulator for Rapier {
             momentum: 1e-5,
             wall_overlap: ALLOWED_OVERLAP + 1e-6,
             ball_overlap: None,
-            stall_by_rate: true,
+            stall_rate: Some(STALL_EVENTS_PER_SIM_S),
         }
     }
 

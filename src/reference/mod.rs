@@ -33,7 +33,7 @@ use search::Search;
 use segment::{Segment, Zeros};
 
 pub use crate::impact_law::impact_law;
-use crate::model::{Budget, Checks, Meter, Model, ModelError, OverBudget, RunOptions, Setting, Simulator};
+use crate::model::{Budget, Checks, Meter, Model, ModelError, OverBudget, RunOptions, Setting, Simulator, STALL_EVENTS_PER_SIM_S};
 pub use crate::oscillator::Oscillator;
 use crate::oscillator::{gauss_legendre, Harmonic, ROUNDOFF_ULPS};
 use crate::run::{BallPath, EnergyAccount, Impact, Record, Recorder, Run};
@@ -140,7 +140,10 @@ impl Simulator for Reference {
             momentum: 1e-9,
             wall_overlap: contact,
             ball_overlap: Some(contact),
-            stall_by_rate: true,
+            stall_rate: Some(match scene.space.beyond_lines(&scene.initial_positions) {
+                Some(_) => spatial::stall_rate(scene),
+                None => STALL_EVENTS_PER_SIM_S,
+            }),
         }
     }
 

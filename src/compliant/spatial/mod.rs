@@ -219,7 +219,7 @@ pub(super) fn checks(scene: &Scene, run: &Run) -> Checks {
         momentum: 1e-6,
         wall_overlap,
         ball_overlap: None,
-        stall_by_rate: false,
+        stall_rate: None,
     }
 }
 

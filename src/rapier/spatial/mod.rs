@@ -18,7 +18,7 @@ use bevy_rapier3d::rapier::prelude::{RigidBodyHandle, RigidBodySet, Vector};
 pub use contacts::closing_speed;
 pub use world::SolverSettings;
 
-use crate::model::{Checks, Meter, Model, ModelError, OverBudget, RunOptions};
+use crate::model::{Checks, Meter, Model, ModelError, OverBudget, RunOptions, STALL_EVENTS_PER_SIM_S};
 use crate::oscillator::{gauss_legendre, Driven, Oscillator};
 use crate::run::{EnergyAccount, Impact, Recorder, Run};
 use crate::scene::{Body, Chamber, Scene, Wall};
@@ -126,7 +126,7 @@ pub fn checks(scene: &Scene, run: &Run) -> Checks {
         momentum: 1e-5,
         wall_overlap: RESTING_SINK_FRACTION * largest + 1e-6,
         ball_overlap: None,
-        stall_by_rate: true,
+        stall_rate: Some(STALL_EVENTS_PER_SIM_S),
     }
 }
 

@@ -48,11 +48,15 @@ pub(super) fn plane_time(g0: f64, s: f64, v: f64, acc: f64) -> Option<f64> {
 /// at centre distance `reach`, looking no further than `limit`: where the squared distance less
 /// `reach^2`, a polynomial of degree two (equal accelerations) or four in time, first falls
 /// through zero. A pair touching now meets now if it closes, else at its next fall through
-/// zero (a ball bouncing on one that rests on the floor comes back).
-pub(super) fn pair_time(dr: [f64; 3], dv: [f64; 3], da: [f64; 3], reach: f64, limit: f64) -> Option<f64> {
+/// zero (a ball bouncing on one that rests on the floor comes back). A touching pair that closes
+/// no faster than `still` (the round-off of its velocities, [`still`]) does not close.
+pub(super) fn pair_time(dr: [f64; 3], dv: [f64; 3], da: [f64; 3], reach: f64, still: f64, limit: f64) -> Option<f64> {
     let dot = |a: [f64; 3], b: [f64; 3]| a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
     let c0 = dot(dr, dr) - reach * reach;
-    let c1 = 2.0 * dot(dr, dv);
+    let mut c1 = 2.0 * dot(dr, dv);
+    if c0 <= 0.0 && c1 < 0.0 && c1 >= -2.0 * reach * still {
+        c1 = 0.0;
+    }
     if da == [0.0; 3] {
         if c1 >= 0.0 {
             return None;
@@ -62,6 +66,12 @@ pub(super) fn pair_time(dr: [f64; 3], dv: [f64; 3], da: [f64; 3], reach: f64, li
     // c0 + c1 t + c2 t^2 + c3 t^3 + c4 t^4.
     let poly = [c0, c1, dot(dv, dv) + dot(dr, da), dot(dv, da), 0.25 * dot(da, da)];
     first_fall(&poly, limit)
+}
+
+/// The relative speed that velocities `vi` and `vj` cannot resolve: a few ulps of the larger.
+pub(super) fn still(vi: [f64; 3], vj: [f64; 3]) -> f64 {
+    let largest = vi.iter().chain(&vj).fold(0.0, |m: f64, c| m.max(c.abs()));
+    8.0 * f64::EPSILON * largest
 }
 
 /// Value of the polynomial with coefficients `c` (constant first) at `t`.
@@ -168,23 +178,36 @@ mod tests {
     #[test]
     fn pairs_meet_at_the_closed_form_times_and_come_back() {
         // Head-on at 1 m/s, 0.1 m of gap.
-        let t = pair_time([0.3, 0.0, 0.0], [-1.0, 0.0, 0.0], [0.0; 3], 0.2, 10.0).unwrap();
+        let t = pair_time([0.3, 0.0, 0.0], [-1.0, 0.0, 0.0], [0.0; 3], 0.2, 0.0, 10.0).unwrap();
         assert!((t - 0.1).abs() < 1e-15);
         // A ball dropping onto one at rest below it, 0.05 m of gap: sqrt(2 * 0.05 / g).
         let g = [0.0, 0.0, -9.81];
-        let t = pair_time([0.0, 0.0, 0.25], [0.0; 3], g, 0.2, 10.0).unwrap();
+        let t = pair_time([0.0, 0.0, 0.25], [0.0; 3], g, 0.2, 0.0, 10.0).unwrap();
         let expect = (0.1f64 / 9.81).sqrt();
         assert!((t - expect).abs() < 1e-14, "{t} vs {expect}");
         // Touching and bouncing up at 1 m/s: back after 2 v / g.
-        let t = pair_time([0.0, 0.0, 0.2], [0.0, 0.0, 1.0], g, 0.2, 10.0).unwrap();
+        let t = pair_time([0.0, 0.0, 0.2], [0.0, 0.0, 1.0], g, 0.2, 0.0, 10.0).unwrap();
         assert!((t - 2.0 / 9.81).abs() < 1e-14, "{t}");
         // Touching and closing: now. Passing by a metre aside: never.
-        assert_eq!(pair_time([0.0, 0.0, 0.2], [0.0, 0.0, -1.0], g, 0.2, 10.0), Some(0.0));
-        assert_eq!(pair_time([1.0, 0.0, 0.2], [0.0, 0.0, 1.0], g, 0.2, 10.0), None);
+        assert_eq!(pair_time([0.0, 0.0, 0.2], [0.0, 0.0, -1.0], g, 0.2, 0.0, 10.0), Some(0.0));
+        assert_eq!(pair_time([1.0, 0.0, 0.2], [0.0, 0.0, 1.0], g, 0.2, 0.0, 10.0), None);
         // Touching and parting by less than round-off before gravity brings them back (a
         // regression: the rise never cleared zero, and the return was missed).
         let dr = [-0.010430267903623017, 0.0, 0.0034942111353854];
         let dv = [0.011975274207752518, 0.0, 0.0357463784770707];
-        assert!(pair_time(dr, dv, g, 0.011, 1.75e-4).is_some_and(|t| t < 1e-8));
+        assert!(pair_time(dr, dv, g, 0.011, 0.0, 1.75e-4).is_some_and(|t| t < 1e-8));
+    }
+
+    #[test]
+    fn touching_balls_closing_by_round_off_do_not_meet() {
+        // Two balls side by side on the floor sliding together at -0.2446 m/s, one ulp of
+        // velocity apart (a regression: their impact could not separate them, and the run
+        // stalled at one instant).
+        let (vi, vj) = ([-0.24459535242340505, 0.0, 0.0], [-0.24459535242340508, 0.0, 0.0]);
+        let dv = std::array::from_fn(|k| vj[k] - vi[k]);
+        let reach = 0.010277931654699434;
+        assert_eq!(pair_time([reach, 0.0, 0.0], dv, [0.0; 3], reach, still(vi, vj), 10.0), None);
+        // Closing at a millimetre a second, they meet now.
+        assert_eq!(pair_time([reach, 0.0, 0.0], [-1e-3, 0.0, 0.0], [0.0; 3], reach, still(vi, vj), 10.0), Some(0.0));
     }
 }

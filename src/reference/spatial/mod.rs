@@ -19,21 +19,25 @@ use super::frame::FrameMotion;
 use super::frame_gap::FrameGap;
 use super::geometry::Limits;
 use super::{CONTACT_DURATION, MAX_EVENTS};
-use crate::impact_law::impact_law;
-use crate::model::{Meter, Model, ModelError, OverBudget, RunOptions};
+use crate::impact_law::{reduced_mass, separate};
+use crate::model::{Meter, Model, ModelError, OverBudget, RunOptions, STALL_EVENTS_PER_SIM_S};
 use crate::run::{EnergyAccount, Impact, Recorder, Run};
 use crate::scene::{Body, Scene};
 use cells::Cells;
-use flight::{pair_time, plane_time};
+use flight::{pair_time, plane_time, still};
 
 /// Most events at one instant before the run is declared stalled.
 const MAX_EVENTS_PER_INSTANT: u64 = 10_000;
 /// Events between two looks at the budgets.
 const BUDGET_EVENTS: u64 = 4096;
-/// Impacts of one ball in a row, each within the contact duration of the last, after which the
-/// ball is taken to be in persistent contact (pressed against a wall of the frame, or resting on
-/// other balls), which the spatial reference has no state for.
-const PERSISTENT_IMPACTS: u32 = 1000;
+
+/// Most events per simulated second a run of `scene` makes before it counts as stalled: the
+/// one-line reference's rate, and for each ball its at most six contacts with other balls and
+/// three with walls, each struck at most once a contact duration while it is pressed (the
+/// collapse rule, docs/MODEL.md §14).
+pub(super) fn stall_rate(scene: &Scene) -> f64 {
+    STALL_EVENTS_PER_SIM_S + 9.0 * scene.balls.len() as f64 / CONTACT_DURATION
+}
 
 /// Why the spatial reference cannot run `scene`, or `None` when it can.
 pub(super) fn refusal(scene: &Scene) -> Option<String> {
@@ -117,8 +121,6 @@ struct Ball {
     rest: Option<(usize, f64)>,
     /// Time of its last impact, s.
     last_impact: f64,
-    /// Impacts in a row, each within the contact duration of the last.
-    quick_impacts: u32,
     /// Changes at every event of the ball: entries with an older stamp are stale.
     stamp: u32,
     cell: [i64; 3],
@@ -160,6 +162,21 @@ impl Ball {
             a[axis] = 0.0;
         }
         a
+    }
+
+    /// How the ball moves under a unit impulse along `n`: the direction of its velocity change
+    /// (times its length squared) and its mass along `n`. A ball resting on a wall that `n`
+    /// pushes it into moves only along the wall, so it weighs `m / (1 - n_w^2)` along `n`.
+    fn pushed(&self, n: [f64; 3]) -> ([f64; 3], f64) {
+        match self.rest {
+            Some((axis, side)) if side * n[axis] > 0.0 => {
+                let mut along = n;
+                along[axis] = 0.0;
+                let share = 1.0 - n[axis] * n[axis];
+                (along, if share > 0.0 { self.mass / share } else { f64::INFINITY })
+            }
+            _ => (n, self.mass),
+        }
     }
 
     /// Centre and velocity at `t`.
@@ -230,7 +247,6 @@ impl<'a> Solver<'a> {
                     radius: b.radius,
                     rest: None,
                     last_impact: f64::NEG_INFINITY,
-                    quick_impacts: 0,
                     stamp: 0,
                     cell,
                     drift: 0.0,
@@ -363,7 +379,7 @@ impl<'a> Solver<'a> {
         let da = std::array::from_fn(|k| aj[k] - ai[k]);
         let reach = self.balls[i].radius + self.balls[j].radius;
         let (lo, hi) = (i.min(j), i.max(j));
-        if let Some(dt) = pair_time(dr, dv, da, reach, self.horizon - from) {
+        if let Some(dt) = pair_time(dr, dv, da, reach, still(vi, vj), self.horizon - from) {
             self.push(from + dt, lo, Kind::Pair(hi as u32), Some(hi));
         }
     }
@@ -472,6 +488,21 @@ impl<'a> Solver<'a> {
         }
     }
 
+    /// The collapse rule's separation speed for a contact closing at `approach` (negative when
+    /// it opens) under the acceleration `pressing` (positive when it closes it), with
+    /// restitution `e`: `e approach`, but never less than the speed that keeps a pressed contact
+    /// open for a contact duration. `None` when the contact opens fast enough by itself.
+    fn separation(&self, approach: f64, pressing: f64, e: f64) -> Option<f64> {
+        let keep_open = if pressing > 0.0 { 0.5 * pressing * CONTACT_DURATION } else { 0.0 };
+        if approach > 0.0 {
+            Some((e * approach).max(keep_open))
+        } else if -approach < keep_open {
+            Some(keep_open)
+        } else {
+            None
+        }
+    }
+
     fn record(&mut self, a: Body, b: Body, approach: f64, lost: f64) {
         self.impact_loss += lost;
         self.impacts.push(Impact {
@@ -526,27 +557,26 @@ impl<'a> Solver<'a> {
                 let gap = dist - bi.radius - bj.radius;
                 let n = d.map(|c| c / dist);
                 let (ui, uj) = (dot(bi.v, n), dot(bj.v, n));
-                if gap <= self.pair_tolerance(i, j, ui - uj) && ui > uj {
-                    for k in [i, j] {
-                        let b = &mut self.balls[k];
-                        b.quick_impacts = if self.t - b.last_impact < CONTACT_DURATION { b.quick_impacts + 1 } else { 0 };
-                        if b.quick_impacts > PERSISTENT_IMPACTS {
-                            return Err(self.stalled(format!(
-                                "ball{} stays in contact with ball{} (a cluster, or a ball resting on others under gravity: more than {PERSISTENT_IMPACTS} impacts each within {} s of the last); the reference beyond one line has no state for persistent contact between balls",
-                                i + 1,
-                                j + 1,
-                                CONTACT_DURATION
-                            )));
-                        }
-                    }
-                    let e = self.restitution(i, Some(j));
-                    let (wi, wj, lost) = impact_law(bi.mass, ui, bj.mass, uj, e);
+                let pressing = dot(bi.acceleration(self.gravity), n) - dot(bj.acceleration(self.gravity), n);
+                // The impulse pushes `j` along `n` and `i` against it. A ball it pushes into the
+                // wall it rests on has the wall's reaction at once: it moves only along the
+                // wall, so along `n` it weighs `m / (1 - n_w^2)` (docs/MODEL.md §14).
+                let (along_i, mi) = bi.pushed(n.map(|c| -c));
+                let (along_j, mj) = bj.pushed(n);
+                // An approach the velocities cannot resolve is none (the pair moves on touching).
+                let approach = if ui - uj > still(bi.v, bj.v) { ui - uj } else { (ui - uj).min(0.0) };
+                let separation = self.separation(approach, pressing, self.restitution(i, Some(j)));
+                if let Some(after) = separation.filter(|_| gap <= self.pair_tolerance(i, j, ui - uj) && (mi.is_finite() || mj.is_finite()))
+                {
+                    let (wi, wj) = separate(mi, ui, mj, uj, after);
+                    let impulse = if mj.is_finite() { mj * (wj - uj) } else { mi * (ui - wi) };
                     for k in 0..3 {
-                        self.balls[i].v[k] += (wi - ui) * n[k];
-                        self.balls[j].v[k] += (wj - uj) * n[k];
+                        self.balls[i].v[k] += impulse / bi.mass * along_i[k];
+                        self.balls[j].v[k] += impulse / bj.mass * along_j[k];
                     }
+                    let lost = 0.5 * reduced_mass(mi, mj) * ((ui - uj) * (ui - uj) - after * after);
                     let rest_loss = self.settle_rest(i) + self.settle_rest(j);
-                    self.record(Body::Ball(i), Body::Ball(j), ui - uj, lost + rest_loss);
+                    self.record(Body::Ball(i), Body::Ball(j), (ui - uj).max(0.0), lost + rest_loss);
                     self.balls[i].last_impact = self.t;
                     self.balls[j].last_impact = self.t;
                     self.check_ball(i, Some(j))?;
@@ -595,18 +625,11 @@ impl<'a> Solver<'a> {
                 let (xs, vs) = self.frame.state(self.t);
                 let b = self.balls[i];
                 let approach = side * (vs - b.v[0]);
-                if approach > 0.0 {
-                    let quick = self.t - b.last_impact < CONTACT_DURATION;
-                    let count = if quick { b.quick_impacts + 1 } else { 0 };
-                    if count > PERSISTENT_IMPACTS {
-                        return Err(self.stalled(format!(
-                            "ball{} is pressed against the {} wall by the frame's acceleration; the reference beyond one line has no state for a ball the frame holds",
-                            i + 1,
-                            if side > 0.0 { "left" } else { "right" }
-                        )));
-                    }
-                    let e = self.restitution(i, None);
-                    let (vb, vf, lost) = impact_law(b.mass, b.v[0], self.frame.mass, vs, e);
+                let pressing = side * self.frame.accel_ahead(self.t);
+                if let Some(after) = self.separation(approach, pressing, self.restitution(i, None)) {
+                    // The wall on the left (`side > 0`) leaves the ball behind it, the right one ahead.
+                    let (vb, vf) = separate(b.mass, b.v[0], self.frame.mass, vs, -side * after);
+                    let lost = 0.5 * reduced_mass(b.mass, self.frame.mass) * (approach * approach - after * after);
                     let (damping, work) = self.frame.segment_energy(self.t, self.scene);
                     self.damping_loss += damping;
                     self.forcing_work += work;
@@ -615,9 +638,8 @@ impl<'a> Solver<'a> {
                     }
                     self.balls[i].v[0] = vb;
                     self.balls[i].last_impact = self.t;
-                    self.balls[i].quick_impacts = count;
                     let (a, bb) = if side > 0.0 { (Body::LeftWall, Body::Ball(i)) } else { (Body::Ball(i), Body::RightWall) };
-                    self.record(a, bb, approach, lost);
+                    self.record(a, bb, approach.max(0.0), lost);
                     self.limits.fastest = self.limits.fastest.max(approach);
                     self.check_ball(i, None)?;
                     self.predict(i);

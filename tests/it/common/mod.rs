@@ -148,6 +148,9 @@ pub fn all_paper_scenes() -> Vec<Scene> {
 /// Smallest gap between neighbours (walls included) over every sample, relative to nothing:
 /// negative means overlap or a ball outside the container.
 pub fn min_gap(scene: &Scene, run: &lpc_damper::run::Run) -> f64 {
+    if scene.space.beyond_lines(&scene.initial_positions).is_some() {
+        return min_gap_in_space(scene, run);
+    }
     let s = &run.series;
     let n = scene.balls.len();
     let pairs = lpc_damper::scene::Pairs::new(n, &scene.space.chain_starts, scene.container.is_some());
@@ -161,6 +164,34 @@ pub fn min_gap(scene: &Scene, run: &lpc_damper::run::Run) -> f64 {
         for p in pairs.range() {
             if let Some(g) = pairs.gap(&scene.balls, &x, walls, p) {
                 min = min.min(g);
+            }
+        }
+    }
+    min
+}
+
+/// [`min_gap`] for balls off their lines: every pair of balls and every ball against every wall
+/// of its chamber, at every sample.
+fn min_gap_in_space(scene: &Scene, run: &lpc_damper::run::Run) -> f64 {
+    let s = &run.series;
+    let chamber = lpc_damper::scene::Chamber::new(scene).expect("a spatial scene has a chamber");
+    let n = scene.balls.len();
+    let mut min = f64::INFINITY;
+    for k in 0..s.len() {
+        let p: Vec<[f64; 3]> = (0..n)
+            .map(|i| {
+                let [y, z] = s.across(i, k);
+                [s.x(i)[k] - s.xs()[k], y, z]
+            })
+            .collect();
+        for i in 0..n {
+            let r = scene.balls[i].radius;
+            for wall in chamber.walls() {
+                min = min.min(chamber.gap(wall, p[i], r).0);
+            }
+            for j in i + 1..n {
+                let d: f64 = (0..3).map(|c| (p[j][c] - p[i][c]).powi(2)).sum::<f64>().sqrt();
+                min = min.min(d - r - scene.balls[j].radius);
             }
         }
     }

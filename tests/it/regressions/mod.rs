@@ -1,6 +1,8 @@
 //! One test per fixed bug, each on the (shrunk) scene that showed it. A file is named for what
 //! went wrong; its module doc names the issue, the cause and the fix.
 
+mod ball_struck_on_the_floor;
+mod balls_sliding_together;
 mod check_bad_scene_exit_status;
 mod closed_pipe;
 mod ensemble_without_tolerances;
