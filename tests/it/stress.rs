@@ -91,6 +91,22 @@ fn contact_model_passes_the_first_seeded_beds() {
 }
 
 #[test]
+fn reference_passes_the_first_seeded_beds() {
+    // Seeds 1-23 of the same draws for the reference: rough beds are refused up front; every
+    // one of the eight smooth ones it finishes passes every check (the balance closed to
+    // round-off with gravity's work, no overlap, no stall); a run may stop at its 3 s budget, a
+    // typed stop (a pile costs a million events per contact and simulated second, docs/MODEL.md
+    // §14).
+    assert_all_pass(&stress(
+        Model::Reference,
+        1,
+        23,
+        Draws { max_horizon: 1.0, forced: false, extreme: false, max_wall_s: Some(3.0), chains: false, beds: true },
+        &|| {},
+    ));
+}
+
+#[test]
 fn compliant_model_passes_the_first_seeded_beds() {
     // The same beds for the compliant model's spatial path: every run it finishes passes every
     // check (its energy balance to the integration error); a run may stop at its 3 s budget,
