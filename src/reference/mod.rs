@@ -81,20 +81,27 @@ const BUDGET_EVENTS: u64 = 4096;
 #[derive(Debug, Clone, Copy)]
 pub struct Reference;
 
+/// Whether the reference runs `scene` beyond one line (docs/MODEL.md §14) rather than on its
+/// lines.
+fn runs_in_space(scene: &Scene) -> bool {
+    scene.space.beyond_lines(&scene.initial_positions).is_some()
+}
+
 impl Simulator for Reference {
     fn model(&self) -> Model {
         Model::Reference
     }
 
     fn supports(&self, scene: &Scene) -> Result<(), String> {
-        match scene.space.beyond_lines(&scene.initial_positions) {
-            None => Ok(()),
-            Some(_) => spatial::refusal(scene).map_or(Ok(()), Err),
+        if runs_in_space(scene) {
+            spatial::refusal(scene).map_or(Ok(()), Err)
+        } else {
+            Ok(())
         }
     }
 
     fn simulate(&self, scene: &Scene, options: &RunOptions) -> Result<Run, ModelError> {
-        if scene.space.beyond_lines(&scene.initial_positions).is_some() {
+        if runs_in_space(scene) {
             return spatial::simulate(scene, options);
         }
         // Every event reads every pair: with many balls the meter looks more often, so that a
@@ -140,10 +147,7 @@ impl Simulator for Reference {
             momentum: 1e-9,
             wall_overlap: contact,
             ball_overlap: Some(contact),
-            stall_rate: Some(match scene.space.beyond_lines(&scene.initial_positions) {
-                Some(_) => spatial::stall_rate(scene),
-                None => STALL_EVENTS_PER_SIM_S,
-            }),
+            stall_rate: Some(if runs_in_space(scene) { spatial::stall_rate(scene) } else { STALL_EVENTS_PER_SIM_S }),
         }
     }
 

@@ -107,6 +107,21 @@ impl Ord for Entry {
     }
 }
 
+/// The collapse rule's separation speed for a contact closing at `approach` (negative when
+/// it opens) under the acceleration `pressing` (positive when it closes it), with
+/// restitution `e`: `e approach`, but never less than the speed that keeps a pressed contact
+/// open for a contact duration. `None` when the contact opens fast enough by itself.
+fn separation(approach: f64, pressing: f64, e: f64) -> Option<f64> {
+    let keep_open = if pressing > 0.0 { 0.5 * pressing * CONTACT_DURATION } else { 0.0 };
+    if approach > 0.0 {
+        Some((e * approach).max(keep_open))
+    } else if -approach < keep_open {
+        Some(keep_open)
+    } else {
+        None
+    }
+}
+
 /// One ball between its events.
 #[derive(Debug, Clone, Copy)]
 struct Ball {
@@ -164,9 +179,9 @@ impl Ball {
         a
     }
 
-    /// How the ball moves under a unit impulse along `n`: the direction of its velocity change
-    /// (times its length squared) and its mass along `n`. A ball resting on a wall that `n`
-    /// pushes it into moves only along the wall, so it weighs `m / (1 - n_w^2)` along `n`.
+    /// How the ball takes an impulse along `n`: the direction its velocity changes in (`n`, less
+    /// its component into the wall the ball rests on when `n` pushes it into that wall) and its
+    /// mass along `n`, `m / (1 - n_w^2)` in that case (the wall's reaction), else `m`.
     fn pushed(&self, n: [f64; 3]) -> ([f64; 3], f64) {
         match self.rest {
             Some((axis, side)) if side * n[axis] > 0.0 => {
@@ -488,21 +503,6 @@ impl<'a> Solver<'a> {
         }
     }
 
-    /// The collapse rule's separation speed for a contact closing at `approach` (negative when
-    /// it opens) under the acceleration `pressing` (positive when it closes it), with
-    /// restitution `e`: `e approach`, but never less than the speed that keeps a pressed contact
-    /// open for a contact duration. `None` when the contact opens fast enough by itself.
-    fn separation(&self, approach: f64, pressing: f64, e: f64) -> Option<f64> {
-        let keep_open = if pressing > 0.0 { 0.5 * pressing * CONTACT_DURATION } else { 0.0 };
-        if approach > 0.0 {
-            Some((e * approach).max(keep_open))
-        } else if -approach < keep_open {
-            Some(keep_open)
-        } else {
-            None
-        }
-    }
-
     fn record(&mut self, a: Body, b: Body, approach: f64, lost: f64) {
         self.impact_loss += lost;
         self.impacts.push(Impact {
@@ -565,9 +565,10 @@ impl<'a> Solver<'a> {
                 let (along_j, mj) = bj.pushed(n);
                 // An approach the velocities cannot resolve is none (the pair moves on touching).
                 let approach = if ui - uj > still(bi.v, bj.v) { ui - uj } else { (ui - uj).min(0.0) };
-                let separation = self.separation(approach, pressing, self.restitution(i, Some(j)));
-                if let Some(after) = separation.filter(|_| gap <= self.pair_tolerance(i, j, ui - uj) && (mi.is_finite() || mj.is_finite()))
-                {
+                let touching = gap <= self.pair_tolerance(i, j, ui - uj);
+                // Two balls each pushed square into its wall cannot move along `n`.
+                let movable = mi.is_finite() || mj.is_finite();
+                if let Some(after) = separation(approach, pressing, self.restitution(i, Some(j))).filter(|_| touching && movable) {
                     let (wi, wj) = separate(mi, ui, mj, uj, after);
                     let impulse = if mj.is_finite() { mj * (wj - uj) } else { mi * (ui - wi) };
                     for k in 0..3 {
@@ -622,11 +623,10 @@ impl<'a> Solver<'a> {
                     return Ok(());
                 }
                 self.bring(i);
-                let (xs, vs) = self.frame.state(self.t);
+                let (xs, vs, accel) = self.frame.now(self.t);
                 let b = self.balls[i];
                 let approach = side * (vs - b.v[0]);
-                let pressing = side * self.frame.accel_ahead(self.t);
-                if let Some(after) = self.separation(approach, pressing, self.restitution(i, None)) {
+                if let Some(after) = separation(approach, side * accel, self.restitution(i, None)) {
                     // The wall on the left (`side > 0`) leaves the ball behind it, the right one ahead.
                     let (vb, vf) = separate(b.mass, b.v[0], self.frame.mass, vs, -side * after);
                     let lost = 0.5 * reduced_mass(b.mass, self.frame.mass) * (approach * approach - after * after);
