@@ -37,6 +37,7 @@ mod registry;
 pub mod render;
 pub mod run;
 pub mod scene;
+pub mod storeys;
 pub mod studies;
 
 pub use model::Model;
