@@ -70,6 +70,52 @@ pub struct RunSummary {
     /// ([`crate::run::series_every`]); the metrics use every sample.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub series_every: Option<usize>,
+    /// A structure's floors, bottom to top, read at the kept samples (empty without one).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub floors: Vec<FloorSummary>,
+    /// The same floors without the damper (the structure alone), when the caller ran it.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub floors_without_damper: Vec<FloorSummary>,
+}
+
+/// One floor's response as a structural engineer reads it.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct FloorSummary {
+    /// 1 at the bottom.
+    pub floor: usize,
+    /// Largest `|u|` relative to the ground, m.
+    pub peak_displacement: f64,
+    /// Largest interstorey drift `|u_i - u_{i-1}|` (the ground below floor 1), m.
+    pub peak_drift: f64,
+    /// Largest absolute acceleration (impulses excluded), m/s^2.
+    pub peak_acceleration: f64,
+    /// Root mean square of `u` over the samples, m.
+    pub rms_displacement: f64,
+}
+
+impl FloorSummary {
+    /// Every floor of `series` (none when it has no floors), over its kept samples.
+    pub fn of(series: &crate::run::Series) -> Vec<FloorSummary> {
+        let n = series.floor_count();
+        let samples = series.len();
+        (0..n)
+            .map(|i| {
+                let mut f =
+                    FloorSummary { floor: i + 1, peak_displacement: 0.0, peak_drift: 0.0, peak_acceleration: 0.0, rms_displacement: 0.0 };
+                let mut sum = 0.0;
+                for k in 0..samples {
+                    let Some((u, _, a)) = series.floor(i, k) else { break };
+                    let below = if i > 0 { series.floor(i - 1, k).map_or(0.0, |b| b.0) } else { 0.0 };
+                    f.peak_displacement = f.peak_displacement.max(u.abs());
+                    f.peak_drift = f.peak_drift.max((u - below).abs());
+                    f.peak_acceleration = f.peak_acceleration.max(a.abs());
+                    sum += u * u;
+                }
+                f.rms_displacement = if samples > 0 { (sum / samples as f64).sqrt() } else { 0.0 };
+                f
+            })
+            .collect()
+    }
 }
 
 impl RunSummary {
@@ -104,6 +150,8 @@ impl RunSummary {
             noise: noise(run),
             wall_time_s: run.wall_time_s,
             series_every: (run.series.every > 1).then_some(run.series.every),
+            floors: FloorSummary::of(&run.series),
+            floors_without_damper: vec![],
         }
     }
 }

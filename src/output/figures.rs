@@ -448,7 +448,8 @@ pub fn read_series_csv(path: &Path) -> Result<Series, FigureError> {
     let fail = |reason: String| FigureError { path: path.display().to_string(), reason };
     let mut r = csv::Reader::from_path(path).map_err(|e| fail(e.to_string()))?;
     let header = r.headers().map_err(|e| fail(e.to_string()))?.clone();
-    let cols = header.len();
+    // A structure's floors (`xs1, vs1, ...`) come last; the plots read the carrying floor.
+    let cols = header.iter().position(|h| h == "xs1").unwrap_or(header.len());
     if cols < 4 || &header[0] != "t" || &header[1] != "xs" || (cols - 4) % 2 != 0 {
         return Err(fail("is not a series.csv (expected columns t, xs, vs, a, x1, v1, ...)".into()));
     }

@@ -57,5 +57,30 @@ pub fn text_summary(s: &RunSummary) -> String {
         e.impact_loss,
         e.balance_error,
         noise_line(&s.noise),
-    )
+    ) + &floors_table(s)
+}
+
+/// A structure's floors, with and without the damper when both are known.
+fn floors_table(s: &RunSummary) -> String {
+    if s.floors.is_empty() {
+        return String::new();
+    }
+    let mut out = String::from("floor  peak disp (mm)  peak drift (mm)  peak abs accel (m/s^2)  rms disp (mm)\n");
+    let row = |f: &crate::metrics::FloorSummary, label: &str| {
+        format!(
+            "{:<5}  {:>14.4}  {:>15.4}  {:>22.4}  {:>13.4}{label}\n",
+            f.floor,
+            f.peak_displacement * 1e3,
+            f.peak_drift * 1e3,
+            f.peak_acceleration,
+            f.rms_displacement * 1e3
+        )
+    };
+    for (i, f) in s.floors.iter().enumerate() {
+        out += &row(f, "");
+        if let Some(bare) = s.floors_without_damper.get(i) {
+            out += &row(bare, "  (without damper)");
+        }
+    }
+    out
 }

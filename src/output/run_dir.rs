@@ -29,6 +29,15 @@ pub fn write_series_csv(run: &Run, out: &mut dyn Write) -> std::io::Result<()> {
         header.push(format!("y{}", i + 1));
         header.push(format!("z{}", i + 1));
     }
+    // A structure: every floor relative to the ground, bottom to top, after the balls, and
+    // then every floor's absolute acceleration.
+    for i in 0..s.floor_count() {
+        header.push(format!("xs{}", i + 1));
+        header.push(format!("vs{}", i + 1));
+    }
+    for i in 0..s.floor_count() {
+        header.push(format!("as{}", i + 1));
+    }
     w.write_record(&header)?;
     let mut row = Vec::with_capacity(header.len());
     for k in 0..s.len() {
@@ -40,6 +49,15 @@ pub fn write_series_csv(run: &Run, out: &mut dyn Write) -> std::io::Result<()> {
         }
         for i in 0..s.balls() * s.has_across() as usize {
             row.extend(s.across(i, k).iter().map(|x| x.to_string()));
+        }
+        let floor = |i: usize| s.floor(i, k).unwrap_or((f64::NAN, f64::NAN, f64::NAN));
+        for i in 0..s.floor_count() {
+            let (u, v, _) = floor(i);
+            row.push(u.to_string());
+            row.push(v.to_string());
+        }
+        for i in 0..s.floor_count() {
+            row.push(floor(i).2.to_string());
         }
         w.write_record(&row)?;
     }

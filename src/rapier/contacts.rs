@@ -232,6 +232,7 @@ mod tests {
             rapier: Default::default(),
             compliant: Default::default(),
             forcing: None,
+            structure: None,
         }
     }
 

@@ -53,12 +53,19 @@ pub fn headless_app_recording(scene: &Scene, settings: StepSettings, record: Rec
 #[derive(Debug, Clone, Copy)]
 pub struct Rapier;
 
+/// Why the model refuses a structure of several storeys or a ground-motion record.
+const STRUCTURES_NOT_YET: &str =
+    "it moves a frame of one storey under free vibration or a sine; structures of several storeys and ground-motion records run with the reference model";
+
 impl Simulator for Rapier {
     fn model(&self) -> Model {
         Model::Rapier
     }
 
     fn supports(&self, scene: &Scene) -> Result<(), String> {
+        if scene.structure.is_some() {
+            return Err(STRUCTURES_NOT_YET.into());
+        }
         // Several chains, or balls beyond lines, go to the spatial path (`spatial`).
         if spatial::needs_spatial(scene) {
             return spatial::refusal(scene).map_or(Ok(()), Err);

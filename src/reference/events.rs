@@ -50,7 +50,7 @@ impl Solver<'_> {
     pub(super) fn book_segment_energy(&mut self) {
         let (damping, work) = self.frame.segment_energy(self.t, self.scene);
         self.ledger.damping_loss += damping;
-        if self.frame.seg.forced.is_some() {
+        if self.frame.is_driven() {
             self.ledger.forcing_work += work;
         }
     }

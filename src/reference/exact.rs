@@ -47,7 +47,7 @@ impl ExactTally {
     /// 0 throughout, the samples serve) or is forced.
     pub(super) fn new(scene: &Scene) -> Option<Self> {
         let frame = scene.frame?;
-        if scene.forcing.is_some() {
+        if scene.forcing.is_some() || scene.structure.is_some() {
             return None;
         }
         let e0 = scene.initial_energy();

@@ -6,6 +6,7 @@
 use std::cell::{Cell, RefCell};
 
 use super::segment::{Segment, SignChanges};
+use super::storeys::StoreyMotion;
 use super::{ROUNDOFF_RELATIVE, SIGN_CHANGES_KEPT};
 use crate::oscillator::{gauss_legendre, Oscillator};
 use crate::scene::Scene;
@@ -45,15 +46,24 @@ pub(super) struct FrameMotion {
     /// the checks ask for the same instant in turn, and each evaluation costs an `exp` and a
     /// `sin_cos` ([`FrameMotion::state`]).
     last_state: Cell<(u64, f64, f64, f64)>,
+    /// A structure of several storeys or a moving ground: the carrying floor's motion comes
+    /// from it, and `seg` is unused.
+    storeys: Option<Box<StoreyMotion>>,
 }
 
 impl FrameMotion {
-    pub(super) fn new(scene: &Scene) -> Self {
+    /// The frame of `scene`, or why its structure has no closed form.
+    pub(super) fn new(scene: &Scene) -> Result<Self, String> {
         let (mass, damping, stiffness) = scene.frame.map_or((f64::INFINITY, 0.0, 0.0), |f| (f.mass, f.damping, f.stiffness));
         let osc = Oscillator::new(if mass.is_finite() { mass } else { 1.0 }, damping, stiffness);
         let load = scene.harmonic_load();
         let seg = Segment::new(0.0, scene.initial_displacement, 0.0, osc, load);
-        FrameMotion {
+        let storeys = match &scene.structure {
+            Some(s) => Some(Box::new(StoreyMotion::new(s.clone(), scene.horizon)?)),
+            None => None,
+        };
+        let span = storeys.as_ref().map_or_else(|| span(&seg, scene.horizon), |s| s.span);
+        Ok(FrameMotion {
             mass,
             damping,
             stiffness,
@@ -61,11 +71,67 @@ impl FrameMotion {
             seg,
             segment: 1,
             held_mass: 0.0,
-            span: span(&seg, scene.horizon),
+            span,
             horizon: scene.horizon,
             sign_changes: Default::default(),
             now: Default::default(),
             last_state: Cell::new((0, f64::NAN, 0.0, 0.0)),
+            storeys,
+        })
+    }
+
+    /// The structure's motion, when the frame is a floor of one.
+    pub(super) fn storeys(&self) -> Option<&StoreyMotion> {
+        self.storeys.as_deref()
+    }
+
+    /// The scan step of a motion whose acceleration's sign changes are scanned (forced, or a
+    /// structure's), `None` when they come in closed form.
+    pub(super) fn scan_step(&self) -> Option<f64> {
+        match &self.storeys {
+            Some(s) => Some(s.scan_step),
+            None => self.seg.forced.map(|f| f.scan),
+        }
+    }
+
+    /// Whether an excitation does work on the frame.
+    pub(super) fn is_driven(&self) -> bool {
+        match &self.storeys {
+            Some(s) => s.is_driven(),
+            None => self.seg.forced.is_some(),
+        }
+    }
+
+    /// The farthest the frame goes from 0 in this segment, when known (an unforced frame).
+    pub(super) fn reach(&self) -> Option<f64> {
+        if self.storeys.is_some() {
+            return None;
+        }
+        self.seg.reach
+    }
+
+    /// A bound on the round-off of the frame's position at `t`.
+    pub(super) fn position_roundoff(&self, t: f64) -> f64 {
+        match &self.storeys {
+            Some(s) => s.position_roundoff(t),
+            None => self.seg.position_roundoff(t),
+        }
+    }
+
+    /// Why the frame's motion cannot go on, once it cannot.
+    pub(super) fn failure(&self) -> Option<&str> {
+        self.storeys.as_ref().and_then(|s| s.failure.as_deref())
+    }
+
+    /// The mechanical energy of the frame (and the floors of its structure) at `t`, without
+    /// the balls it holds.
+    pub(super) fn energy(&self, t: f64, scene: &Scene) -> f64 {
+        match &self.storeys {
+            Some(s) => s.energy(t),
+            None => {
+                let (xs, vs) = self.seg.state(t);
+                scene.frame_energy(t, xs, vs)
+            }
         }
     }
 
@@ -77,6 +143,12 @@ impl FrameMotion {
     /// Starts a new segment at `t` from displacement `xs` with velocity `v`, the frame carrying
     /// `held_mass` of balls.
     pub(super) fn restart(&mut self, t: f64, xs: f64, v: f64) {
+        if let Some(s) = &mut self.storeys {
+            s.restart(t, v, self.held_mass);
+            self.segment += 1;
+            self.span = s.span;
+            return;
+        }
         let osc = if self.seg.osc.mass == self.mass + self.held_mass {
             self.seg.osc
         } else {
@@ -91,6 +163,9 @@ impl FrameMotion {
     /// up to `t`: closed form when free; when forced, Gauss-Legendre on pieces of a sixteenth of
     /// the shorter period (exact to round-off, see [`gauss_legendre`]).
     pub(super) fn segment_energy(&self, t: f64, scene: &Scene) -> (f64, f64) {
+        if let Some(s) = &self.storeys {
+            return s.segment_energy(t);
+        }
         let seg = self.seg;
         let Some(f) = seg.forced else {
             return (seg.osc.dissipated(seg.x0, seg.v0, t - seg.t0), 0.0);
@@ -109,7 +184,10 @@ impl FrameMotion {
         if segment == self.segment && last == t {
             return (xs, vs);
         }
-        let (xs, vs) = self.seg.state(t);
+        let (xs, vs) = match &self.storeys {
+            Some(s) => s.state(t),
+            None => self.seg.state(t),
+        };
         self.last_state.set((self.segment, t, xs, vs));
         (xs, vs)
     }
@@ -134,19 +212,11 @@ impl FrameMotion {
     /// Every sign involved is that of `-(c v + k x)` and its derivatives, whatever the mass
     /// the frame carries, so holding and releasing a ball always agree.
     pub(super) fn accel_ahead(&self, t: f64) -> f64 {
+        if let Some(s) = &self.storeys {
+            return s.accel_ahead(t);
+        }
         if let Some(f) = &self.seg.forced {
-            let [(a, sa), (jerk, sj), (snap, _)] = self.seg.forced_derivatives(f, t);
-            if a.abs() > ROUNDOFF_RELATIVE * sa {
-                return a;
-            }
-            let sign = if jerk.abs() > ROUNDOFF_RELATIVE * sj {
-                jerk.signum()
-            } else if snap == 0.0 {
-                return 0.0;
-            } else {
-                snap.signum()
-            };
-            return sign * a.abs().max(f64::MIN_POSITIVE);
+            return ahead(self.seg.forced_derivatives(f, t));
         }
         let (x, v) = self.state(t);
         let o = &self.seg.osc;
@@ -174,6 +244,9 @@ impl FrameMotion {
     /// A forced segment's sign changes are scanned once and kept ([`SignChanges`]); no search
     /// starts before `now`, so older ones are dropped.
     pub(super) fn next_sign_change(&self, t: f64, limit: f64, now: f64) -> f64 {
+        if let Some(s) = &self.storeys {
+            return s.next_sign_change(t, limit);
+        }
         let Some(f) = &self.seg.forced else {
             return self.seg.free_sign_change(t);
         };
@@ -201,6 +274,23 @@ impl FrameMotion {
             c.pieces += 1;
         }
     }
+}
+
+/// The acceleration just after an instant, from its value, jerk and snap there with the size
+/// of the terms of each: the value, with the sign of the first derivative that is not
+/// round-off when the value itself is.
+pub(super) fn ahead([(a, sa), (jerk, sj), (snap, _)]: [(f64, f64); 3]) -> f64 {
+    if a.abs() > ROUNDOFF_RELATIVE * sa {
+        return a;
+    }
+    let sign = if jerk.abs() > ROUNDOFF_RELATIVE * sj {
+        jerk.signum()
+    } else if snap == 0.0 {
+        return 0.0;
+    } else {
+        snap.signum()
+    };
+    sign * a.abs().max(f64::MIN_POSITIVE)
 }
 
 /// One damped period of the frame in segment `seg`, or the horizon.

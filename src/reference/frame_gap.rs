@@ -57,7 +57,7 @@ impl FrameGap<'_> {
         let eps = f64::EPSILON;
         self.limits.tol
             + self.drift
-            + self.frame.seg.position_roundoff(t)
+            + self.frame.position_roundoff(t)
             + 4.0 * eps * (xb.abs() + xs.abs() + self.k.abs())
             + 2.0 * eps * t.abs() * rate.abs().max(self.limits.fastest)
     }
@@ -71,7 +71,7 @@ impl FrameGap<'_> {
         // Only a forced segment's search is cut at `bound`: its sign changes are scanned, so
         // looking further costs, where an unforced segment's come in closed form (and cutting
         // its pieces would change the roots' last bits, which chaotic runs amplify).
-        let bound = if self.frame.seg.forced.is_some() { bound } else { self.horizon };
+        let bound = if self.frame.scan_step().is_some() { bound } else { self.horizon };
         let limit = (from + self.frame.span).min(self.horizon).min(bound);
         if !self.may_reach(from, limit) {
             // What the search below would conclude, without evaluating the frame's motion.
@@ -108,7 +108,7 @@ impl FrameGap<'_> {
     /// an ulp of time.
     pub(super) fn may_reach(&self, from: f64, limit: f64) -> bool {
         let seg = &self.frame.seg;
-        let Some(reach) = seg.reach else { return true };
+        let Some(reach) = self.frame.reach() else { return true };
         let speed = seg.osc.w0() * reach;
         let (x, v) = (self.x, self.v);
         let (s, k) = (self.s, self.k);

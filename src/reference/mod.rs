@@ -21,6 +21,7 @@ mod output;
 mod search;
 mod segment;
 mod spatial;
+mod storeys;
 
 use balls::{Balls, Gap, Hold};
 use events::Ledger;
@@ -108,7 +109,7 @@ impl Simulator for Reference {
         // long run reports about once per a few hundred thousand pair readings.
         let every = (BUDGET_EVENTS * 16 / (scene.balls.len() as u64 + 1)).clamp(1, BUDGET_EVENTS);
         let meter = Meter::new(options, every);
-        let mut solver = Solver::new(scene, options.record);
+        let mut solver = Solver::new(scene, options.record)?;
         let stop = solver.run(&meter)?;
         let (t, events) = (solver.t, solver.events);
         meter.finish(t, events);
@@ -187,13 +188,13 @@ struct Solver<'a> {
 }
 
 impl<'a> Solver<'a> {
-    fn new(scene: &'a Scene, record: Record) -> Self {
+    fn new(scene: &'a Scene, record: Record) -> Result<Self, ModelError> {
         let balls = Balls::new(scene);
         let pairs = balls.pairs.count();
-        Solver {
+        Ok(Solver {
             scene,
             balls,
-            frame: FrameMotion::new(scene),
+            frame: FrameMotion::new(scene).map_err(ModelError::Refused)?,
             search: Search::new(pairs),
             limits: Limits::new(scene),
             ledger: Ledger::new(pairs),
@@ -203,7 +204,7 @@ impl<'a> Solver<'a> {
             t: 0.0,
             horizon: scene.horizon,
             events: 0,
-        }
+        })
     }
 
     fn has_frame(&self) -> bool {
@@ -255,6 +256,9 @@ impl<'a> Solver<'a> {
             self.events += 1;
             if let Some(budget) = meter.look(t, self.events) {
                 return Ok(Some(budget));
+            }
+            if let Some(why) = self.frame.failure() {
+                return Err(ModelError::Unstable { scene: self.scene.name.clone(), model: Model::Reference, t, reason: why.to_string() });
             }
             if self.events > MAX_EVENTS || same_instant > MAX_EVENTS_PER_INSTANT {
                 let why = if same_instant > MAX_EVENTS_PER_INSTANT {

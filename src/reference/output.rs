@@ -35,6 +35,10 @@ pub(super) struct Sampler {
     pub(super) cursor: SampleCursor,
     /// Scratch: the frame's state at each sample of an interval, and each ball's path over it.
     frame: Vec<(f64, f64)>,
+    /// Scratch: a structure's floors at each sample of an interval (`u1..un, v1..vn` each).
+    floors: Vec<f64>,
+    /// Scratch: the ground's displacement and velocity at each sample, when it moves.
+    ground: Vec<(f64, f64)>,
     paths: Vec<BallPath>,
 }
 
@@ -61,6 +65,8 @@ impl Sampler {
                 turn: scene.forcing.map_or((0.0, 1.0), |g| (g.omega() * scene.sample_dt).sin_cos()),
             },
             frame: Vec::new(),
+            floors: Vec::new(),
+            ground: Vec::new(),
             paths: Vec::new(),
         }
     }
@@ -89,8 +95,26 @@ impl Solver<'_> {
             return;
         }
         let mut frame = std::mem::take(&mut self.sampler.frame);
+        let mut floors = std::mem::take(&mut self.sampler.floors);
         frame.clear();
-        if self.has_frame() {
+        floors.clear();
+        let mut ground = std::mem::take(&mut self.sampler.ground);
+        ground.clear();
+        if let Some(storeys) = self.frame.storeys() {
+            // A structure: every floor from its closed form at each sample, in the ground's
+            // frame (the balls are moved into it by the recorder).
+            let n = self.scene.structure.as_ref().map_or(0, |s| s.floors());
+            let d = self.scene.structure.as_ref().map_or(0, |s| s.floor);
+            for k in first..end {
+                let ts = k as f64 * dt;
+                let (z, _) = storeys.floors(ts);
+                frame.push((z[d], z[n + d]));
+                floors.extend_from_slice(&z);
+                if storeys.is_driven() {
+                    ground.push(storeys.ground(ts));
+                }
+            }
+        } else if self.has_frame() {
             self.frame_samples(first, end, &mut frame);
         } else {
             frame.resize(end - first, (0.0, 0.0));
@@ -101,8 +125,10 @@ impl Solver<'_> {
             Hold::Free => BallPath::Free { x: b.x[i], v: b.v[i], t: self.t },
             _ => BallPath::Held { offset: b.offset[i] },
         }));
-        self.sampler.recorder.sample_interval(self.scene, first, &frame, &self.sampler.paths);
+        self.sampler.recorder.sample_interval_with_floors(self.scene, first, &frame, &floors, &ground, &self.sampler.paths);
         self.sampler.frame = frame;
+        self.sampler.floors = floors;
+        self.sampler.ground = ground;
         self.sampler.next_sample = end;
     }
 
@@ -204,8 +230,8 @@ impl Solver<'_> {
     }
 
     pub(super) fn mechanical_energy(&self) -> f64 {
-        let (xs, vs) = if self.has_frame() { self.frame.seg.state(self.t) } else { (0.0, 0.0) };
-        let frame = self.scene.frame_energy(self.t, xs, vs);
+        let (_, vs) = if self.has_frame() { self.frame.state(self.t) } else { (0.0, 0.0) };
+        let frame = if self.has_frame() { self.frame.energy(self.t, self.scene) } else { 0.0 };
         frame
             + (0..self.balls.n)
                 .map(|i| {
@@ -229,7 +255,7 @@ impl Solver<'_> {
         if self.has_frame() {
             self.book_segment_energy();
         }
-        let (_, vs) = if self.has_frame() { self.frame.seg.state(self.t) } else { (0.0, 0.0) };
+        let (_, vs) = if self.has_frame() { self.frame.state(self.t) } else { (0.0, 0.0) };
         let final_velocities = (0..self.balls.n).map(|i| if self.balls.hold[i] == Hold::Free { self.balls.v[i] } else { vs }).collect();
         let energy = EnergyAccount::forced(
             self.scene.initial_energy(),
@@ -270,7 +296,7 @@ mod tests {
     fn stepped_samples_are_the_closed_form() {
         for name in ["lpc-lsl", "forced-lsl"] {
             let scene = crate::scene::load_scene(crate::scene::scenes_dir().join(format!("{name}.toml"))).unwrap();
-            let mut solver = Solver::new(&scene, Record::Series);
+            let mut solver = Solver::new(&scene, Record::Series).unwrap();
             // A segment of the bare frame moving from a state of its own, from t = 0.3 s.
             let t0 = 0.3;
             solver.frame.restart(t0, 0.01, -0.2);

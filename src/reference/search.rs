@@ -100,13 +100,13 @@ impl Solver<'_> {
             }
         }
         debug_assert!(frame.len() <= 2 * self.balls.chains.len().max(1), "more than two ball-frame pairs per chain");
-        match self.frame.seg.forced {
+        match self.frame.scan_step() {
             // Both frame pairs searched side by side over windows that double from a scan
             // step: the far wall's search then stops where the near wall's contact is. As
             // unforced, no search looks more than a span ahead; one that finds nothing by then
             // goes on when its time comes.
-            Some(f) => {
-                let (mut reached, mut window) = (self.t, f.scan);
+            Some(scan) => {
+                let (mut reached, mut window) = (self.t, scan);
                 let mut bound = bound.min(self.t + self.frame.span);
                 loop {
                     let until = (reached + window).min(bound);
@@ -163,7 +163,7 @@ mod tests {
         let mut rng = rand_pcg::Pcg64::seed_from_u64(13);
         let (mut ruled_out, mut kept) = (0, 0);
         for _ in 0..2000 {
-            let mut s = Solver::new(&scene, Record::MetricsOnly);
+            let mut s = Solver::new(&scene, Record::MetricsOnly).unwrap();
             let (x0, v0) = (rng.random_range(-0.02..0.02), rng.random_range(-1.0..1.0));
             let t0 = rng.random_range(0.0..2.0);
             s.frame.seg = Segment::new(t0, x0, v0, s.frame.seg.osc, None);

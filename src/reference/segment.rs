@@ -266,35 +266,7 @@ impl Segment {
     /// the Illinois variant of regula falsi: the bracket shrinks from both sides, to a few
     /// ulps; the root is its right end, where the sign has changed.
     pub(super) fn illinois(&self, f: &Forced, l: &Probe, r: &Probe) -> f64 {
-        let (mut a, mut fa, mut b, mut fb) = (l.s, l.a, r.s, r.a);
-        let mut side = 0;
-        for _ in 0..MAX_ROOT_ITERATIONS {
-            if b - a <= self.time_resolution(b, f) {
-                break;
-            }
-            let mut m = (a * fb - b * fa) / (fb - fa);
-            if !(m > a && m < b) {
-                m = 0.5 * (a + b);
-            }
-            let fm = self.probe(f, m).a;
-            if fm == 0.0 {
-                return m;
-            }
-            if (fm > 0.0) == (fa > 0.0) {
-                (a, fa) = (m, fm);
-                if side == -1 {
-                    fb *= 0.5;
-                }
-                side = -1;
-            } else {
-                (b, fb) = (m, fm);
-                if side == 1 {
-                    fa *= 0.5;
-                }
-                side = 1;
-            }
-        }
-        b
+        illinois((l.s, l.a), (r.s, r.a), |b| self.time_resolution(b, f), |m| self.probe(f, m).a)
     }
 
     /// Width below which a bracket of a sign change is not split further: a few ulps of time.
@@ -310,4 +282,44 @@ impl Segment {
             Some(f) => self.osc.roundoff(f.h0.0, f.h0.1, tau) + f.xp.roundoff(t, 0),
         }
     }
+}
+
+/// The one root of a monotone function `y` between `(a, y(a))` and `(b, y(b))` (of opposite
+/// signs), by the Illinois variant of regula falsi: the bracket shrinks from both sides until
+/// it is no wider than `resolution` at its right end; the root is that end, where the sign has
+/// changed.
+pub(super) fn illinois(
+    (mut a, mut fa): (f64, f64),
+    (mut b, mut fb): (f64, f64),
+    resolution: impl Fn(f64) -> f64,
+    y: impl Fn(f64) -> f64,
+) -> f64 {
+    let mut side = 0;
+    for _ in 0..MAX_ROOT_ITERATIONS {
+        if b - a <= resolution(b) {
+            break;
+        }
+        let mut m = (a * fb - b * fa) / (fb - fa);
+        if !(m > a && m < b) {
+            m = 0.5 * (a + b);
+        }
+        let fm = y(m);
+        if fm == 0.0 {
+            return m;
+        }
+        if (fm > 0.0) == (fa > 0.0) {
+            (a, fa) = (m, fm);
+            if side == -1 {
+                fb *= 0.5;
+            }
+            side = -1;
+        } else {
+            (b, fb) = (m, fm);
+            if side == 1 {
+                fa *= 0.5;
+            }
+            side = 1;
+        }
+    }
+    b
 }

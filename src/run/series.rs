@@ -28,6 +28,13 @@ pub struct Series {
     /// sample; empty unless the model moves balls across the motion (the spatial paths of
     /// the Rapier model and the reference).
     across: Vec<f64>,
+    /// Each kept sample's floors, `u1, ..., un, v1, ..., vn, a1, ..., an` sample after sample
+    /// (displacements and velocities relative to the ground, absolute accelerations without
+    /// impulses); empty unless the scene has a structure of several storeys or a moving ground
+    /// ([`crate::scene::Structure`]).
+    floors: Vec<f64>,
+    /// The number of floors in `floors`.
+    floor_count: usize,
 }
 
 /// Columns before the balls': `t`, `xs`, `vs`, `a`.
@@ -40,13 +47,23 @@ impl PartialEq for Series {
             && self.every == other.every
             && (0..self.columns()).all(|c| self.column(c) == other.column(c))
             && self.across == other.across
+            && self.floors == other.floors
     }
 }
 
 impl Series {
     /// An empty series with room for `samples` samples of `balls` balls.
     pub fn with_capacity(balls: usize, samples: usize) -> Self {
-        Series { data: vec![0.0; (FRAME_COLUMNS + 2 * balls) * samples], capacity: samples, len: 0, balls, every: 1, across: vec![] }
+        Series {
+            data: vec![0.0; (FRAME_COLUMNS + 2 * balls) * samples],
+            capacity: samples,
+            len: 0,
+            balls,
+            every: 1,
+            across: vec![],
+            floors: vec![],
+            floor_count: 0,
+        }
     }
     /// A series of the given columns (all of one length): times, the frame's displacement,
     /// velocity and acceleration, and each ball's centre and velocity.
@@ -127,6 +144,18 @@ impl Series {
             None => [0.0; 2],
         }
     }
+    /// The number of floors whose motion the series holds (0 without a structure).
+    pub fn floor_count(&self) -> usize {
+        self.floor_count
+    }
+    /// Floor `i`'s (0 at the bottom) displacement and velocity relative to the ground, and its
+    /// absolute acceleration without impulses, at kept sample `k` (m, m/s, m/s^2); `None` when
+    /// the series has no floors.
+    pub fn floor(&self, i: usize, k: usize) -> Option<(f64, f64, f64)> {
+        let n = self.floor_count;
+        let at = 3 * n * k;
+        self.floors.get(at..at + 3 * n).map(|z| (z[i], z[n + i], z[2 * n + i]))
+    }
     /// The balls' centres across the motion, moved out: `y1, z1, y2, z2, ...` for each kept
     /// sample in turn (empty when the series has none).
     pub fn take_across(&mut self) -> Vec<f64> {
@@ -206,6 +235,21 @@ impl Series {
             }
         }
         self.len += count;
+    }
+    /// The free balls of the last `count` samples moved into the ground's frame: less the
+    /// ground's displacement and velocity at each (a held ball is written from the frame,
+    /// already in it).
+    fn shift_free_balls(&mut self, count: usize, ground: &[(f64, f64)], paths: &[BallPath]) {
+        let (cap, start) = (self.capacity, self.len - count);
+        for (i, path) in paths.iter().enumerate() {
+            if let BallPath::Free { .. } = path {
+                let (xc, vc) = (self.x_column(i), self.v_column(i));
+                for (j, &(xg, vg)) in ground.iter().enumerate().take(count) {
+                    self.data[xc * cap + start + j] -= xg;
+                    self.data[vc * cap + start + j] -= vg;
+                }
+            }
+        }
     }
     /// The next `count` times, written already, and the next `count` entries of column `c`
     /// (after the time column), to be written.
@@ -312,6 +356,20 @@ impl Recorder {
     #[inline]
     pub fn sample(&mut self, scene: &Scene, t: f64, xs: f64, vs: f64, ball: impl Fn(usize) -> (f64, f64)) {
         let a = scene.frame_acceleration(t, xs, vs);
+        let frame_energy = |t: f64, xs: f64, vs: f64| scene.frame_energy(t, xs, vs);
+        self.sample_with(t, xs, vs, a, frame_energy, ball);
+    }
+    /// [`Recorder::sample`] with the frame's acceleration `a` and its energy given.
+    #[inline]
+    fn sample_with(
+        &mut self,
+        t: f64,
+        xs: f64,
+        vs: f64,
+        a: f64,
+        frame_energy: impl Fn(f64, f64, f64) -> f64,
+        ball: impl Fn(usize) -> (f64, f64),
+    ) {
         let wants_energy = self.tally.as_ref().is_some_and(|t| t.wants_energy());
         let mut kinetic = 0.0;
         let kept = self.series.as_mut().filter(|s| self.taken.is_multiple_of(s.every.max(1)));
@@ -329,7 +387,7 @@ impl Recorder {
                 kinetic += 0.5 * m * v * v;
             }
         }
-        let energy = if wants_energy { scene.frame_energy(t, xs, vs) + kinetic } else { 0.0 };
+        let energy = if wants_energy { frame_energy(t, xs, vs) + kinetic } else { 0.0 };
         if let Some(tally) = &mut self.tally {
             tally.add(t, xs, a, energy);
         }
@@ -345,12 +403,62 @@ impl Recorder {
     /// at `frame[j]` at sample `first + j` and each ball `i` follows `paths[i]`: the same values
     /// as [`Recorder::sample`] at each, written a column at a time unless the series is thinned.
     pub fn sample_interval(&mut self, scene: &Scene, first: usize, frame: &[(f64, f64)], paths: &[BallPath]) {
+        self.sample_interval_with_floors(scene, first, frame, &[], &[], paths);
+    }
+    /// [`Recorder::sample_interval`] for a scene with a structure, in the ground's frame:
+    /// `frame` is the carrying floor relative to the ground, `floors` each sample's floors
+    /// relative to it (`u1, ..., un, v1, ..., vn`, sample after sample), from which the
+    /// carrying floor's (absolute) acceleration and the structure's energy come, and `ground`
+    /// the ground's displacement and velocity at each sample (empty when it is still), taken
+    /// from the free balls' positions and velocities.
+    pub fn sample_interval_with_floors(
+        &mut self,
+        scene: &Scene,
+        first: usize,
+        frame: &[(f64, f64)],
+        floors: &[f64],
+        ground: &[(f64, f64)],
+        paths: &[BallPath],
+    ) {
+        let in_ground_frame = |j: usize, path: &BallPath, (x, v): (f64, f64)| match (path, ground.get(j)) {
+            (BallPath::Free { .. }, Some(&(xg, vg))) => (x - xg, v - vg),
+            _ => (x, v),
+        };
         let dt = scene.sample_dt;
         let time = |j: usize| (first + j) as f64 * dt;
+        let structure = scene.structure.as_deref().filter(|_| !floors.is_empty());
+        let width = structure.map_or(0, |s| 2 * s.floors());
+        let floor_state = |j: usize| floors[j * width..(j + 1) * width].split_at(width / 2);
+        // The carrying floor's acceleration and the structure's energy (in free vibration,
+        // where the ground is still) at sample `j`.
+        let structure_acceleration = |j: usize| {
+            let s = structure.expect("floors come with a structure");
+            let (u, v) = floor_state(j);
+            s.accelerations(u, v)[s.floor]
+        };
+        if let (Some(s), Some(series)) = (structure, &mut self.series) {
+            series.floor_count = s.floors();
+            let every = series.every.max(1);
+            for j in 0..frame.len() {
+                if (self.taken + j).is_multiple_of(every) {
+                    let (u, v) = floor_state(j);
+                    series.floors.extend_from_slice(&floors[j * width..(j + 1) * width]);
+                    series.floors.extend(s.accelerations(u, v));
+                }
+            }
+        }
         if self.series.as_ref().is_some_and(|s| s.every > 1) {
             for (j, &(xs, vs)) in frame.iter().enumerate() {
                 let ts = time(j);
-                self.sample(scene, ts, xs, vs, |i| paths[i].at(ts, xs, vs));
+                match structure {
+                    None => self.sample(scene, ts, xs, vs, |i| paths[i].at(ts, xs, vs)),
+                    Some(s) => {
+                        let (u, v) = floor_state(j);
+                        let energy = s.energy(u, v, 0.0);
+                        let ball = |i: usize| in_ground_frame(j, &paths[i], paths[i].at(ts, xs, vs));
+                        self.sample_with(ts, xs, vs, structure_acceleration(j), |_, _, _| energy, ball);
+                    }
+                }
             }
             return;
         }
@@ -358,12 +466,16 @@ impl Recorder {
         let mut accelerations = std::mem::take(&mut self.accelerations);
         accelerations.clear();
         match (scene.frame, scene.forcing) {
+            _ if structure.is_some() => accelerations.extend((0..count).map(structure_acceleration)),
             // Free vibration: the acceleration needs no time (a loop the compiler vectorises).
             (Some(f), None) => accelerations.extend(frame.iter().map(|&(xs, vs)| f.acceleration(xs, vs))),
             _ => accelerations.extend(frame.iter().enumerate().map(|(j, &(xs, vs))| scene.frame_acceleration(time(j), xs, vs))),
         }
         if let Some(s) = &mut self.series {
             s.write_interval(first, dt, frame, &accelerations, paths);
+            if !ground.is_empty() {
+                s.shift_free_balls(count, ground, paths);
+            }
         }
         if let Some(tally) = &mut self.tally {
             let wants_energy = tally.wants_energy();
@@ -382,12 +494,19 @@ impl Recorder {
             };
             let all_free = paths.iter().all(|p| matches!(p, BallPath::Free { .. }));
             let free_kinetic = if wants_energy && all_free { kinetic(0.0) } else { 0.0 };
+            let frame_energy = |j: usize, ts: f64, xs: f64, vs: f64| match structure {
+                None => scene.frame_energy(ts, xs, vs),
+                Some(s) => {
+                    let (u, v) = floor_state(j);
+                    s.energy(u, v, 0.0)
+                }
+            };
             for (j, (&(xs, vs), &a)) in frame.iter().zip(&accelerations).enumerate() {
                 let ts = time(j);
                 let energy = match (wants_energy, all_free) {
                     (false, _) => 0.0,
-                    (true, true) => scene.frame_energy(ts, xs, vs) + free_kinetic,
-                    (true, false) => scene.frame_energy(ts, xs, vs) + kinetic(vs),
+                    (true, true) => frame_energy(j, ts, xs, vs) + free_kinetic,
+                    (true, false) => frame_energy(j, ts, xs, vs) + kinetic(vs),
                 };
                 tally.add(ts, xs, a, energy);
             }

@@ -60,7 +60,7 @@ impl SampleTally {
             from: scene.frame.map_or(0.0, |f| f.damped_period()),
             band: SETTLING_FRACTION * scene.initial_displacement.abs(),
             // Energy only falls in free vibration: a forced run has no dissipation time.
-            initial_energy: if scene.forcing.is_none() && initial_energy > 0.0 { initial_energy } else { 0.0 },
+            initial_energy: if !scene.is_driven() && initial_energy > 0.0 { initial_energy } else { 0.0 },
             ..Default::default()
         }
     }

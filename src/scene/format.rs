@@ -13,6 +13,8 @@ pub struct SceneFile {
     pub name: Option<String>,
     /// The primary structure.
     pub frame: Option<FrameFile>,
+    /// A primary structure of several storeys, instead of `[frame]`.
+    pub structure: Option<StructureFile>,
     /// The damper's balls and container.
     pub balls: Option<BallsFile>,
     /// Run settings.
@@ -180,6 +182,26 @@ pub struct FrameFile {
     pub initial_displacement: Length,
 }
 
+/// `[structure]`: a shear building of several storeys (docs/MODEL.md §16).
+#[derive(Debug, Clone, Deserialize, Serialize)]
+#[serde(deny_unknown_fields)]
+pub struct StructureFile {
+    /// Floor masses, bottom to top, kg.
+    pub masses: Vec<f64>,
+    /// Storey stiffnesses, bottom to top (storey `i` joins floor `i - 1` to floor `i`), N/m.
+    pub stiffnesses: Vec<f64>,
+    /// Rayleigh damping `C = a0 M + a1 K`, as `[a0, a1]`.
+    pub rayleigh: Option<[f64; 2]>,
+    /// Damping ratios of the undamped modes, lowest first (instead of `rayleigh`).
+    pub damping_ratios: Option<Vec<f64>>,
+    /// Each floor's initial displacement relative to the ground, m (default 0).
+    pub initial_displacements: Option<Vec<f64>>,
+    /// Each floor's initial velocity relative to the ground, m/s (default 0).
+    pub initial_velocities: Option<Vec<f64>>,
+    /// The floor that carries the container, 1 at the bottom (default the top floor).
+    pub damper_floor: Option<u32>,
+}
+
 /// `[balls]`: the balls in the container and the container geometry.
 #[derive(Debug, Clone, Deserialize, Serialize)]
 #[serde(deny_unknown_fields)]
@@ -273,16 +295,43 @@ pub enum ForcingKind {
     Base,
 }
 
-/// `[forcing]`: harmonic excitation of the frame.
-#[derive(Debug, Clone, Deserialize, Serialize)]
+/// What drives the structure: a sine ([`ForcingKind`]) or a ground-motion record.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize, Serialize, Default)]
+#[serde(rename_all = "lowercase")]
+pub enum ExcitationKind {
+    /// A sine force on the frame.
+    #[default]
+    Force,
+    /// A sine motion of the ground.
+    Base,
+    /// The ground accelerates as a record read from `file` (docs/MODEL.md §17).
+    Record,
+}
+
+impl From<ForcingKind> for ExcitationKind {
+    fn from(k: ForcingKind) -> Self {
+        match k {
+            ForcingKind::Force => ExcitationKind::Force,
+            ForcingKind::Base => ExcitationKind::Base,
+        }
+    }
+}
+
+/// `[forcing]`: harmonic excitation of the frame, or a ground-motion record.
+#[derive(Debug, Clone, Deserialize, Serialize, Default)]
 #[serde(deny_unknown_fields)]
 pub struct ForcingFile {
-    /// `"force"` or `"base"`.
-    pub kind: ForcingKind,
+    /// `"force"`, `"base"` or `"record"`.
+    pub kind: ExcitationKind,
     /// `F0` in N (force) or `Y` in m (base).
-    pub amplitude: f64,
+    pub amplitude: Option<f64>,
     /// Forcing frequency, Hz.
-    pub frequency: f64,
+    pub frequency: Option<f64>,
+    /// A record's file (relative to the scene file): two columns of time (s) and ground
+    /// acceleration (m/s^2) separated by a comma or spaces, or a PEER `.AT2` file.
+    pub file: Option<String>,
+    /// A factor on the record's accelerations (default 1).
+    pub scale: Option<f64>,
 }
 
 /// `[sweep]`: one parameter and its values.

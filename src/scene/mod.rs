@@ -8,6 +8,7 @@ mod geometry;
 mod overrides;
 mod parameters;
 mod placement;
+pub mod record;
 mod rules;
 mod settings;
 mod space;
@@ -22,10 +23,11 @@ pub use geometry::{ball_radius, pair_bodies, pair_gap, pair_range, Ball, BallKin
 pub use overrides::{with_settings_of, Overrides};
 pub use parameters::{Parameter, Tolerances};
 pub use placement::MAX_BED_BALLS;
+pub use record::GroundRecord;
 pub use rules::{from_file, validate_sample_dt};
 pub use settings::{CompliantSettings, RapierSettings, DEFAULT_COMPLIANT_TOLERANCE};
 pub use space::Space;
-pub use structure::Frame;
+pub use structure::{Frame, Structure};
 
 /// Default simulated time, s (docs/MODEL.md §8).
 pub const DEFAULT_HORIZON: f64 = 5.0;
@@ -100,6 +102,9 @@ pub struct Scene {
     pub reference_radius: f64,
     /// The chains, the balls' places across the motion, gravity and friction.
     pub space: Space,
+    /// A structure of several storeys or a ground-motion record, which `frame` alone cannot
+    /// describe; `None` for a frame in free vibration or under a sine.
+    pub structure: Option<std::sync::Arc<Structure>>,
 }
 
 impl Scene {
@@ -110,9 +115,18 @@ impl Scene {
         ((self.horizon / self.sample_dt * (1.0 + 1e-12)).floor() as usize).saturating_add(1)
     }
 
+    /// Whether something drives the structure (a sine or a moving ground): then energy is put
+    /// in, and dissipation times mean nothing.
+    pub fn is_driven(&self) -> bool {
+        self.forcing.is_some() || self.structure.as_ref().is_some_and(|s| s.ground.is_some())
+    }
+
     /// Initial mechanical energy: spring energy plus balls' kinetic energy.
     pub fn initial_energy(&self) -> f64 {
-        let spring = self.frame.map_or(0.0, |f| f.energy(self.initial_displacement, 0.0));
+        let spring = match &self.structure {
+            Some(s) => s.energy(&s.initial_displacements, &s.initial_velocities, 0.0),
+            None => self.frame.map_or(0.0, |f| f.energy(self.initial_displacement, 0.0)),
+        };
         let across: f64 = (0..self.balls.len())
             .map(|i| {
                 let [vy, vz] = self.space.lateral_velocity_of(i);
@@ -135,8 +149,20 @@ impl Scene {
             });
             (osc.w0sq.sqrt() * self.initial_displacement.abs()).max(forced)
         });
+        // A structure: the carrying floor's speed with all the structure's energy, and a
+        // record's fastest ground velocity plus the response of a fundamental-period
+        // oscillator to its peak acceleration.
+        let structure = self.structure.as_ref().map_or(0.0, |s| {
+            let own = (2.0 * s.energy(&s.initial_displacements, &s.initial_velocities, 0.0) / s.building.masses[s.floor]).sqrt();
+            let ground = s.ground.as_ref().map_or(0.0, |g| {
+                let fastest = g.ground.iter().fold(0.0, |m: f64, (_, v)| m.max(v.abs()));
+                let (omegas, _) = s.building.undamped_modes();
+                fastest + g.peak() / omegas[0]
+            });
+            own + ground
+        });
         let across = self.space.lateral_velocities.iter().fold(0.0, |m: f64, [vy, vz]| m.max(vy.hypot(*vz)));
-        self.initial_velocities.iter().fold(frame.max(across), |m: f64, v| m.max(v.abs()))
+        self.initial_velocities.iter().fold(frame.max(across).max(structure), |m: f64, v| m.max(v.abs()))
     }
 
     /// The scene's length scale, m: the container's length (or a free chain's span), the

@@ -79,9 +79,10 @@ impl Overrides {
             (true, Some(frame)) => {
                 let old = scene.forcing;
                 let g = format::ForcingFile {
-                    kind: self.forcing_kind.or(old.map(|g| g.kind)).unwrap_or(ForcingKind::Force),
-                    amplitude: self.forcing_amplitude.or(old.map(|g| g.amplitude)).unwrap_or(0.0),
-                    frequency: self.forcing_frequency.or(old.map(|g| g.frequency)).unwrap_or(1.0),
+                    kind: self.forcing_kind.or(old.map(|g| g.kind)).unwrap_or(ForcingKind::Force).into(),
+                    amplitude: Some(self.forcing_amplitude.or(old.map(|g| g.amplitude)).unwrap_or(0.0)),
+                    frequency: Some(self.forcing_frequency.or(old.map(|g| g.frequency)).unwrap_or(1.0)),
+                    ..Default::default()
                 };
                 Some(forcing(&g, &frame, &v)?)
             }
@@ -112,7 +113,16 @@ pub fn with_settings_of(file: &SceneFile, scene: &Scene) -> SceneFile {
             poisson_ratio: Some(scene.compliant.poisson_ratio),
             tolerance: Some(scene.compliant.tolerance),
         },
-        forcing: scene.forcing.map(|g| format::ForcingFile { kind: g.kind, amplitude: g.amplitude, frequency: g.frequency }),
+        // A record stays as the file gives it (the scene keeps it with its structure).
+        forcing: match scene.forcing {
+            Some(g) => Some(format::ForcingFile {
+                kind: g.kind.into(),
+                amplitude: Some(g.amplitude),
+                frequency: Some(g.frequency),
+                ..Default::default()
+            }),
+            None => file.forcing.clone().filter(|g| g.kind == format::ExcitationKind::Record),
+        },
         ..file.clone()
     }
 }

@@ -140,9 +140,9 @@ impl Parameter {
                 let x = number()?;
                 let g = f.forcing.as_mut().ok_or("needs a [forcing] table")?;
                 if self == Parameter::ForcingAmplitude {
-                    g.amplitude = x;
+                    g.amplitude = Some(x);
                 } else {
-                    g.frequency = x;
+                    g.frequency = Some(x);
                 }
             }
             Parameter::Clearance

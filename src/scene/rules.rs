@@ -4,12 +4,16 @@
 
 use super::excitation::Forcing;
 use super::format::{self, Arrangement, Length, SceneFile};
+use super::format::{ExcitationKind, ForcingKind};
 use super::geometry::{ball_radius, Ball, BallKind, Container};
 use super::parameters::{Parameter, Tolerances};
+use super::record::{read_points, GroundRecord};
 use super::settings::{CompliantSettings, RapierSettings};
 use super::space::Space;
-use super::structure::Frame;
+use super::structure::{Frame, Structure};
 use super::{human, ChainCase, Loaded, Scene, SceneError, CHAIN_HORIZON, DEFAULT_HORIZON, DEFAULT_SAMPLE_DT, MAX_SAMPLES};
+use crate::storeys::{Building, StoreyDamping};
+use std::sync::Arc;
 
 /// Validates an already parsed file.
 pub fn from_file(parsed: SceneFile, file: &str, default_name: &str) -> Result<Loaded, SceneError> {
@@ -18,10 +22,13 @@ pub fn from_file(parsed: SceneFile, file: &str, default_name: &str) -> Result<Lo
     if parsed.chain.is_some() && (parsed.frame.is_some() || parsed.balls.is_some()) {
         return Err(v.err("chain", "cannot be combined with [frame] or [balls]: a chain file describes only the KER experiment"));
     }
-    let scene = match (&parsed.frame, &parsed.chain) {
-        (Some(_), _) => Some(build_damper(&parsed, &name, &v)?),
-        (None, None) => return Err(v.err("frame", "is missing: a scene needs a [frame] table (or a [chain] table)")),
-        (None, Some(_)) => None,
+    if parsed.chain.is_some() && parsed.structure.is_some() {
+        return Err(v.err("chain", "cannot be combined with [structure]: a chain file describes only the KER experiment"));
+    }
+    let scene = match (parsed.frame.is_some() || parsed.structure.is_some(), &parsed.chain) {
+        (true, _) => Some(build_damper(&parsed, &name, &v)?),
+        (false, None) => return Err(v.err("frame", "is missing: a scene needs a [frame] table (or [structure], or [chain])")),
+        (false, Some(_)) => None,
     };
     let chain = match &parsed.chain {
         Some(c) => Some(build_chain(c, &parsed.run, &name, &v)?),
@@ -137,6 +144,131 @@ pub fn validate_sample_dt(horizon: f64, dt: f64) -> Result<(), String> {
 }
 
 pub(super) fn build_damper(f: &SceneFile, name: &str, v: &Validator) -> Result<Scene, SceneError> {
+    let record = match &f.forcing {
+        Some(g) if g.kind == ExcitationKind::Record => Some(Arc::new(ground_record(g, v)?)),
+        _ => None,
+    };
+    let Some(st) = &f.structure else {
+        let Some(record) = record else { return build_frame_damper(f, name, v) };
+        // A frame under a record: a structure of one storey.
+        let plain = SceneFile { forcing: None, ..f.clone() };
+        let mut scene = build_frame_damper(&plain, name, v)?;
+        let fr = scene.frame.expect("a damper scene has a frame");
+        if fr.stiffness <= 0.0 {
+            return Err(v.err("frame.stiffness", "must be positive under a ground-motion record (the frame must stand on the ground)"));
+        }
+        let mut building = Building::new(vec![fr.mass], vec![fr.stiffness], &StoreyDamping::Rayleigh { mass: 0.0, stiffness: 0.0 });
+        building.damping[(0, 0)] = fr.damping;
+        scene.structure = Some(Arc::new(Structure {
+            building,
+            floor: 0,
+            initial_displacements: vec![scene.initial_displacement],
+            initial_velocities: vec![0.0],
+            ground: Some(record),
+        }));
+        return Ok(scene);
+    };
+    if f.frame.is_some() {
+        return Err(v.err("structure", "cannot be combined with [frame]: give the primary structure one way"));
+    }
+    let structure = structure(st, record, v)?;
+    if structure.floors() > 1 && f.forcing.as_ref().is_some_and(|g| g.kind != ExcitationKind::Record) {
+        return Err(v.err("forcing.kind", "a sine on a structure of several storeys is not supported yet: give a record"));
+    }
+    let d = structure.floor;
+    let b = &structure.building;
+    // The carrying floor seen alone: its mass takes the balls' impulses, and its spring gives
+    // it the structure's fundamental period (the scale of periods, speeds and peaks).
+    let (omegas, _) = b.undamped_modes();
+    let frame = format::FrameFile {
+        mass: b.masses[d],
+        stiffness: if b.floors() == 1 { b.stiffnesses[0] } else { b.masses[d] * omegas[0] * omegas[0] },
+        damping: b.damping[(d, d)],
+        initial_displacement: Length::Metres(structure.initial_displacements[d]),
+    };
+    let forcing = if structure.ground.is_some() { None } else { f.forcing.clone() };
+    let plain = SceneFile { structure: None, frame: Some(frame), forcing, ..f.clone() };
+    let mut scene = build_frame_damper(&plain, name, v)?;
+    let one_storey_at_rest = structure.floors() == 1 && structure.ground.is_none() && structure.initial_velocities[0] == 0.0;
+    if !one_storey_at_rest {
+        scene.structure = Some(Arc::new(structure));
+    }
+    Ok(scene)
+}
+
+/// The `[structure]` table, checked.
+fn structure(st: &format::StructureFile, ground: Option<Arc<GroundRecord>>, v: &Validator) -> Result<Structure, SceneError> {
+    let n = st.masses.len();
+    if n == 0 {
+        return Err(v.err("structure.masses", "is empty: give each floor's mass"));
+    }
+    if st.stiffnesses.len() != n {
+        return Err(v.err("structure.stiffnesses", &format!("has {} values for {n} floors: give one per storey", st.stiffnesses.len())));
+    }
+    for i in 0..n {
+        v.positive(&format!("structure.masses[{i}]"), st.masses[i])?;
+        v.positive(&format!("structure.stiffnesses[{i}]"), st.stiffnesses[i])?;
+    }
+    let per_floor = |field: &str, values: &Option<Vec<f64>>| -> Result<Vec<f64>, SceneError> {
+        let Some(values) = values else { return Ok(vec![0.0; n]) };
+        if values.len() != n {
+            return Err(v.err(field, &format!("has {} values for {n} floors: give one per floor", values.len())));
+        }
+        for (i, &x) in values.iter().enumerate() {
+            v.finite(&format!("{field}[{i}]"), x)?;
+        }
+        Ok(values.clone())
+    };
+    let initial_displacements = per_floor("structure.initial_displacements", &st.initial_displacements)?;
+    let initial_velocities = per_floor("structure.initial_velocities", &st.initial_velocities)?;
+    let damping = match (&st.rayleigh, &st.damping_ratios) {
+        (Some(_), Some(_)) => return Err(v.err("structure.damping_ratios", "cannot be combined with `rayleigh`: give the damping one way")),
+        (Some([a0, a1]), None) => StoreyDamping::Rayleigh {
+            mass: v.non_negative("structure.rayleigh[0]", *a0)?,
+            stiffness: v.non_negative("structure.rayleigh[1]", *a1)?,
+        },
+        (None, Some(ratios)) => {
+            if ratios.len() != n {
+                return Err(v.err("structure.damping_ratios", &format!("has {} values for {n} modes: give one per mode", ratios.len())));
+            }
+            for (i, &z) in ratios.iter().enumerate() {
+                let field = format!("structure.damping_ratios[{i}]");
+                if !(v.non_negative(&field, z)? < 1.0) {
+                    return Err(
+                        v.err(&field, &format!("must be below 1: an overdamped mode is not a mode of vibration (got {})", human(z)))
+                    );
+                }
+            }
+            StoreyDamping::Modal(ratios.clone())
+        }
+        (None, None) => StoreyDamping::Rayleigh { mass: 0.0, stiffness: 0.0 },
+    };
+    let floor = match st.damper_floor {
+        None => n - 1,
+        Some(k) if (1..=n as u32).contains(&k) => k as usize - 1,
+        Some(k) => return Err(v.err("structure.damper_floor", &format!("must name a floor from 1 (bottom) to {n} (got {k})"))),
+    };
+    let building = Building::new(st.masses.clone(), st.stiffnesses.clone(), &damping);
+    building.modes(floor, 0.0).map_err(|why| v.err("structure", &why))?;
+    Ok(Structure { building, floor, initial_displacements, initial_velocities, ground })
+}
+
+/// The record a `[forcing]` of kind `record` names, read and scaled.
+fn ground_record(g: &format::ForcingFile, v: &Validator) -> Result<GroundRecord, SceneError> {
+    for (field, given) in [("forcing.amplitude", g.amplitude.is_some()), ("forcing.frequency", g.frequency.is_some())] {
+        if given {
+            return Err(v.err(field, "belongs to a sine, not to a record (which gives its own accelerations)"));
+        }
+    }
+    let file = g.file.as_ref().ok_or_else(|| v.err("forcing.file", "is missing: a record needs its file"))?;
+    let scale = v.finite("forcing.scale", g.scale.unwrap_or(1.0))?;
+    let path = std::path::Path::new(v.file).parent().unwrap_or(std::path::Path::new("")).join(file);
+    let text = std::fs::read_to_string(&path).map_err(|e| v.err("forcing.file", &format!("cannot be read ({}): {e}", path.display())))?;
+    let (times, accel) = read_points(&text).map_err(|why| v.err("forcing.file", &format!("({}) {why}", path.display())))?;
+    Ok(GroundRecord::new(times, accel, scale))
+}
+
+fn build_frame_damper(f: &SceneFile, name: &str, v: &Validator) -> Result<Scene, SceneError> {
     let fr = f.frame.as_ref().expect("checked by caller");
     let frame = Frame {
         mass: v.positive("frame.mass", fr.mass)?,
@@ -187,6 +319,7 @@ pub(super) fn build_damper(f: &SceneFile, name: &str, v: &Validator) -> Result<S
             forcing,
             reference_radius: 0.0,
             space: Space::line(0),
+            structure: None,
         });
     };
     if world.restitution.is_some() {
@@ -254,6 +387,7 @@ pub(super) fn build_damper(f: &SceneFile, name: &str, v: &Validator) -> Result<S
         compliant,
         forcing,
         reference_radius: rr,
+        structure: None,
     })
 }
 
@@ -431,6 +565,7 @@ fn placed_damper(f: &SceneFile, name: &str, v: &Validator, frame: Frame, world: 
         forcing: s.forcing,
         reference_radius: largest,
         space,
+        structure: None,
     })
 }
 
@@ -449,9 +584,20 @@ pub(super) fn compliant_settings(c: &format::CompliantFile, v: &Validator) -> Re
 }
 
 pub(super) fn forcing(g: &format::ForcingFile, frame: &Frame, v: &Validator) -> Result<Forcing, SceneError> {
-    let amplitude = v.non_negative("forcing.amplitude", g.amplitude)?;
-    let frequency = v.positive("forcing.frequency", g.frequency)?;
-    let forcing = Forcing { kind: g.kind, amplitude, frequency };
+    for (field, given) in [("forcing.file", g.file.is_some()), ("forcing.scale", g.scale.is_some())] {
+        if given {
+            return Err(v.err(field, "belongs to a record (`kind = \"record\"`), not to a sine"));
+        }
+    }
+    let missing = |field: &str| v.err(field, "is missing: a sine needs its amplitude and frequency");
+    let amplitude = v.non_negative("forcing.amplitude", g.amplitude.ok_or_else(|| missing("forcing.amplitude"))?)?;
+    let frequency = v.positive("forcing.frequency", g.frequency.ok_or_else(|| missing("forcing.frequency"))?)?;
+    let kind = match g.kind {
+        ExcitationKind::Force => ForcingKind::Force,
+        ExcitationKind::Base => ForcingKind::Base,
+        ExcitationKind::Record => return Err(v.err("forcing.kind", "is a record, which is not a sine")),
+    };
+    let forcing = Forcing { kind, amplitude, frequency };
     // An undamped frame driven exactly at resonance has no bounded particular solution.
     if frame.resonance_without_steady_state(frequency, frequency).is_some() {
         return Err(v.err(
@@ -587,6 +733,7 @@ pub(super) fn build_chain(c: &format::ChainFile, run: &format::RunFile, name: &s
                     forcing: None,
                     reference_radius: rr,
                     space: Space::line(balls_len),
+                    structure: None,
                 },
             });
         }

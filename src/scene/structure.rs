@@ -48,3 +48,42 @@ impl Frame {
         self.damped_omega().map_or(0.0, |w| 2.0 * PI / w)
     }
 }
+
+/// A primary structure of several storeys, or one storey under a ground-motion record: what
+/// the closed form of [`crate::storeys`] moves (docs/MODEL.md §16-17). A scene's `frame` is
+/// then its carrying floor's mass, which takes the balls' impulses, on a spring that gives it
+/// the structure's fundamental period.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Structure {
+    /// Floors, storeys and damping.
+    pub building: Building,
+    /// The floor that carries the container, 0 at the bottom.
+    pub floor: usize,
+    /// Each floor's initial displacement relative to the ground, m.
+    pub initial_displacements: Vec<f64>,
+    /// Each floor's initial velocity relative to the ground, m/s.
+    pub initial_velocities: Vec<f64>,
+    /// The ground's acceleration, when it moves.
+    pub ground: Option<std::sync::Arc<GroundRecord>>,
+}
+
+impl Structure {
+    /// Number of floors.
+    pub fn floors(&self) -> usize {
+        self.building.floors()
+    }
+    /// The floors' mechanical energy with the floors at `u` relative to the ground and moving
+    /// at `v` relative to it, the ground at velocity `vg`: kinetic energy in the ground's
+    /// inertial frame, `sum m (v + vg)^2 / 2`, plus the springs' `u^T K u / 2`, J.
+    pub fn energy(&self, u: &[f64], v: &[f64], vg: f64) -> f64 {
+        let kinetic: f64 = self.building.masses.iter().zip(v).map(|(m, v)| 0.5 * m * (v + vg) * (v + vg)).sum();
+        kinetic + self.building.spring_energy(u)
+    }
+    /// The floors' absolute accelerations without impulses, `-M^-1 (C v + K u)`, m/s^2.
+    pub fn accelerations(&self, u: &[f64], v: &[f64]) -> Vec<f64> {
+        self.building.restoring_forces(u, v).iter().zip(&self.building.masses).map(|(f, m)| f / m).collect()
+    }
+}
+
+use super::record::GroundRecord;
+use crate::storeys::Building;

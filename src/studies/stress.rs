@@ -199,7 +199,7 @@ pub fn random_scene_file(seed: u64, max_horizon: f64, forced: bool) -> SceneFile
             ForcingKind::Force => x * dynamic,
             ForcingKind::Base => x * dynamic / stiffness.hypot(damping * w),
         };
-        ForcingFile { kind, amplitude, frequency }
+        ForcingFile { kind: kind.into(), amplitude: Some(amplitude), frequency: Some(frequency), ..Default::default() }
     });
     SceneFile {
         name: Some(format!("stress-{seed}")),

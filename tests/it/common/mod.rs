@@ -92,6 +92,7 @@ pub fn damper(frame: Frame, xs0: f64, masses: &[f64], e: f64, gap: f64, clearanc
         rapier: RapierSettings::default(),
         compliant: Default::default(),
         forcing: None,
+        structure: None,
     }
 }
 
@@ -118,6 +119,7 @@ pub fn free_chain(balls: Vec<Ball>, gaps: &[f64], speeds: &[f64], e: f64, horizo
         rapier: RapierSettings::default(),
         compliant: Default::default(),
         forcing: None,
+        structure: None,
     }
 }
 

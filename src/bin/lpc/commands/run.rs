@@ -72,7 +72,12 @@ pub fn run(a: Args) -> Result<ExitStatus> {
         );
     }
     let run = crate::watch::watched(a.model, &scene, RunOptions::limited(limits), a.out.as_deref())?;
-    let summary = RunSummary::of(&run);
+    let mut summary = RunSummary::of(&run);
+    if scene.structure.is_some() && !scene.balls.is_empty() {
+        // The structure alone, for the floors' response without the damper.
+        let bare = a.model.simulate(&scene.without_damper(), &RunOptions::limited(limits))?;
+        summary.floors_without_damper = lpc_damper::metrics::FloorSummary::of(&bare.series);
+    }
     if let Some(dir) = &a.out {
         write_run_dir(&run, dir).with_context(|| format!("writing outputs to {}", dir.display()))?;
     }
