@@ -30,3 +30,4 @@ mod spatial_reference;
 mod stability_map;
 mod sticking;
 mod stress;
+mod structures;

@@ -1,0 +1,239 @@
+//! Structures of several storeys and ground-motion records (docs/MODEL.md §16-17): the
+//! reference's floors against an independent solution, a one-storey structure against the
+//! frame it is, and the rules a structure's scene keeps.
+
+use lpc_damper::model::{Model, RunOptions};
+use lpc_damper::run::Run;
+use lpc_damper::scene::Scene;
+use nalgebra::{DMatrix, DVector};
+
+use crate::common::{lpc_command, LSL_TOML};
+
+/// A three-storey building (Rayleigh damping) without a damper, shaken by `record`.
+fn building_text(record: &str) -> String {
+    format!(
+        r#"
+name = "building"
+[structure]
+masses = [2.0, 1.6, 1.35]
+stiffnesses = [3000.0, 2400.0, 865.0]
+rayleigh = [0.4, 0.002]
+initial_displacements = [0.001, -0.002, 0.004]
+initial_velocities = [0.0, 0.05, -0.02]
+[forcing]
+kind = "record"
+file = "{record}"
+scale = 2.0
+[run]
+horizon = 3.0
+sample_dt = 0.01
+"#
+    )
+}
+
+/// Writes `text` as `scene.toml` beside a record of `points` and loads it.
+fn scene_with_record(text: impl Fn(&str) -> String, points: &[(f64, f64)]) -> (tempfile::TempDir, Scene) {
+    let dir = tempfile::tempdir().unwrap();
+    let record: String = points.iter().map(|(t, a)| format!("{t} {a}\n")).collect();
+    std::fs::write(dir.path().join("quake.txt"), record).unwrap();
+    let file = dir.path().join("scene.toml");
+    std::fs::write(&file, text("quake.txt")).unwrap();
+    let scene = lpc_damper::scene::load_scene(&file).unwrap();
+    (dir, scene)
+}
+
+fn reference(scene: &Scene) -> Run {
+    Model::Reference.simulate(scene, &RunOptions::default()).unwrap()
+}
+
+/// The state of the building of [`building_text`] advanced by the matrix exponential of the
+/// state matrix bordered by the ground's line (nalgebra's Pade approximant: nothing of the
+/// modal closed form), record point to record point.
+fn by_matrix_exponential(points: &[(f64, f64)], scale: f64, samples: &[f64]) -> Vec<Vec<f64>> {
+    let (m, k, a) = ([2.0, 1.6, 1.35], [3000.0, 2400.0, 865.0], [0.4, 0.002]);
+    let n = 3;
+    let kk = DMatrix::from_fn(n, n, |i, j| match (i, j) {
+        _ if i == j => k[i] + if i + 1 < n { k[i + 1] } else { 0.0 },
+        _ if j == i + 1 => -k[j],
+        _ if i == j + 1 => -k[i],
+        _ => 0.0,
+    });
+    let c = DMatrix::from_diagonal(&DVector::from_row_slice(&m)) * a[0] + &kk * a[1];
+    // Augmented state [u; u'; 1; s]: u'' = -M^-1 (C u' + K u) - (g0 + g1 s).
+    let step = |z: &DVector<f64>, g0: f64, g1: f64, h: f64| -> DVector<f64> {
+        let dim = 2 * n + 2;
+        let mut aug = DMatrix::<f64>::zeros(dim, dim);
+        for i in 0..n {
+            aug[(i, n + i)] = 1.0;
+            for j in 0..n {
+                aug[(n + i, j)] = -kk[(i, j)] / m[i];
+                aug[(n + i, n + j)] = -c[(i, j)] / m[i];
+            }
+            aug[(n + i, 2 * n)] = -g0;
+            aug[(n + i, 2 * n + 1)] = -g1;
+        }
+        aug[(2 * n + 1, 2 * n)] = 1.0;
+        let mut x = DVector::<f64>::zeros(dim);
+        x.rows_mut(0, 2 * n).copy_from(z);
+        x[2 * n] = 1.0;
+        ((aug * h).exp() * x).rows(0, 2 * n).into_owned()
+    };
+    let mut z = DVector::from_row_slice(&[0.001, -0.002, 0.004, 0.0, 0.05, -0.02]);
+    let mut t = 0.0;
+    let mut out = Vec::new();
+    let mut j = 0;
+    for &ts in samples {
+        // Advance to each record point before `ts`, then to `ts`.
+        loop {
+            let (g0, g1, end) = if j + 1 < points.len() {
+                let (t0, a0) = points[j];
+                let (t1, a1) = points[j + 1];
+                (scale * (a0 + (a1 - a0) / (t1 - t0) * (t - t0)), scale * (a1 - a0) / (t1 - t0), t1)
+            } else {
+                (0.0, 0.0, f64::INFINITY)
+            };
+            if end <= ts {
+                z = step(&z, g0, g1, end - t);
+                t = end;
+                j += 1;
+            } else {
+                z = step(&z, g0, g1, ts - t);
+                t = ts;
+                break;
+            }
+        }
+        out.push(z.iter().copied().collect());
+    }
+    out
+}
+
+/// The reference's floors under a piecewise-linear record agree with the matrix exponential
+/// to 1e-8 of the largest displacement and velocity (both are exact to round-off; what is left
+/// is the round-off of two different evaluations over a few hundred stretches).
+#[test]
+fn a_three_storey_building_under_a_record_is_the_matrix_exponential() {
+    let points: Vec<(f64, f64)> =
+        (0..=200).map(|j| (j as f64 * 0.01, (j as f64 * 0.37).sin() * (1.0 + 0.5 * (j as f64 * 0.05).cos()))).collect();
+    let (_dir, scene) = scene_with_record(building_text, &points);
+    let run = reference(&scene);
+    let s = &run.series;
+    assert_eq!(s.floor_count(), 3);
+    let times: Vec<f64> = s.t().to_vec();
+    let exact = by_matrix_exponential(&points, 2.0, &times);
+    let peak_u = exact.iter().flat_map(|z| z[..3].to_vec()).fold(0.0, |m: f64, x| m.max(x.abs()));
+    let peak_v = exact.iter().flat_map(|z| z[3..].to_vec()).fold(0.0, |m: f64, x| m.max(x.abs()));
+    for (k, z) in exact.iter().enumerate() {
+        for i in 0..3 {
+            let (u, v, _) = s.floor(i, k).unwrap();
+            assert!((u - z[i]).abs() <= 1e-8 * peak_u, "floor {} at {} s: u {u} vs {}", i + 1, times[k], z[i]);
+            assert!((v - z[3 + i]).abs() <= 1e-8 * peak_v, "floor {} at {} s: v {v} vs {}", i + 1, times[k], z[3 + i]);
+        }
+    }
+    // The energy balance closes with the ground's work.
+    let e = &run.energy;
+    assert!(e.balance_error.abs() <= 1e-9, "{e:?}");
+}
+
+/// A `[structure]` of one storey at rest is the `[frame]` it describes: the same scene, and the
+/// same run to the bit.
+#[test]
+fn a_one_storey_structure_is_its_frame_to_the_bit() {
+    let frame = crate::common::scene_from_toml(&LSL_TOML.replace("damping = 1.092", "damping = 1.35"));
+    let storey = LSL_TOML.replace(
+        "[frame]\nmass = 1.35\nstiffness = 865.0\ndamping = 1.092\ninitial_displacement = 0.0185",
+        "[structure]\nmasses = [1.35]\nstiffnesses = [865.0]\nrayleigh = [1.0, 0.0]\ninitial_displacements = [0.0185]",
+    );
+    let structure = crate::common::scene_from_toml(&storey);
+    assert_eq!(structure, frame);
+    let (a, b) = (reference(&frame), reference(&structure));
+    assert_eq!(a.series, b.series);
+    assert_eq!(a.impacts, b.impacts);
+}
+
+/// The LSL damper on the top floor of a building whose lower storeys are far stiffer than the
+/// top one moves as on the paper's frame: its early impacts come at the frame's times, to the
+/// relative flexibility of the lower storeys.
+#[test]
+fn a_damper_on_a_floor_whose_storeys_below_are_stiff_moves_as_on_a_frame() {
+    let frame = crate::common::scene_from_toml(&LSL_TOML.replace("horizon = 5.0", "horizon = 0.5"));
+    let stiff = 865.0e4;
+    // The top storey's stiffness-proportional damping is the frame's 1.092 N s/m.
+    let storeys = LSL_TOML.replace("horizon = 5.0", "horizon = 0.5").replace(
+        "[frame]\nmass = 1.35\nstiffness = 865.0\ndamping = 1.092\ninitial_displacement = 0.0185",
+        &format!(
+            "[structure]\nmasses = [1.35, 1.35]\nstiffnesses = [{stiff}, 865.0]\nrayleigh = [0.0, 0.0012624]\ninitial_displacements = [{}, 0.0185]",
+            0.0185 * 865.0 / stiff
+        ),
+    );
+    let building = crate::common::scene_from_toml(&storeys);
+    let (a, b) = (reference(&frame), reference(&building));
+    assert!(a.impacts.len() >= 10 && b.impacts.len() >= 10);
+    // The lower storey stretches by 1e-4 of the top one: times agree to a few 1e-4 of the
+    // frame's period over the first impacts.
+    let period = frame.frame.unwrap().damped_period();
+    for (x, y) in a.impacts.iter().zip(&b.impacts).take(10) {
+        assert_eq!((x.a, x.b), (y.a, y.b));
+        assert!((x.t - y.t).abs() <= 1e-3 * period, "{} vs {}", x.t, y.t);
+    }
+}
+
+fn expect_error(text: &str, field: &str, words: &str) {
+    let dir = tempfile::tempdir().unwrap();
+    let file = dir.path().join("scene.toml");
+    std::fs::write(&file, text).unwrap();
+    let out = dir.path().join("out");
+    let o = lpc_command().arg("run").arg(&file).arg("--out").arg(&out).output().unwrap();
+    let stderr = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(2), "{field}: {stderr}");
+    assert!(stderr.contains(field) && stderr.to_lowercase().contains(words), "{field} / {words}: {stderr}");
+    assert!(!out.exists());
+}
+
+/// A structure's bad input names the field, exits 2 and writes nothing.
+#[test]
+fn a_structure_or_record_that_cannot_exist_is_refused() {
+    let base = building_text("missing.txt");
+    expect_error(&base, "forcing.file", "cannot be read");
+    let good = base.replace("kind = \"record\"\nfile = \"missing.txt\"\nscale = 2.0", "kind = \"force\"\namplitude = 1.0\nfrequency = 2.0");
+    expect_error(&good, "forcing.kind", "not supported yet");
+    let free = base.replace("[forcing]\nkind = \"record\"\nfile = \"missing.txt\"\nscale = 2.0\n", "");
+    expect_error(
+        &free.replace("stiffnesses = [3000.0, 2400.0, 865.0]", "stiffnesses = [3000.0, 865.0]"),
+        "structure.stiffnesses",
+        "one per storey",
+    );
+    expect_error(&free.replace("masses = [2.0, 1.6, 1.35]", "masses = [2.0, -1.6, 1.35]"), "structure.masses[1]", "positive");
+    expect_error(&free.replace("rayleigh = [0.4, 0.002]", "rayleigh = [0.4, 0.002]\ndamper_floor = 4"), "structure.damper_floor", "from 1");
+    expect_error(
+        &free.replace("rayleigh = [0.4, 0.002]", "rayleigh = [0.4, 0.002]\ndamping_ratios = [0.1, 0.1, 0.1]"),
+        "structure.damping_ratios",
+        "one way",
+    );
+    expect_error(&free.replace("rayleigh = [0.4, 0.002]", "damping_ratios = [0.1, 1.5, 0.1]"), "structure.damping_ratios[1]", "below 1");
+    expect_error(
+        &free.replace("initial_velocities = [0.0, 0.05, -0.02]", "initial_velocities = [0.0, nan, -0.02]"),
+        "structure.initial_velocities[1]",
+        "finite",
+    );
+    expect_error(&format!("{LSL_TOML}\n[structure]\nmasses = [1.0]\nstiffnesses = [1.0]\n"), "structure", "cannot be combined");
+    // A record whose times go back.
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::write(dir.path().join("bad.txt"), "0 0\n0.1 1\n0.05 2\n").unwrap();
+    let file = dir.path().join("scene.toml");
+    std::fs::write(&file, building_text("bad.txt")).unwrap();
+    let o = lpc_command().arg("run").arg(&file).output().unwrap();
+    let stderr = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(2), "{stderr}");
+    assert!(stderr.contains("forcing.file") && stderr.contains("must increase"), "{stderr}");
+}
+
+/// The models that move one storey say so, up front.
+#[test]
+fn models_that_cannot_move_a_structure_refuse_it() {
+    let scene = lpc_damper::scene::load_scene(lpc_damper::scene::scenes_dir().join("mdof-3storey.toml")).unwrap();
+    for model in [Model::Rapier, Model::Compliant] {
+        let why = model.supports(&scene).unwrap_err();
+        assert!(why.contains("reference"), "{why}");
+    }
+    assert!(Model::Reference.supports(&scene).is_ok());
+}
