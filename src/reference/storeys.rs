@@ -297,16 +297,31 @@ impl StoreyMotion {
         }
         let h = r.t - l.t;
         let curvature = p.bounds[order + 4];
-        let s = r.t - p.start;
+        yl.abs().min(yr.abs()) - self.roundoff(p, r.t, order) > curvature * (1.0 + ROUNDOFF_ULPS * f64::EPSILON) * h * h / 8.0
+    }
+
+    /// A bound on the round-off of the acceleration (`order` 0) or the jerk (`order` 1) of the
+    /// carrying floor evaluated at `t` on piece `p` (at most `t` into it).
+    fn roundoff(&self, p: &Piece, t: f64, order: usize) -> f64 {
+        let s = t - p.start;
         let line = if order == 0 { p.g0.abs() + p.g1.abs() * s } else { p.g1.abs() };
-        let err = ROUNDOFF_ULPS * f64::EPSILON * ((2.0 + self.modes.rate * s) * p.bounds[order + 2] + line);
-        yl.abs().min(yr.abs()) - err > curvature * (1.0 + ROUNDOFF_ULPS * f64::EPSILON) * h * h / 8.0
+        ROUNDOFF_ULPS * f64::EPSILON * ((2.0 + self.modes.rate * s) * p.bounds[order + 2] + line)
+    }
+
+    /// Whether the acceleration is round-off over all of `[l.t, r.t]`, so that its sign there
+    /// says nothing: both ends within their round-off `err`, and its curvature bound keeping it
+    /// within `2 err` in between (a floor starting from rest, whose acceleration grows as the
+    /// square of time). No sign change is taken there.
+    fn is_roundoff(&self, p: &Piece, l: &Probe, r: &Probe) -> bool {
+        let err = self.roundoff(p, r.t, 0);
+        let h = r.t - l.t;
+        l.a.abs() <= err && r.a.abs() <= err && p.bounds[4] * h * h / 8.0 <= err
     }
 
     /// The first sign change of the acceleration in `(l.t, r.t]`: depth-first over halves.
     fn first_sign_change(&self, p: &Piece, l: &Probe, r: &Probe) -> Option<f64> {
         let same_sign = (l.a > 0.0 && r.a > 0.0) || (l.a < 0.0 && r.a < 0.0);
-        if same_sign && self.holds(p, l, r, 0) {
+        if (same_sign && self.holds(p, l, r, 0)) || self.is_roundoff(p, l, r) {
             return None;
         }
         if !same_sign && l.a != 0.0 && r.a != 0.0 && self.holds(p, l, r, 1) {

@@ -6,6 +6,7 @@ mod balls_sliding_together;
 mod check_bad_scene_exit_status;
 mod closed_pipe;
 mod ensemble_without_tolerances;
+mod floor_starting_from_rest;
 mod forced_ball_through_wall;
 mod issue_14_touching_chain;
 mod loaded_contact_sinks;
