@@ -306,6 +306,9 @@ pub enum ExcitationKind {
     Base,
     /// The ground accelerates as a record read from `file` (docs/MODEL.md §17).
     Record,
+    /// The ground accelerates as Kanai-Tajimi filtered white noise drawn from `seed`
+    /// (docs/MODEL.md §17): each ensemble member draws its own.
+    Random,
 }
 
 impl From<ForcingKind> for ExcitationKind {
@@ -332,6 +335,22 @@ pub struct ForcingFile {
     pub file: Option<String>,
     /// A factor on the record's accelerations (default 1).
     pub scale: Option<f64>,
+    /// Random ground motion: the soil's frequency `fg`, Hz.
+    pub ground_frequency: Option<f64>,
+    /// Random ground motion: the soil's damping ratio `zeta_g`.
+    pub ground_damping: Option<f64>,
+    /// Random ground motion: the white noise's two-sided spectral density `S0`, m^2/s^3.
+    pub intensity: Option<f64>,
+    /// Random ground motion: how long the ground shakes, s.
+    pub duration: Option<f64>,
+    /// Random ground motion: the step between its points, s (default 0.01).
+    pub step: Option<f64>,
+    /// Random ground motion: an envelope `[rise, strong, decay]`, rising as `(t / rise)^2` to
+    /// 1, holding to `strong` s, then decaying as `exp(-decay (t - strong))` (none: 1).
+    pub envelope: Option<[f64; 3]>,
+    /// Random ground motion: the seed of its noise (default 1; an ensemble's members draw
+    /// their own).
+    pub seed: Option<u64>,
 }
 
 /// `[sweep]`: one parameter and its values.

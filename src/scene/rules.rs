@@ -7,7 +7,7 @@ use super::format::{self, Arrangement, Length, SceneFile};
 use super::format::{ExcitationKind, ForcingKind};
 use super::geometry::{ball_radius, Ball, BallKind, Container};
 use super::parameters::{Parameter, Tolerances};
-use super::record::{read_points, GroundRecord};
+use super::record::{read_points, GroundRecord, KanaiTajimi};
 use super::settings::{CompliantSettings, RapierSettings};
 use super::space::Space;
 use super::structure::{Frame, Structure};
@@ -146,6 +146,7 @@ pub fn validate_sample_dt(horizon: f64, dt: f64) -> Result<(), String> {
 pub(super) fn build_damper(f: &SceneFile, name: &str, v: &Validator) -> Result<Scene, SceneError> {
     let record = match &f.forcing {
         Some(g) if g.kind == ExcitationKind::Record => Some(Arc::new(ground_record(g, v)?)),
+        Some(g) if g.kind == ExcitationKind::Random => Some(Arc::new(random_ground(g, v)?.record(g.seed.unwrap_or(1)))),
         _ => None,
     };
     let Some(st) = &f.structure else {
@@ -172,7 +173,7 @@ pub(super) fn build_damper(f: &SceneFile, name: &str, v: &Validator) -> Result<S
         return Err(v.err("structure", "cannot be combined with [frame]: give the primary structure one way"));
     }
     let structure = structure(st, record, v)?;
-    if structure.floors() > 1 && f.forcing.as_ref().is_some_and(|g| g.kind != ExcitationKind::Record) {
+    if structure.floors() > 1 && f.forcing.as_ref().is_some_and(|g| matches!(g.kind, ExcitationKind::Force | ExcitationKind::Base)) {
         return Err(v.err("forcing.kind", "a sine on a structure of several storeys is not supported yet: give a record"));
     }
     let d = structure.floor;
@@ -253,13 +254,60 @@ fn structure(st: &format::StructureFile, ground: Option<Arc<GroundRecord>>, v: &
     Ok(Structure { building, floor, initial_displacements, initial_velocities, ground })
 }
 
+/// Refuses the keys of `[forcing]` that belong to another kind than `kind`.
+fn only_keys_of(g: &format::ForcingFile, kind: &str, keys: &[&str], v: &Validator) -> Result<(), SceneError> {
+    let given = [
+        ("amplitude", g.amplitude.is_some()),
+        ("frequency", g.frequency.is_some()),
+        ("file", g.file.is_some()),
+        ("scale", g.scale.is_some()),
+        ("ground_frequency", g.ground_frequency.is_some()),
+        ("ground_damping", g.ground_damping.is_some()),
+        ("intensity", g.intensity.is_some()),
+        ("duration", g.duration.is_some()),
+        ("step", g.step.is_some()),
+        ("envelope", g.envelope.is_some()),
+        ("seed", g.seed.is_some()),
+    ];
+    match given.iter().find(|(key, given)| *given && !keys.contains(key)) {
+        Some((key, _)) => Err(v.err(&format!("forcing.{key}"), &format!("does not belong to a forcing of kind `{kind}`"))),
+        None => Ok(()),
+    }
+}
+
+/// The Kanai-Tajimi ground motion a `[forcing]` of kind `random` describes, checked.
+fn random_ground(g: &format::ForcingFile, v: &Validator) -> Result<KanaiTajimi, SceneError> {
+    let keys = ["ground_frequency", "ground_damping", "intensity", "duration", "step", "envelope", "seed"];
+    only_keys_of(g, "random", &keys, v)?;
+    let needed = |field: &str, x: Option<f64>| x.ok_or_else(|| v.err(field, "is missing: a random ground motion needs it"));
+    let kt = KanaiTajimi {
+        ground_frequency: v.positive("forcing.ground_frequency", needed("forcing.ground_frequency", g.ground_frequency)?)?,
+        ground_damping: v.positive("forcing.ground_damping", needed("forcing.ground_damping", g.ground_damping)?)?,
+        intensity: v.non_negative("forcing.intensity", needed("forcing.intensity", g.intensity)?)?,
+        duration: v.positive("forcing.duration", needed("forcing.duration", g.duration)?)?,
+        step: v.positive("forcing.step", g.step.unwrap_or(0.01))?,
+        envelope: match g.envelope {
+            None => None,
+            Some(e) => {
+                for (i, x) in e.iter().enumerate() {
+                    v.non_negative(&format!("forcing.envelope[{i}]"), *x)?;
+                }
+                if !(e[0] <= e[1]) {
+                    return Err(v.err("forcing.envelope", "must rise (its first time) before its strong motion ends (its second)"));
+                }
+                Some(e)
+            }
+        },
+    };
+    if kt.duration / kt.step > 1e7 {
+        return Err(v.err("forcing.step", &format!("({} s) would draw more than 1e7 points over {} s", human(kt.step), human(kt.duration))));
+    }
+    Ok(kt)
+}
+
 /// The record a `[forcing]` of kind `record` names, read and scaled.
 fn ground_record(g: &format::ForcingFile, v: &Validator) -> Result<GroundRecord, SceneError> {
-    for (field, given) in [("forcing.amplitude", g.amplitude.is_some()), ("forcing.frequency", g.frequency.is_some())] {
-        if given {
-            return Err(v.err(field, "belongs to a sine, not to a record (which gives its own accelerations)"));
-        }
-    }
+    only_keys_of(g, "record", &["file", "scale"], v)?;
     let file = g.file.as_ref().ok_or_else(|| v.err("forcing.file", "is missing: a record needs its file"))?;
     let scale = v.finite("forcing.scale", g.scale.unwrap_or(1.0))?;
     let path = std::path::Path::new(v.file).parent().unwrap_or(std::path::Path::new("")).join(file);
@@ -584,18 +632,14 @@ pub(super) fn compliant_settings(c: &format::CompliantFile, v: &Validator) -> Re
 }
 
 pub(super) fn forcing(g: &format::ForcingFile, frame: &Frame, v: &Validator) -> Result<Forcing, SceneError> {
-    for (field, given) in [("forcing.file", g.file.is_some()), ("forcing.scale", g.scale.is_some())] {
-        if given {
-            return Err(v.err(field, "belongs to a record (`kind = \"record\"`), not to a sine"));
-        }
-    }
+    only_keys_of(g, if g.kind == ExcitationKind::Base { "base" } else { "force" }, &["amplitude", "frequency"], v)?;
     let missing = |field: &str| v.err(field, "is missing: a sine needs its amplitude and frequency");
     let amplitude = v.non_negative("forcing.amplitude", g.amplitude.ok_or_else(|| missing("forcing.amplitude"))?)?;
     let frequency = v.positive("forcing.frequency", g.frequency.ok_or_else(|| missing("forcing.frequency"))?)?;
     let kind = match g.kind {
         ExcitationKind::Force => ForcingKind::Force,
         ExcitationKind::Base => ForcingKind::Base,
-        ExcitationKind::Record => return Err(v.err("forcing.kind", "is a record, which is not a sine")),
+        ExcitationKind::Record | ExcitationKind::Random => return Err(v.err("forcing.kind", "is a ground motion, which is not a sine")),
     };
     let forcing = Forcing { kind, amplitude, frequency };
     // An undamped frame driven exactly at resonance has no bounded particular solution.

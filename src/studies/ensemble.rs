@@ -66,6 +66,11 @@ pub fn places_bed_at_random(file: &SceneFile) -> bool {
     file.bed.as_ref().is_some_and(|b| b.placement == scene::format::Placement::Random)
 }
 
+/// Whether `file` shakes its ground at random: its members then each draw their own motion.
+pub fn shakes_at_random(file: &SceneFile) -> bool {
+    file.forcing.as_ref().is_some_and(|g| g.kind == scene::format::ExcitationKind::Random)
+}
+
 /// A draw that made no valid scene: the parameter to blame and why.
 struct Failure {
     parameter: Parameter,
@@ -74,8 +79,9 @@ struct Failure {
 
 /// Draws `count` members of `nominal` (built from `file`, perhaps with command-line
 /// overrides) under `tolerances`. A bed placed at random is placed anew in every member, from a
-/// seed drawn from `(seed, k)` (the members' last column, `bed_seed`). Without tolerances and
-/// without a random bed every member is the nominal scene.
+/// seed drawn from `(seed, k)` (the members' column `bed_seed`), and a random ground motion is
+/// drawn anew likewise (`ground_seed`). Without tolerances, a random bed or a random ground
+/// every member is the nominal scene.
 /// A tolerance so wide that a member finds no valid scene in [`MAX_DRAWS_PER_MEMBER`] draws,
 /// or that more draws fail than succeed, is an error naming it.
 pub fn draw(
@@ -118,12 +124,14 @@ pub fn draw_range(
     base.sweep = None;
     base.tolerances = None;
     let random_bed = places_bed_at_random(&base);
+    let random_ground = shakes_at_random(&base);
     let columns = spreads
         .iter()
         .flat_map(|&(p, _)| if p == Parameter::Gap { (1..=n).map(|i| format!("gap{i}")).collect() } else { vec![p.to_string()] })
         .chain(random_bed.then(|| "bed_seed".to_string()))
+        .chain(random_ground.then(|| "ground_seed".to_string()))
         .collect();
-    let drawer = Drawer { base, path, nominal, spreads, normal, random_bed };
+    let drawer = Drawer { base, path, nominal, spreads, normal, random_bed, random_ground };
     let drawn: Vec<(Member, Vec<Failure>)> = range.into_par_iter().map(|k| drawer.member(seed, k)).collect::<Result<_, _>>()?;
     let redraws: u64 = drawn.iter().map(|d| d.1.len() as u64).sum();
     if redraws > count as u64 {
@@ -230,6 +238,9 @@ struct Drawer<'a> {
     /// Whether the scene places a bed at random: each member then places its own, from a seed
     /// of its own.
     random_bed: bool,
+    /// Whether the scene shakes its ground at random: each member then draws its own motion,
+    /// from a seed of its own.
+    random_ground: bool,
 }
 
 impl Drawer<'_> {
@@ -274,10 +285,14 @@ impl Drawer<'_> {
             .collect();
         // Below 2^53, so that the members' table holds it exactly.
         let bed_seed = self.random_bed.then(|| rng.random::<u64>() >> 11);
-        let mut file: Option<SceneFile> = bed_seed.map(|seed| {
+        let ground_seed = self.random_ground.then(|| rng.random::<u64>() >> 11);
+        let mut file: Option<SceneFile> = (bed_seed.is_some() || ground_seed.is_some()).then(|| {
             let mut f = self.base.clone();
-            if let Some(bed) = f.bed.as_mut() {
+            if let (Some(bed), Some(seed)) = (f.bed.as_mut(), bed_seed) {
                 bed.seed = Some(seed);
+            }
+            if let (Some(g), Some(seed)) = (f.forcing.as_mut(), ground_seed) {
+                g.seed = Some(seed);
             }
             f
         });
@@ -317,6 +332,7 @@ impl Drawer<'_> {
             }
         }
         drawn.extend(bed_seed.map(|seed| seed as f64));
+        drawn.extend(ground_seed.map(|seed| seed as f64));
         Ok(Member { index: k, drawn, scene })
     }
 }

@@ -133,10 +133,13 @@ impl Nominal {
             .map(|n| {
                 static NOTED: std::sync::Once = std::sync::Once::new();
                 let random_bed = ensemble::places_bed_at_random(file);
+                let random_ground = ensemble::shakes_at_random(file);
                 if self.tolerances.is_none() {
                     NOTED.call_once(|| {
                         if random_bed {
                             eprintln!("note: {} has no [tolerances]: the members differ only in their beds' random placement", self.path)
+                        } else if random_ground {
+                            eprintln!("note: {} has no [tolerances]: the members differ only in their random ground motions", self.path)
                         } else {
                             eprintln!("note: {} has no [tolerances]: every member is the nominal scene", self.path)
                         }
