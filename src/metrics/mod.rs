@@ -58,6 +58,8 @@ metrics! {
     ImpactLoss = "impact_loss",
     /// Impacts per simulated second.
     ImpactRate = "impact_rate",
+    /// A structure's largest interstorey drift for `t >= T`, m.
+    PeakDrift = "peak_drift",
 }
 
 impl std::fmt::Display for Metric {
@@ -116,6 +118,10 @@ pub struct Metrics {
     /// max |a| for t >= T with contact forces included, m/s^2 (`None` for impulse models).
     #[serde(default)]
     pub peak_true_acceleration: Option<f64>,
+    /// A structure's largest interstorey drift over its floors for t >= T, m (`None` without
+    /// a structure).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub peak_drift: Option<f64>,
 }
 
 /// Mean, 95th percentile and largest of a set of per-impact values.
@@ -197,6 +203,7 @@ pub fn metrics(run: &Run) -> Metrics {
         dissipation_time_99: m.dissipation_times[1],
         peak_contact_force: run.impacts.iter().filter_map(|i| i.peak_force).reduce(f64::max),
         peak_true_acceleration: run.peak_true_acceleration,
+        peak_drift: m.peak_drift,
     }
 }
 

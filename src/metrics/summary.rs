@@ -200,6 +200,7 @@ impl Headline {
             Metric::ImpactCount => Some(self.impact_count as f64),
             Metric::ImpactLoss => Some(self.impact_loss),
             Metric::ImpactRate => Some(self.impact_rate),
+            Metric::PeakDrift => m.peak_drift,
         }
     }
     /// Every metric, in [`Metric::ALL`] order.

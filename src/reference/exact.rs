@@ -189,6 +189,7 @@ impl ExactTally {
             rms_displacement: if self.horizon > 0.0 { (self.integral_x2 / self.horizon).sqrt() } else { 0.0 },
             settling_time,
             dissipation_times: self.dissipated,
+            peak_drift: None,
         }
     }
 }

@@ -457,6 +457,9 @@ impl Recorder {
                         let energy = s.energy(u, v, 0.0);
                         let ball = |i: usize| in_ground_frame(j, &paths[i], paths[i].at(ts, xs, vs));
                         self.sample_with(ts, xs, vs, structure_acceleration(j), |_, _, _| energy, ball);
+                        if let Some(tally) = &mut self.tally {
+                            tally.add_floors(ts, u);
+                        }
                     }
                 }
             }
@@ -509,6 +512,9 @@ impl Recorder {
                     (true, false) => frame_energy(j, ts, xs, vs) + kinetic(vs),
                 };
                 tally.add(ts, xs, a, energy);
+                if structure.is_some() {
+                    tally.add_floors(ts, floor_state(j).0);
+                }
             }
         }
         self.taken += count;

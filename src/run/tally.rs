@@ -25,6 +25,9 @@ pub struct MotionMetrics {
     pub settling_time: Option<f64>,
     /// First times the energy has fallen to each of [`DISSIPATION_LEVELS`].
     pub dissipation_times: [Option<f64>; 2],
+    /// A structure's largest interstorey drift over its floors for t >= T, m (`None` without
+    /// a structure).
+    pub peak_drift: Option<f64>,
 }
 
 /// Energy fractions left at which the dissipation times are read: 10 % and 1 %.
@@ -50,6 +53,7 @@ pub struct SampleTally {
     last_outside: Option<f64>,
     last_is_outside: bool,
     dissipated: [Option<f64>; 2],
+    peak_drift: Option<f64>,
 }
 
 impl SampleTally {
@@ -100,7 +104,21 @@ impl SampleTally {
             rms_displacement: if self.samples == 0 { 0.0 } else { (self.sum_sq / self.samples as f64).sqrt() },
             settling_time: self.settling_time(),
             dissipation_times: self.dissipated,
+            peak_drift: self.peak_drift,
         }
+    }
+    /// Adds a structure's floors at `t`, relative to the ground, bottom to top.
+    #[inline]
+    pub fn add_floors(&mut self, t: f64, u: &[f64]) {
+        let mut drift = self.peak_drift.unwrap_or(0.0);
+        if t >= self.from {
+            let mut below = 0.0;
+            for &x in u {
+                drift = drift.max((x - below).abs());
+                below = x;
+            }
+        }
+        self.peak_drift = Some(drift);
     }
     /// The last sampled time at which `|xs| >= 5 % |xs0|`, or `None` if the last sample still
     /// is (not settled within the horizon). A series that never reaches the band settles at 0.

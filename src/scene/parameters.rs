@@ -75,6 +75,8 @@ parameters! {
     Friction = "friction", "world.friction", false;
     /// Solid fraction of the container a bed fills.
     FillFraction = "fill_fraction", "bed.fill_fraction", false;
+    /// The floor of a structure that carries the container, 1 at the bottom (a whole number).
+    DamperFloor = "damper_floor", "structure.damper_floor", false;
 }
 
 impl std::fmt::Display for Parameter {
@@ -96,7 +98,7 @@ impl Parameter {
     /// Whether its values are whole numbers (a count, as the number of chains): a study
     /// refines it over the whole numbers, never between them.
     pub fn is_count(self) -> bool {
-        self == Parameter::Chains
+        matches!(self, Parameter::Chains | Parameter::DamperFloor)
     }
 
     /// The parameter whose value a scene file's field holds (`balls.container_length` holds
@@ -117,7 +119,7 @@ impl Parameter {
             Length::Metres(x) => Ok(x),
             Length::Rr(_) => Err(format!("`{self}` is not a length: its values must be plain numbers")),
         };
-        let frame = f.frame.as_mut().ok_or("needs a [frame] table")?;
+        let no_frame = "needs a [frame] table";
         match self {
             Parameter::Chains => {
                 let x = number()?;
@@ -132,10 +134,17 @@ impl Parameter {
                 bed.fill_fraction = Some(number()?);
                 bed.count = None;
             }
-            Parameter::FrameMass => frame.mass = number()?,
-            Parameter::Stiffness => frame.stiffness = number()?,
-            Parameter::Damping => frame.damping = number()?,
-            Parameter::InitialDisplacement => frame.initial_displacement = value,
+            Parameter::FrameMass => f.frame.as_mut().ok_or(no_frame)?.mass = number()?,
+            Parameter::Stiffness => f.frame.as_mut().ok_or(no_frame)?.stiffness = number()?,
+            Parameter::Damping => f.frame.as_mut().ok_or(no_frame)?.damping = number()?,
+            Parameter::InitialDisplacement => f.frame.as_mut().ok_or(no_frame)?.initial_displacement = value,
+            Parameter::DamperFloor => {
+                let x = number()?;
+                if !(x >= 1.0 && x <= u32::MAX as f64 && x.fract() == 0.0) {
+                    return Err(format!("`damper_floor` must be a whole number from 1 (got {})", super::human(x)));
+                }
+                f.structure.as_mut().ok_or("needs a [structure] table")?.damper_floor = Some(x as u32);
+            }
             Parameter::ForcingAmplitude | Parameter::ForcingFrequency => {
                 let x = number()?;
                 let g = f.forcing.as_mut().ok_or("needs a [forcing] table")?;
@@ -188,6 +197,7 @@ impl Parameter {
             Parameter::Chains => Some(scene.space.chains() as f64),
             Parameter::Friction => Some(scene.space.friction),
             Parameter::FillFraction => file.bed.as_ref().and_then(|b| b.fill_fraction),
+            Parameter::DamperFloor => scene.structure.as_ref().map(|s| (s.floor + 1) as f64),
         }
     }
 }

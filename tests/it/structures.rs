@@ -262,3 +262,46 @@ fn each_member_shakes_with_its_own_random_ground() {
     assert_eq!(third.members[0].scene, all.members[2].scene);
     assert_eq!(all.columns.last().map(String::as_str), Some("ground_seed"));
 }
+
+/// The largest interstorey drift is tallied as the run goes, so a run without a series has it
+/// too: it is the series' largest drift from one period on, and a frame has none.
+#[test]
+fn the_peak_drift_is_the_largest_drift_of_the_floors() {
+    let scene = lpc_damper::scene::load_scene(lpc_damper::scene::scenes_dir().join("mdof-3storey.toml")).unwrap();
+    let run = reference(&scene);
+    let s = &run.series;
+    let from = scene.frame.unwrap().damped_period();
+    let mut largest: f64 = 0.0;
+    for k in (0..s.len()).filter(|&k| s.t()[k] >= from) {
+        let mut below = 0.0;
+        for i in 0..3 {
+            let u = s.floor(i, k).unwrap().0;
+            largest = largest.max((u - below).abs());
+            below = u;
+        }
+    }
+    let metrics = lpc_damper::metrics::metrics(&run);
+    assert_eq!(metrics.peak_drift, Some(largest));
+    let quiet = Model::Reference.simulate(&scene, &RunOptions::metrics_only()).unwrap();
+    assert_eq!(lpc_damper::metrics::metrics(&quiet).peak_drift, Some(largest));
+    let frame = crate::common::scene_from_toml(LSL_TOML);
+    assert_eq!(lpc_damper::metrics::metrics(&reference(&frame)).peak_drift, None);
+}
+
+/// `lpc sweep` varies the floor that carries the damper, and refuses a floor the building has
+/// not.
+#[test]
+fn a_sweep_moves_the_damper_from_floor_to_floor() {
+    let o = lpc_command()
+        .args(["sweep", "scenes/mdof-3storey-record.toml", "--x", "damper_floor=1,2,3", "--horizon", "2", "--format", "json"])
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let out: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    let text = out.to_string();
+    assert!(text.contains("damper_floor") && text.contains("peak_drift"), "{text}");
+    let o = lpc_command().args(["sweep", "scenes/mdof-3storey-record.toml", "--x", "damper_floor=1,4"]).output().unwrap();
+    let stderr = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(2), "{stderr}");
+    assert!(stderr.contains("damper_floor"), "{stderr}");
+}
