@@ -288,6 +288,54 @@ pub fn time_histories(with: &Run, without: Option<&Run>) -> Vec<Figure> {
     ]
 }
 
+/// A structure's floors: each floor's displacement relative to the ground against time (with
+/// the damper), and the drift profile, each storey's peak interstorey drift against its
+/// height, with and without the damper. None without floors.
+pub fn floor_responses(with: &Run, without: Option<&Run>) -> Vec<Figure> {
+    let s = &with.series;
+    let n = s.floor_count();
+    if n == 0 {
+        return vec![];
+    }
+    let floors = (0..n)
+        .map(|i| Curve {
+            label: format!("floor {}", i + 1),
+            x: s.t().to_vec(),
+            y: (0..s.len()).map(|k| s.floor(i, k).map_or(f64::NAN, |f| f.0 * 1e3)).collect(),
+        })
+        .collect();
+    let profile = |run: &Run, label: &str| {
+        let storeys = crate::metrics::FloorSummary::of(&run.series);
+        Curve {
+            label: label.into(),
+            x: storeys.iter().map(|f| f.peak_drift * 1e3).collect(),
+            y: storeys.iter().map(|f| f.floor as f64).collect(),
+        }
+    };
+    let mut drift = vec![profile(with, &format!("with damper ({})", with.model))];
+    if let Some(w) = without.filter(|w| w.series.floor_count() == n) {
+        drift.insert(0, profile(w, "without damper"));
+    }
+    vec![
+        Figure {
+            name: "floors".into(),
+            title: format!("{}: floor displacements relative to the ground", with.scene),
+            x_desc: "t (s)".into(),
+            y_desc: "u (mm)".into(),
+            curves: floors,
+            points: false,
+        },
+        Figure {
+            name: "drift-profile".into(),
+            title: format!("{}: peak interstorey drift over height", with.scene),
+            x_desc: "peak drift (mm)".into(),
+            y_desc: "storey".into(),
+            curves: drift,
+            points: true,
+        },
+    ]
+}
+
 /// Fig. 12: each ball's centre relative to the container's left wall, with the walls' inner
 /// faces when the container length is known; one figure per chain (`chains` the balls of each,
 /// in order), named `positions` for one chain and `positions-chainK` for several.

@@ -305,3 +305,22 @@ fn a_sweep_moves_the_damper_from_floor_to_floor() {
     assert_eq!(o.status.code(), Some(2), "{stderr}");
     assert!(stderr.contains("damper_floor"), "{stderr}");
 }
+
+/// A structure's figures: every floor against time, and the drift profile with and without
+/// the damper, one point per storey at its peak drift; a frame has neither.
+#[test]
+fn a_structure_plots_its_floors_and_drift_profile() {
+    use lpc_damper::output::figures::floor_responses;
+    let scene = lpc_damper::scene::load_scene(lpc_damper::scene::scenes_dir().join("mdof-3storey.toml")).unwrap();
+    let (with, without) = (reference(&scene), reference(&scene.without_damper()));
+    let figs = floor_responses(&with, Some(&without));
+    assert_eq!(figs.iter().map(|f| f.name.as_str()).collect::<Vec<_>>(), ["floors", "drift-profile"]);
+    assert_eq!(figs[0].curves.len(), 3);
+    let profile = &figs[1].curves;
+    assert_eq!(profile.len(), 2);
+    let floors = lpc_damper::metrics::FloorSummary::of(&with.series);
+    assert_eq!(profile[1].x, floors.iter().map(|f| f.peak_drift * 1e3).collect::<Vec<_>>());
+    assert_eq!(profile[1].y, vec![1.0, 2.0, 3.0]);
+    let frame = crate::common::scene_from_toml(LSL_TOML);
+    assert!(floor_responses(&reference(&frame), None).is_empty());
+}

@@ -109,6 +109,7 @@ pub fn run(a: Args) -> Result<ExitStatus> {
             let run = crate::watch::watched(a.model, &s, RunOptions::limited(limits), None)?;
             let bare = crate::watch::watched(lpc_damper::Model::Reference, &s.without_damper(), RunOptions::limited(limits), None)?;
             figs.extend(figures::time_histories(&run, (!s.balls.is_empty()).then_some(&bare)));
+            figs.extend(figures::floor_responses(&run, (!s.balls.is_empty()).then_some(&bare)));
             if !s.balls.is_empty() {
                 let chains: Vec<_> = (0..s.space.chains()).map(|k| s.space.chain(k, s.balls.len())).collect();
                 figs.extend(figures::ball_positions(&run, s.container.map(|c| c.length), &chains));
