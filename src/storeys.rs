@@ -133,6 +133,20 @@ impl Building {
         -self.restoring_forces(u, v).iter().sum::<f64>()
     }
 
+    /// The steady response `U` (complex amplitudes per floor, `u = Re U e^{i w t}`) to the
+    /// loads `Re F e^{i w t}` on the floors of masses `masses`: `(K - w^2 M + i w C) U = F`.
+    /// `None` when the structure has no steady state at `w` (undamped, at a natural frequency).
+    pub fn harmonic_response(&self, masses: &[f64], omega: f64, loads: &[C64]) -> Option<Vec<C64>> {
+        let n = self.floors();
+        let k = self.stiffness();
+        let d = DMatrix::<C64>::from_fn(n, n, |i, j| {
+            let mass = if i == j { masses[i] } else { 0.0 };
+            C64::new(k[(i, j)] - omega * omega * mass, omega * self.damping[(i, j)])
+        });
+        let u = d.lu().solve(&DVector::from_column_slice(loads))?;
+        u.iter().all(|x| x.re.is_finite() && x.im.is_finite()).then(|| u.iter().copied().collect())
+    }
+
     /// The state matrix's modes with `added` kg on floor `floor` (balls the floor carries).
     pub fn modes(&self, floor: usize, added: f64) -> Result<Modes, String> {
         Modes::new(self, floor, added)

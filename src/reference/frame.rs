@@ -59,7 +59,7 @@ impl FrameMotion {
         let load = scene.harmonic_load();
         let seg = Segment::new(0.0, scene.initial_displacement, 0.0, osc, load);
         let storeys = match &scene.structure {
-            Some(s) => Some(Box::new(StoreyMotion::new(s.clone(), scene.horizon)?)),
+            Some(s) => Some(Box::new(StoreyMotion::new(s.clone(), scene.forcing, scene.horizon)?)),
             None => None,
         };
         let span = storeys.as_ref().map_or_else(|| span(&seg, scene.horizon), |s| s.span);

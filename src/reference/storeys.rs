@@ -13,12 +13,14 @@ use std::cell::RefCell;
 use std::rc::Rc;
 use std::sync::Arc;
 
-use super::frame::ahead;
 use super::segment::illinois;
 use crate::oscillator::{gauss_legendre, ROUNDOFF_ULPS};
 use crate::scene::record::Stretch;
-use crate::scene::Structure;
+use crate::scene::{Forcing, ForcingKind, Structure};
 use crate::storeys::{Modes, C64};
+use nalgebra::DMatrix;
+
+use super::ROUNDOFF_RELATIVE;
 
 /// One stretch of the segment: on `[start, end)` the ground accelerates as `g0 + g1 (t - start)`.
 #[derive(Debug, Clone)]
@@ -62,6 +64,21 @@ impl Compensated {
     }
 }
 
+/// A sine load on the structure (a force on the carrying floor, or the ground moving as
+/// `Y sin w t`) and the floors' steady response to it, for the current modes.
+#[derive(Debug, Clone)]
+struct Sine {
+    omega: f64,
+    /// The ground's amplitude `Y` (base motion), m.
+    ground: f64,
+    /// The force's amplitude on the carrying floor, N.
+    force: f64,
+    /// The floors' steady response, `u = Re U e^{i w t}`.
+    u: Vec<C64>,
+    /// The carrying floor's absolute acceleration in it, `Re H e^{i w t}`.
+    h: C64,
+}
+
 /// The sign changes found so far in the current segment, and how far the scan has gone.
 #[derive(Debug, Default)]
 struct SignScan {
@@ -85,11 +102,18 @@ pub(super) struct StoreyMotion {
     pub(super) span: f64,
     /// Why the motion cannot go on (a decomposition that failed), once it cannot.
     pub(super) failure: Option<String>,
+    /// The sine load and the response to it, when the scene has one.
+    sine: Option<Sine>,
+    /// The sine load as the scene gives it.
+    forcing: Option<Forcing>,
+    /// `K`.
+    stiffness: DMatrix<f64>,
 }
 
 impl StoreyMotion {
-    pub(super) fn new(structure: Arc<Structure>, horizon: f64) -> Result<Self, String> {
+    pub(super) fn new(structure: Arc<Structure>, forcing: Option<Forcing>, horizon: f64) -> Result<Self, String> {
         let modes = Rc::new(structure.building.modes(structure.floor, 0.0)?);
+        let structure_stiffness = structure.building.stiffness();
         let z0 = structure.initial_displacements.iter().chain(&structure.initial_velocities).copied().collect();
         let mut m = StoreyMotion {
             structure,
@@ -102,14 +126,53 @@ impl StoreyMotion {
             scan_step: 0.0,
             span: 0.0,
             failure: None,
+            sine: None,
+            forcing,
+            stiffness: structure_stiffness,
         };
+        m.sine = m.steady_response()?;
         m.set_scales(horizon);
         m.reset();
         Ok(m)
     }
 
+    /// The steady response to the sine load with the current modes' masses, if any.
+    fn steady_response(&self) -> Result<Option<Sine>, String> {
+        let Some(g) = self.forcing else { return Ok(None) };
+        let (n, d, omega) = (self.n(), self.structure.floor, g.omega());
+        let (ground, force) = match g.kind {
+            ForcingKind::Base => (g.amplitude, 0.0),
+            ForcingKind::Force => (0.0, g.amplitude),
+        };
+        // sin w t = Re(-i e^{i w t}): the ground's acceleration -Y w^2 sin w t is Re(i Y w^2 e^{i w t}).
+        let ag = C64::new(0.0, ground * omega * omega);
+        let loads: Vec<C64> =
+            (0..n).map(|i| -ag * self.modes.masses[i] + if i == d { C64::new(0.0, -force) } else { C64::new(0.0, 0.0) }).collect();
+        let u = self
+            .structure
+            .building
+            .harmonic_response(&self.modes.masses, omega, &loads)
+            .ok_or_else(|| format!("the structure has no steady response at {} Hz (undamped, at a natural frequency)", g.frequency))?;
+        let h = -u[d] * omega * omega + ag;
+        Ok(Some(Sine { omega, ground, force, u, h }))
+    }
+
+    /// The sine's part of the floors' state `[u; u']` at `t` (zero without one).
+    fn sine_state(&self, t: f64) -> Vec<f64> {
+        let n = self.n();
+        match &self.sine {
+            None => vec![0.0; 2 * n],
+            Some(s) => {
+                let e = C64::new(0.0, s.omega * t).exp();
+                let i_w = C64::new(0.0, s.omega);
+                (0..2 * n).map(|k| if k < n { (s.u[k] * e).re } else { (s.u[k - n] * e * i_w).re }).collect()
+            }
+        }
+    }
+
     fn set_scales(&mut self, horizon: f64) {
-        let shortest = self.modes.shortest_period;
+        let forcing_period = self.sine.as_ref().map_or(f64::INFINITY, |s| 2.0 * std::f64::consts::PI / s.omega);
+        let shortest = self.modes.shortest_period.min(forcing_period);
         self.scan_step = if shortest.is_finite() { shortest / 16.0 } else { horizon.min(1.0 / self.modes.rate.max(1e-300)) };
         self.span = if self.modes.longest_period.is_finite() { self.modes.longest_period } else { horizon };
     }
@@ -130,9 +193,19 @@ impl StoreyMotion {
     fn piece(&self, start: f64, z: &[f64]) -> Piece {
         let ground = self.stretch(start);
         let (g0, g1) = (ground.g0 + ground.g1 * (start - ground.start), ground.g1);
-        let c = self.modes.coefficients(z, g0, g1);
+        let steady = self.sine_state(start);
+        let departure: Vec<f64> = z.iter().zip(&steady).map(|(z, s)| z - s).collect();
+        let c = self.modes.coefficients(&departure, g0, g1);
         let w = self.modes.floor_terms(&c, self.structure.floor);
-        let bounds = std::array::from_fn(|n| w.iter().zip(&self.modes.lambda).map(|(w, l)| w.norm() * l.norm().powi(n as i32)).sum());
+        let mut bounds: [f64; 6] =
+            std::array::from_fn(|n| w.iter().zip(&self.modes.lambda).map(|(w, l)| w.norm() * l.norm().powi(n as i32)).sum());
+        if let Some(s) = &self.sine {
+            // The sine's displacement (with the ground's) and its absolute acceleration.
+            let shift = s.u[self.structure.floor].norm() + s.ground;
+            for (n, b) in bounds.iter_mut().enumerate() {
+                *b += if n < 2 { shift * s.omega.powi(n as i32) } else { s.h.norm() * s.omega.powi(n as i32 - 2) };
+            }
+        }
         Piece { start, end: ground.end, ground, g0, g1, c, w, bounds }
     }
 
@@ -149,7 +222,7 @@ impl StoreyMotion {
         let mut pieces = self.pieces.borrow_mut();
         while pieces.last().is_some_and(|p| p.end <= t) {
             let last = pieces.last().expect("a segment has a piece");
-            let z = self.modes.state(&last.c, last.g0, last.g1, last.end - last.start);
+            let z = self.full_state(last, last.end);
             let next = self.piece(last.end, &z);
             pieces.push(next);
         }
@@ -161,11 +234,34 @@ impl StoreyMotion {
         f(&self.pieces.borrow()[k])
     }
 
+    /// The floors' state `[u; u']` at `t` on piece `p`: its free and linear parts and the sine's.
+    fn full_state(&self, p: &Piece, t: f64) -> Vec<f64> {
+        let mut z = self.modes.state(&p.c, p.g0, p.g1, t - p.start);
+        if self.sine.is_some() {
+            for (z, s) in z.iter_mut().zip(self.sine_state(t)) {
+                *z += s;
+            }
+        }
+        z
+    }
+
+    /// The sine ground's displacement and velocity at `t` (zero without one).
+    fn sine_ground(&self, t: f64) -> (f64, f64) {
+        match &self.sine {
+            Some(s) if s.ground != 0.0 => {
+                let (sin, cos) = (s.omega * t).sin_cos();
+                (s.ground * sin, s.ground * s.omega * cos)
+            }
+            _ => (0.0, 0.0),
+        }
+    }
+
     /// The ground's displacement and velocity at `t`.
     pub(super) fn ground(&self, t: f64) -> (f64, f64) {
         let g = self.stretch(t);
         let (x, v, _) = g.at(t - g.start);
-        (x, v)
+        let (xs, vs) = self.sine_ground(t);
+        (x + xs, v + vs)
     }
 
     /// The floors' state `[u; u']` relative to the ground at `t`, and the ground's velocity.
@@ -173,7 +269,7 @@ impl StoreyMotion {
         if t == self.t0 {
             return (self.z0.clone(), self.ground(t).1);
         }
-        self.with_piece(t, |p| (self.modes.state(&p.c, p.g0, p.g1, t - p.start), p.ground.at(t - p.ground.start).1))
+        self.with_piece(t, |p| (self.full_state(p, t), p.ground.at(t - p.ground.start).1 + self.sine_ground(t).1))
     }
 
     /// The carrying floor's absolute displacement and velocity at `t`.
@@ -181,8 +277,7 @@ impl StoreyMotion {
         let d = self.structure.floor;
         if t == self.t0 {
             // At its start the segment is exactly the state it was made from.
-            let g = self.stretch(t);
-            let (xg, vg, _) = g.at(t - g.start);
+            let (xg, vg) = self.ground(t);
             return (xg + self.z0[d], vg + self.z0[self.n() + d]);
         }
         self.with_piece(t, |p| {
@@ -194,6 +289,12 @@ impl StoreyMotion {
                 v += (e * l).re;
             }
             let (xg, vg, _) = p.ground.at(t - p.ground.start);
+            if let Some(sine) = &self.sine {
+                let e = sine.u[d] * C64::new(0.0, sine.omega * t).exp();
+                let (xs, vs) = self.sine_ground(t);
+                u += e.re + xs;
+                v += (e * C64::new(0.0, sine.omega)).re + vs;
+            }
             (xg + u, vg + v)
         })
     }
@@ -210,6 +311,14 @@ impl StoreyMotion {
                 e *= l;
             }
         }
+        if let Some(sine) = &self.sine {
+            let i_w = C64::new(0.0, sine.omega);
+            let mut e = sine.h * C64::new(0.0, sine.omega * t).exp();
+            for x in &mut d {
+                *x += e.re;
+                e *= i_w;
+            }
+        }
         [(d[0] + p.g0 + p.g1 * s, p.bounds[2] + (p.g0 + p.g1 * s).abs()), (d[1] + p.g1, p.bounds[3] + p.g1.abs()), (d[2], p.bounds[4])]
     }
 
@@ -219,9 +328,60 @@ impl StoreyMotion {
     }
 
     /// The carrying floor's absolute acceleration just after `t`: its value, with the sign of
-    /// the first derivative that is not round-off when the acceleration itself is.
+    /// the first derivative that is not round-off when the acceleration itself is. The value
+    /// and the jerk come from the floors' state, as the force of the storeys (and of a sine)
+    /// over the floor's mass: at a segment's start that state is exactly the one it was made
+    /// from, so the sign is the same whatever mass the floor holds, and holding and releasing
+    /// a ball agree at the instant they happen.
     pub(super) fn accel_ahead(&self, t: f64) -> f64 {
-        self.with_piece(t, |p| ahead(self.derivatives(p, t)))
+        let n = self.n();
+        let d = self.structure.floor;
+        let b = &self.structure.building;
+        let m = &self.modes.masses;
+        let (z, _) = self.floors(t);
+        let (u, v) = z.split_at(n);
+        // The external force on the carrying floor and its rate, and the ground's acceleration.
+        let (force, force_rate, ag) = {
+            let stretch = self.stretch(t);
+            let s = t - stretch.start;
+            let (mut f, mut fr, mut g) = (0.0, 0.0, stretch.g0 + stretch.g1 * s);
+            if let Some(sine) = &self.sine {
+                let (sin, cos) = (sine.omega * t).sin_cos();
+                let w = sine.omega;
+                f += sine.force * sin;
+                fr += sine.force * w * cos;
+                g -= sine.ground * w * w * sin;
+            }
+            (f, fr, g)
+        };
+        let mut forces = b.restoring_forces(u, v);
+        forces[d] += force;
+        let row = |j: usize| (self.stiffness[(d, j)], b.damping[(d, j)]);
+        let size: f64 = (0..n).map(|j| row(j).0.abs() * u[j].abs() + row(j).1.abs() * v[j].abs()).sum::<f64>() + force.abs();
+        let a = forces[d] / m[d];
+        if a.abs() > ROUNDOFF_RELATIVE * size / m[d] {
+            return a;
+        }
+        // The storeys' force changes as `-(C u'' + K u')`, with `u''` each floor's force over
+        // its mass less the ground's acceleration.
+        let relative: Vec<f64> = (0..n).map(|j| forces[j] / m[j] - ag).collect();
+        let mut jerk = force_rate;
+        let mut jerk_size = force_rate.abs();
+        for j in 0..n {
+            let (k, c) = row(j);
+            jerk -= c * relative[j] + k * v[j];
+            jerk_size += (c * relative[j]).abs() + (k * v[j]).abs();
+        }
+        let sign = if jerk.abs() > ROUNDOFF_RELATIVE * jerk_size {
+            jerk.signum()
+        } else {
+            let snap = self.with_piece(t, |p| self.derivatives(p, t)[2].0);
+            if snap == 0.0 {
+                return 0.0;
+            }
+            snap.signum()
+        };
+        sign * a.abs().max(f64::MIN_POSITIVE)
     }
 
     /// A bound on the round-off of the carrying floor's absolute position at `t`.
@@ -233,7 +393,8 @@ impl StoreyMotion {
             let sg = t - p.ground.start;
             let g = &p.ground;
             let ground = g.x0.abs() + sg * (g.v0.abs() + sg * (0.5 * g.g0.abs() + sg * g.g1.abs() / 6.0));
-            let free = (2.0 + self.modes.rate * s) * p.bounds[0];
+            let phase = self.sine.as_ref().map_or(0.0, |sine| sine.omega * t.abs());
+            let free = (2.0 + self.modes.rate * s + phase) * p.bounds[0];
             ROUNDOFF_ULPS * f64::EPSILON * (free + up.abs() + self.modes.influence[d].abs() * p.g0.abs() + ground)
         })
     }
@@ -305,7 +466,8 @@ impl StoreyMotion {
     fn roundoff(&self, p: &Piece, t: f64, order: usize) -> f64 {
         let s = t - p.start;
         let line = if order == 0 { p.g0.abs() + p.g1.abs() * s } else { p.g1.abs() };
-        ROUNDOFF_ULPS * f64::EPSILON * ((2.0 + self.modes.rate * s) * p.bounds[order + 2] + line)
+        let phase = self.sine.as_ref().map_or(0.0, |sine| sine.omega * t.abs());
+        ROUNDOFF_ULPS * f64::EPSILON * ((2.0 + self.modes.rate * s + phase) * p.bounds[order + 2] + line)
     }
 
     /// Whether the acceleration is round-off over all of `[l.t, r.t]`, so that its sign there
@@ -361,6 +523,12 @@ impl StoreyMotion {
                 Err(why) => self.failure = Some(format!("with {held} kg of balls held on floor {}, {why}", d + 1)),
             }
         }
+        if self.forcing.is_some() {
+            match self.steady_response() {
+                Ok(sine) => self.sine = sine,
+                Err(why) => self.failure = Some(format!("with {held} kg of balls held on floor {}, {why}", d + 1)),
+            }
+        }
         self.t0 = t;
         self.z0 = z;
         self.reset();
@@ -381,9 +549,11 @@ impl StoreyMotion {
         if !(t > self.t0) {
             return (0.0, 0.0);
         }
-        let sub = std::f64::consts::PI / (8.0 * self.modes.rate.max(1e-300));
+        let fastest = self.modes.rate.max(self.sine.as_ref().map_or(0.0, |s| s.omega));
+        let sub = std::f64::consts::PI / (8.0 * fastest.max(1e-300));
         let last = self.index(t);
         let b_ = &self.structure.building;
+        let floor = self.structure.floor;
         let n = self.n();
         // Each sub-piece's integral is added with Neumaier's compensation: a long segment
         // has thousands of them, and plain sums would lose more than the quadrature does.
@@ -396,10 +566,11 @@ impl StoreyMotion {
             for j in 0..count as usize {
                 let (lo, hi) = (a + j as f64 * h, if j + 1 == count as usize { b } else { a + (j + 1) as f64 * h });
                 let [d, w] = gauss_legendre(lo, hi, hi - lo, |s| {
-                    let z = self.modes.state(&p.c, p.g0, p.g1, s - p.start);
+                    let z = self.full_state(&p, s);
                     let (u, v) = z.split_at(n);
-                    let vg = p.ground.at(s - p.ground.start).1;
-                    [b_.damping_power(v), -vg * b_.base_shear(u, v)]
+                    let vg = p.ground.at(s - p.ground.start).1 + self.sine_ground(s).1;
+                    let force = self.sine.as_ref().map_or(0.0, |sine| sine.force * (sine.omega * s).sin() * (v[floor] + vg));
+                    [b_.damping_power(v), -vg * b_.base_shear(u, v) + force]
                 });
                 sums[0].add(d);
                 sums[1].add(w);
@@ -409,8 +580,8 @@ impl StoreyMotion {
         (damping, work)
     }
 
-    /// Whether the ground moves (then it does work).
+    /// Whether the ground moves or a force acts (then they do work).
     pub(super) fn is_driven(&self) -> bool {
-        self.structure.ground.is_some()
+        self.structure.ground.is_some() || self.sine.is_some()
     }
 }

@@ -124,7 +124,12 @@ impl Scene {
     /// Initial mechanical energy: spring energy plus balls' kinetic energy.
     pub fn initial_energy(&self) -> f64 {
         let spring = match &self.structure {
-            Some(s) => s.energy(&s.initial_displacements, &s.initial_velocities, 0.0),
+            // The floors start at their velocities relative to a ground that may move (a sine
+            // base starts at `Y w`).
+            Some(s) => {
+                let ground = self.forcing.filter(|g| g.kind == ForcingKind::Base).map_or(0.0, |g| g.ground(0.0).1);
+                s.energy(&s.initial_displacements, &s.initial_velocities, ground)
+            }
             None => self.frame.map_or(0.0, |f| f.energy(self.initial_displacement, 0.0)),
         };
         let across: f64 = (0..self.balls.len())

@@ -173,8 +173,24 @@ pub(super) fn build_damper(f: &SceneFile, name: &str, v: &Validator) -> Result<S
         return Err(v.err("structure", "cannot be combined with [frame]: give the primary structure one way"));
     }
     let structure = structure(st, record, v)?;
-    if structure.floors() > 1 && f.forcing.as_ref().is_some_and(|g| matches!(g.kind, ExcitationKind::Force | ExcitationKind::Base)) {
-        return Err(v.err("forcing.kind", "a sine on a structure of several storeys is not supported yet: give a record"));
+    if let Some(g) = f.forcing.as_ref().filter(|g| matches!(g.kind, ExcitationKind::Force | ExcitationKind::Base)) {
+        // A sine drives the structure only where it has a steady response: an undamped
+        // building has none at a natural frequency (within 1e-12 relative, the round-off of
+        // its modes), nor where its dynamic stiffness is singular.
+        let b = &structure.building;
+        let omega = 2.0 * std::f64::consts::PI * g.frequency.unwrap_or(0.0);
+        let undamped = b.damping.iter().all(|&c| c == 0.0);
+        let at_mode = undamped && b.undamped_modes().0.iter().any(|w| (omega - w).abs() <= 1e-12 * w);
+        let unit = vec![crate::storeys::C64::new(1.0, 0.0); b.floors()];
+        if omega.is_finite() && omega > 0.0 && (at_mode || b.harmonic_response(&b.masses, omega, &unit).is_none()) {
+            return Err(v.err(
+                "forcing.frequency",
+                &format!(
+                    "({} Hz) drives an undamped structure at a natural frequency: its amplitude grows without bound",
+                    human(omega / (2.0 * std::f64::consts::PI))
+                ),
+            ));
+        }
     }
     let d = structure.floor;
     let b = &structure.building;
