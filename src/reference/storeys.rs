@@ -5,9 +5,10 @@
 //! the one-storey frame's are.
 //!
 //! On a stretch the carrying floor's absolute acceleration is `a(s) = Re sum_k w_k L_k^2
-//! e^{L_k s} + g0 + g1 s`: with damping `>= 0` every `|e^{L_k s}| <= 1`, so its `n`-th
-//! derivative is bounded by `B_n = sum_k |w_k| |L_k|^n` (the ground's line adds to the first
-//! only), and the scan that clears an interval of sign changes uses those bounds.
+//! e^{L_k s} + g0 + g1 s`, plus `Re H e^{i w t}` under a sine: with damping `>= 0` every
+//! `|e^{L_k s}| <= 1`, so its `n`-th derivative is bounded by `B_n = sum_k |w_k| |L_k|^n` (the
+//! ground's line adds to the first only, a sine `|H| w^n` to each), and the scan that clears an
+//! interval of sign changes uses those bounds.
 
 use std::cell::RefCell;
 use std::rc::Rc;
@@ -555,8 +556,8 @@ impl StoreyMotion {
         let b_ = &self.structure.building;
         let floor = self.structure.floor;
         let n = self.n();
-        // Each sub-piece's integral is added with Neumaier's compensation: a long segment
-        // has thousands of them, and plain sums would lose more than the quadrature does.
+        // Each sub-piece's integral is added with Neumaier's compensation, so that the sum of
+        // a long segment's thousands of them adds no round-off of its own.
         let mut sums = [Compensated::default(), Compensated::default()];
         for k in 0..=last {
             let p = self.pieces.borrow()[k].clone();
