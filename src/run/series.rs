@@ -434,7 +434,7 @@ impl Recorder {
         let structure_acceleration = |j: usize| {
             let s = structure.expect("floors come with a structure");
             let (u, v) = floor_state(j);
-            s.accelerations(u, v)[s.floor]
+            scene.floor_accelerations(time(j), u, v)[s.floor]
         };
         if let (Some(s), Some(series)) = (structure, &mut self.series) {
             series.floor_count = s.floors();
@@ -443,7 +443,7 @@ impl Recorder {
                 if (self.taken + j).is_multiple_of(every) {
                     let (u, v) = floor_state(j);
                     series.floors.extend_from_slice(&floors[j * width..(j + 1) * width]);
-                    series.floors.extend(s.accelerations(u, v));
+                    series.floors.extend(scene.floor_accelerations(time(j), u, v));
                 }
             }
         }

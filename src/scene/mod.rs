@@ -251,6 +251,18 @@ impl Scene {
         }
     }
 
+    /// A structure's floors' absolute accelerations at `t` without impulses and contact
+    /// forces, with the floors at `u` and moving at `v` relative to the ground: the storeys'
+    /// `-M^-1 (C v + K u)` plus a sine force on the carrying floor, m/s^2.
+    pub fn floor_accelerations(&self, t: f64, u: &[f64], v: &[f64]) -> Vec<f64> {
+        let Some(s) = self.structure.as_deref() else { return Vec::new() };
+        let mut a = s.accelerations(u, v);
+        if let Some(g) = self.forcing.filter(|g| g.kind == ForcingKind::Force) {
+            a[s.floor] += g.force(t) / s.building.masses[s.floor];
+        }
+        a
+    }
+
     /// The same frame without its damper: no container, no balls (the paper's "without
     /// damper" curves of Figs. 8-11).
     pub fn without_damper(&self) -> Scene {
