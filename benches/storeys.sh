@@ -1,13 +1,15 @@
 #!/bin/bash
-# The reference on structures of several storeys (docs/BENCHMARKS.md "Structures of several
+# A model on structures of several storeys (docs/BENCHMARKS.md "Structures of several
 # storeys"): a uniform shear building of N storeys (1.35 kg floors, the fundamental mode at the
 # paper's 4.03 Hz, every mode damped 1.6 %) with the paper's LSL damper on its top floor, shaken
 # for 20 s by records/synthetic-kt.csv scaled to 0.5 m/s^2; the computing time of each run
 # (best of three) against N, per simulated second and per impact, and the same building alone.
-#   bash benches/storeys.sh [LPC] [STOREYS]   (default: target/release/lpc, "1 2 3 5 10 20")
+# MODEL (default reference) may be compliant, which integrates the floors with its balls.
+#   bash benches/storeys.sh [LPC] [STOREYS] [MODEL]   (default: target/release/lpc, "1 2 3 5 10 20", reference)
 set -euo pipefail
 lpc=${1:-target/release/lpc}
 storeys=${2:-1 2 3 5 10 20}
+model=${3:-reference}
 dir=$(mktemp -d)
 cp -r scenes/records "$dir/"
 echo "| storeys | impacts | with damper: ms (x real time) | per impact | building alone: ms |"
@@ -47,7 +49,7 @@ PY
   best() {
     local b=""
     for _ in 1 2 3; do
-      "$lpc" run "$1" --model reference --format json > "$dir/out.json"
+      "$lpc" run "$1" --model "$model" --format json > "$dir/out.json"
       b=$(python3 -c "import json,sys; s=json.load(open('$dir/out.json')); b='$b'; t=s['wall_time_s']; print(t if not b else min(t, float(b)))")
     done
     echo "$b"

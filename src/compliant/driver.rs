@@ -63,7 +63,16 @@ impl<'s, 'a> Driver<'s, 'a> {
     pub(super) fn new(sys: &'s System<'a>, record: Record) -> Self {
         let scene = sys.scene;
         let mut y = vec![0.0; sys.len()];
-        if sys.has_frame() {
+        if let Some(floors) = &sys.floors {
+            // The floors start relative to the ground; the carrying floor is carried absolute.
+            let (xg, vg, _) = scene.ground_motion(0.0);
+            let s = floors.structure;
+            for j in 0..floors.count() {
+                let ground = if j == s.floor { (xg, vg) } else { (0.0, 0.0) };
+                y[floors.x(j)] = s.initial_displacements[j] + ground.0;
+                y[floors.v(j)] = s.initial_velocities[j] + ground.1;
+            }
+        } else if sys.has_frame() {
             y[XS] = scene.initial_displacement;
         }
         for i in 0..sys.n {
@@ -106,11 +115,17 @@ impl<'s, 'a> Driver<'s, 'a> {
             return;
         }
         sys.factor(self.t, &self.y, &self.dy, v_max, h * rosenbrock::GAMMA, &mut self.stage);
-        let ft = match sys.scene.forcing {
-            Some(g) => {
-                // Only the excitation depends on time: a central difference over a ten-thousandth
-                // of its radian period is exact to about 1e-9 of it.
-                let dt = 1e-4 / g.omega();
+        // Only the excitation depends on time: a central difference over a ten-thousandth of
+        // its radian period (or of the fastest floor's, for a record linear between its points)
+        // is exact to about 1e-9 of it.
+        let moving_ground = sys.floors.as_ref().filter(|f| f.structure.ground.is_some());
+        let time_step = match (sys.scene.forcing, moving_ground) {
+            (Some(g), _) => Some(1e-4 / g.omega()),
+            (None, Some(f)) => Some(1e-4 / f.fastest),
+            (None, None) => None,
+        };
+        let ft = match time_step {
+            Some(dt) => {
                 sys.rhs(self.t + dt, &self.y, &mut self.ft_ahead, v_max);
                 sys.rhs(self.t - dt, &self.y, &mut self.ft, v_max);
                 for (d, a) in self.ft.iter_mut().zip(&self.ft_ahead) {
@@ -182,6 +197,12 @@ impl<'s, 'a> Driver<'s, 'a> {
         let (ex, ev) = ((tol * length).max(ulps), tol * speed);
         self.scale[XS] = if sys.has_frame() { ex } else { f64::INFINITY };
         self.scale[VS] = if sys.has_frame() { ev } else { f64::INFINITY };
+        if let Some(floors) = &sys.floors {
+            for j in 0..floors.count() {
+                self.scale[floors.x(j)] = ex;
+                self.scale[floors.v(j)] = ev;
+            }
+        }
         for i in 0..sys.n {
             self.scale[sys.x(i)] = ex;
             self.scale[sys.v(i)] = ev;
@@ -194,7 +215,7 @@ impl<'s, 'a> Driver<'s, 'a> {
         let sys = self.sys;
         let mut bound = sys.h_max;
         let mut contact_bound = f64::INFINITY;
-        let frame_accel = if sys.has_frame() { sys.frame_accel_bound(self.t, self.y[XS], self.y[VS]) } else { 0.0 };
+        let frame_accel = if sys.has_frame() { sys.frame_accel_bound(self.t, &self.y) } else { 0.0 };
         for (q, pair) in sys.pairs.iter().enumerate() {
             let (d, rate) = sys.overlap(pair, |i| self.y[i]);
             if let Some(c) = &self.contacts[q] {

@@ -13,7 +13,7 @@
 //! and one Schur complement. The integrals (damper and forcing work, contact dissipation)
 //! depend on the bodies but nothing depends on them: their increments follow explicitly.
 
-use super::system::{Pair, Side, System, VS, XS};
+use super::system::{Floors, Pair, Side, System, VS, XS};
 
 /// One contact's partial derivatives at the start of a step.
 #[derive(Debug, Clone, Copy, Default)]
@@ -53,6 +53,19 @@ pub(super) struct Stage {
     /// Scratch: the right-hand side over the balls, and the balls' diagonal.
     rhs: Vec<f64>,
     diag: Vec<f64>,
+    /// A structure's floors: their matrix less the border's Schur term on the carrying floor,
+    /// factored, and the derivatives of the damper and forcing powers by each floor's
+    /// displacement and velocity.
+    floors: Option<FloorStage>,
+}
+
+/// The floors' part of a factored stage.
+#[derive(Debug, Clone)]
+struct FloorStage {
+    lu: nalgebra::LU<f64, nalgebra::Dyn, nalgebra::Dyn>,
+    damping_dv: Vec<f64>,
+    forcing_dx: Vec<f64>,
+    forcing_dv: Vec<f64>,
 }
 
 impl System<'_> {
@@ -124,7 +137,9 @@ impl System<'_> {
         stage.border.resize(n, 0.0);
         let mut frame_diag = 0.0;
         (stage.frame_kx, stage.frame_kv, stage.damping_dv, stage.forcing_dx, stage.forcing_dv) = (0.0, 0.0, 0.0, 0.0, 0.0);
-        if let Some(f) = self.scene.frame {
+        if self.floors.is_some() {
+            // The floors' own terms are added by `factor_floors`.
+        } else if let Some(f) = self.scene.frame {
             let (yd, force) = match self.scene.forcing {
                 Some(g) => (g.ground(t).1, g.force(t)),
                 None => (0.0, 0.0),
@@ -170,8 +185,31 @@ impl System<'_> {
         Self::thomas(stage, true);
         let coupling: f64 = stage.border.iter().zip(&stage.border_solved).map(|(c, w)| c * w).sum();
         stage.schur = frame_diag - coupling;
+        stage.floors = self.floors.as_ref().map(|floors| self.factor_floors(floors, t, y, hg, frame_diag - coupling));
         stage.rhs.resize(n, 0.0);
         stage.diag = diag;
+    }
+
+    /// The floors' stage matrix `M / hg + hg K + C`, with `contacts` (the balls' contact terms
+    /// less their Schur complement) added on the carrying floor, factored; and the partials of
+    /// the storeys' dissipation `v^T C v` and of the excitation's power
+    /// `vg sum(-(K u + C v)) + F vs`.
+    fn factor_floors(&self, floors: &Floors, t: f64, y: &[f64], hg: f64, contacts: f64) -> FloorStage {
+        let structure = floors.structure;
+        let b = &structure.building;
+        let (d, n) = (structure.floor, floors.count());
+        let mut matrix = &floors.stiffness * hg + &b.damping;
+        for j in 0..n {
+            matrix[(j, j)] += b.masses[j] / hg;
+        }
+        matrix[(d, d)] += contacts;
+        let (xg, vg, _) = self.scene.ground_motion(t);
+        let (_, v) = floors.relative(|i| y[i], (xg, vg));
+        let damping_dv = (0..n).map(|k| 2.0 * (0..n).map(|j| b.damping[(k, j)] * v[j]).sum::<f64>()).collect();
+        let forcing_dx = (0..n).map(|k| -vg * floors.stiffness.column(k).sum()).collect();
+        let force = self.scene.forcing.map_or(0.0, |g| g.force(t));
+        let forcing_dv = (0..n).map(|k| -vg * b.damping.column(k).sum() + if k == d { force } else { 0.0 }).collect();
+        FloorStage { lu: matrix.lu(), damping_dv, forcing_dx, forcing_dv }
     }
 
     /// Solves the balls' tridiagonal system in place, on `border_solved` or on `rhs`.
@@ -195,7 +233,9 @@ impl System<'_> {
             stage.rhs[i] = self.mass[i] * r[self.v(i)];
         }
         let mut frame_rhs = 0.0;
-        if self.has_frame() {
+        if self.floors.is_some() {
+            // The carrying floor's own terms come with the other floors'.
+        } else if self.has_frame() {
             frame_rhs = self.frame_mass * r[VS] + hg * stage.frame_kx * r[XS];
         }
         let position = |side: Side, r: &[f64]| match side {
@@ -217,6 +257,11 @@ impl System<'_> {
         }
         // Balls, then the frame by its Schur complement, then the balls' correction.
         Self::thomas(stage, false);
+        if let (Some(floors), Some(fs)) = (&self.floors, stage.floors.take()) {
+            self.solve_floors(floors, &fs, stage, r, frame_rhs);
+            stage.floors = Some(fs);
+            return;
+        }
         let frame_u = if self.has_frame() {
             let u = (frame_rhs - stage.border.iter().zip(&stage.rhs).map(|(c, z)| c * z).sum::<f64>()) / stage.schur;
             for (z, w) in stage.rhs.iter_mut().zip(&stage.border_solved) {
@@ -237,7 +282,57 @@ impl System<'_> {
             r[VS] *= hg;
             r[XS] *= hg;
         }
-        // The integrals: u_q = hg (r_q + J_q u), J_q acting on the increments just found.
+        self.solve_integrals(stage, r);
+        let (dw, fw) = (self.damping_work(), self.forcing_work());
+        r[dw] = hg * (r[dw] + stage.damping_dv * r[VS]);
+        r[fw] = hg * (r[fw] + stage.forcing_dx * r[XS] + stage.forcing_dv * r[VS]);
+    }
+
+    /// [`System::solve`] for the floors of a structure, once the balls' system is solved on
+    /// `stage.rhs`: the floors' velocity increments from their factored matrix, with
+    /// `contact_rhs` (the contacts' terms) on the carrying floor, then the balls' correction.
+    fn solve_floors(&self, floors: &Floors, fs: &FloorStage, stage: &mut Stage, r: &mut [f64], contact_rhs: f64) {
+        let (n, hg) = (self.n, stage.hg);
+        let structure = floors.structure;
+        let b = &structure.building;
+        let (d, count) = (structure.floor, floors.count());
+        // Velocity equations times each floor's mass: m r_v - hg (K r_x).
+        let mut rhs = nalgebra::DVector::from_iterator(
+            count,
+            (0..count).map(|j| {
+                let spring: f64 = (0..count).map(|k| floors.stiffness[(j, k)] * r[floors.x(k)]).sum();
+                b.masses[j] * r[floors.v(j)] - hg * spring
+            }),
+        );
+        rhs[d] += contact_rhs - stage.border.iter().zip(&stage.rhs).map(|(c, z)| c * z).sum::<f64>();
+        let w = fs.lu.solve(&rhs).unwrap_or_else(|| nalgebra::DVector::from_element(count, f64::NAN));
+        for (z, c) in stage.rhs.iter_mut().zip(&stage.border_solved) {
+            *z -= c * w[d];
+        }
+        for i in 0..n {
+            r[self.v(i)] = stage.rhs[i];
+            r[self.x(i)] = hg * (r[self.x(i)] + stage.rhs[i]);
+        }
+        for j in 0..count {
+            r[floors.v(j)] = w[j];
+            r[floors.x(j)] = hg * (r[floors.x(j)] + w[j]);
+        }
+        self.solve_integrals(stage, r);
+        let (dw, fw) = (self.damping_work(), self.forcing_work());
+        let (mut damping, mut forcing) = (0.0, 0.0);
+        for j in 0..count {
+            let (x, v) = (r[floors.x(j)], r[floors.v(j)]);
+            damping += fs.damping_dv[j] * v;
+            forcing += fs.forcing_dx[j] * x + fs.forcing_dv[j] * v;
+        }
+        r[dw] = hg * (r[dw] + damping);
+        r[fw] = hg * (r[fw] + forcing);
+    }
+
+    /// The contacts' dissipation integrals of [`System::solve`]: `u_q = hg (r_q + J_q u)`, `J_q`
+    /// acting on the bodies' increments just found.
+    fn solve_integrals(&self, stage: &Stage, r: &mut [f64]) {
+        let hg = stage.hg;
         let edge = |side: Side, r: &[f64]| match side {
             Side::Ball(i) => (r[self.x(i)], r[self.v(i)]),
             Side::Wall(_) => (r[XS], r[VS]),
@@ -251,9 +346,6 @@ impl System<'_> {
                 r[self.dissipation(pair.p)] += hg * (p.gd * (xl - xr) + p.gr * (vl - vr));
             }
         }
-        let (dw, fw) = (self.damping_work(), self.forcing_work());
-        r[dw] = hg * (r[dw] + stage.damping_dv * r[VS]);
-        r[fw] = hg * (r[fw] + stage.forcing_dx * r[XS] + stage.forcing_dv * r[VS]);
     }
 }
 
@@ -261,7 +353,7 @@ impl System<'_> {
 mod tests {
     use super::super::system::{System, VS, XS};
     use super::Stage;
-    use crate::scene::{load_scene, scenes_dir};
+    use crate::scene::{load_scene, scenes_dir, Scene};
 
     /// The analytic Jacobian and the bordered tridiagonal solve against central differences
     /// of the derivative: every pair pressed (both walls too), a base-excited frame, so every
@@ -270,7 +362,18 @@ mod tests {
     /// `ulp(x) / delta` are both about 1e-8 here).
     #[test]
     fn solve_inverts_the_stage_matrix_of_finite_differences() {
-        let mut scene = load_scene(scenes_dir().join("forced-lsl.toml")).unwrap();
+        check_stage(load_scene(scenes_dir().join("forced-lsl.toml")).unwrap());
+    }
+
+    /// The same for the floors of a building shaken by a record, the damper on its top floor:
+    /// the floors' block, its coupling to the balls through the walls, and the storeys'
+    /// dissipation and the ground's work.
+    #[test]
+    fn solve_inverts_the_stage_matrix_of_a_building() {
+        check_stage(load_scene(scenes_dir().join("mdof-3storey-record.toml")).unwrap());
+    }
+
+    fn check_stage(mut scene: Scene) {
         let diameters: f64 = scene.balls.iter().map(|b| 2.0 * b.radius).sum();
         let mut container = scene.container.unwrap();
         // Shorter than the balls by 80 um: the walls and the balls all press each other.
@@ -288,6 +391,14 @@ mod tests {
             y[sys.v(i)] = 0.1 * (i as f64 - 1.0);
             x += scene.balls[i].radius - 2e-5;
         }
+        let mut floor_positions = Vec::new();
+        if let Some(floors) = &sys.floors {
+            for j in (0..floors.count()).filter(|&j| j != floors.structure.floor) {
+                y[floors.x(j)] = 1e-3 * (0.5 + j as f64);
+                y[floors.v(j)] = 0.03 * (1.0 - j as f64);
+                floor_positions.push(floors.x(j));
+            }
+        }
         for pair in &sys.pairs {
             assert!(sys.overlap(pair, |i| y[i]).0 > 0.0, "pair {} does not press", pair.p);
         }
@@ -300,10 +411,11 @@ mod tests {
         sys.factor(t, &y, &dy, &v_max, hg, &mut stage);
         // A direction with every component moving, the integrals' too, positions by about `hg`
         // times velocities as in a step (so that neither half of the matrix swamps the other).
-        let position = |k: usize| k == XS || (2..2 + n).contains(&k);
+        let integral = |k: usize| (sys.damping_work()..sys.dissipation(sys.slots.count())).contains(&k);
+        let position = |k: usize| k == XS || (2..2 + n).contains(&k) || floor_positions.contains(&k);
         let u: Vec<f64> = (0..y.len())
             .map(|k| match k {
-                k if k >= 2 + 2 * n => 0.5,
+                k if integral(k) => 0.5,
                 k if position(k) => hg * 1e-6 * (1.0 + 0.37 * k as f64).sin(),
                 k => 1e-6 * (1.0 + 0.37 * k as f64).sin(),
             })
@@ -311,7 +423,7 @@ mod tests {
         let mut ju = vec![0.0; y.len()];
         let (mut ahead, mut behind) = (vec![0.0; y.len()], vec![0.0; y.len()]);
         for k in 0..y.len() {
-            let delta = if k >= 2 + 2 * n {
+            let delta = if integral(k) {
                 1.0
             } else if position(k) {
                 1e-9
@@ -331,7 +443,7 @@ mod tests {
         sys.solve(&mut stage, &mut r);
         let scale = u.iter().fold(0.0f64, |m, v| m.max(v.abs()));
         for k in 0..y.len() {
-            let of = if k >= 2 + 2 * n {
+            let of = if integral(k) {
                 scale
             } else if position(k) {
                 hg * 1e-6

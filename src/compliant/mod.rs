@@ -55,14 +55,14 @@ impl Simulator for Compliant {
     }
 
     fn supports(&self, scene: &Scene) -> Result<(), String> {
-        if scene.structure.is_some() {
-            return Err("it integrates a frame of one storey under free vibration or a sine; structures of several storeys and ground-motion records run with the reference model".into());
-        }
         let tolerance = scene.compliant.tolerance;
         if !(tolerance > 0.0 && tolerance <= 1e-2) {
             return Err(format!("its error tolerance must lie in (0, 1e-2] (got {})", crate::scene::human(tolerance)));
         }
         match scene.space.beyond_lines(&scene.initial_positions) {
+            Some(_) if scene.structure.is_some() => Err(
+                "it moves balls beyond their lines on a frame of one storey only; on a structure of several storeys or under a ground-motion record its balls must stay on their lines".into(),
+            ),
             Some(_) => spatial::refusal(scene).map_or(Ok(()), Err),
             None => Ok(()),
         }

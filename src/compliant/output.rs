@@ -28,6 +28,14 @@ impl Driver<'_, '_> {
                 }
                 &buf
             };
+            if let Some(floors) = &sys.floors {
+                // A structure is written in the ground's frame.
+                let (xg, vg, _) = sys.scene.ground_motion(ts);
+                let (u, v) = floors.relative(|i| state[i], (xg, vg));
+                self.recorder.sample_floors(sys.scene, ts, (&u, &v), (xg, vg), |i| (state[sys.x(i)], state[sys.v(i)]));
+                self.next_sample += 1;
+                continue;
+            }
             let (xs, vs) = if sys.has_frame() { (state[XS], state[VS]) } else { (0.0, 0.0) };
             self.recorder.sample(sys.scene, ts, xs, vs, |i| (state[sys.x(i)], state[sys.v(i)]));
             self.next_sample += 1;

@@ -4,7 +4,8 @@
 
 use super::contact;
 use super::FLOOR_SPEED_FRACTION;
-use crate::scene::{Body, Pairs, Scene};
+use crate::scene::{Body, Pairs, Scene, Structure};
+use nalgebra::DMatrix;
 
 /// One side of a pair.
 #[derive(Debug, Clone, Copy)]
@@ -58,6 +59,56 @@ pub(super) struct System<'a> {
     /// Shortest step the closing bound may ask for (a tenth of the shortest contact time scale
     /// at `v_scale`): pairs touching at rest would otherwise shrink steps to nothing.
     pub(super) h_floor: f64,
+    /// A structure's floors, when the frame is the floor of a building that carries it.
+    pub(super) floors: Option<Floors<'a>>,
+}
+
+/// A structure of several storeys (or one under a ground record) as the ODE carries it. The
+/// carrying floor is the frame (`XS`, `VS`: absolute, as the balls are); every other floor's
+/// displacement and velocity relative to the ground follow the contact dissipations.
+pub(super) struct Floors<'a> {
+    pub(super) structure: &'a Structure,
+    /// `K`, N/m.
+    pub(super) stiffness: DMatrix<f64>,
+    /// Index of the first other floor's displacement in the state.
+    base: usize,
+    /// The fastest undamped mode's rate, rad/s.
+    pub(super) fastest: f64,
+    /// Largest `|ag|` of the ground's record, m/s^2.
+    peak_ground: f64,
+}
+
+impl Floors<'_> {
+    /// Number of floors.
+    pub(super) fn count(&self) -> usize {
+        self.structure.floors()
+    }
+    /// State index of floor `j`'s displacement (the carrying floor's is `XS`).
+    pub(super) fn x(&self, j: usize) -> usize {
+        let d = self.structure.floor;
+        match j.cmp(&d) {
+            std::cmp::Ordering::Equal => XS,
+            std::cmp::Ordering::Less => self.base + j,
+            std::cmp::Ordering::Greater => self.base + j - 1,
+        }
+    }
+    /// State index of floor `j`'s velocity (the carrying floor's is `VS`).
+    pub(super) fn v(&self, j: usize) -> usize {
+        if j == self.structure.floor {
+            VS
+        } else {
+            self.x(j) + self.count() - 1
+        }
+    }
+    /// The floors' displacements and velocities relative to the ground, read through `get`,
+    /// the ground at `(xg, vg)`.
+    pub(super) fn relative(&self, get: impl Fn(usize) -> f64, (xg, vg): (f64, f64)) -> (Vec<f64>, Vec<f64>) {
+        let d = self.structure.floor;
+        let n = self.count();
+        let u = (0..n).map(|j| get(self.x(j)) - if j == d { xg } else { 0.0 }).collect();
+        let v = (0..n).map(|j| get(self.v(j)) - if j == d { vg } else { 0.0 }).collect();
+        (u, v)
+    }
 }
 
 pub(super) const XS: usize = 0;
@@ -109,6 +160,20 @@ impl<'a> System<'a> {
         if let Some(g) = scene.forcing {
             h_max = h_max.min(1.0 / (20.0 * g.frequency));
         }
+        let floors = scene.structure.as_deref().map(|structure| {
+            let (omegas, _) = structure.building.undamped_modes();
+            let fastest = omegas.iter().fold(0.0, |m: f64, w| m.max(*w));
+            Floors {
+                structure,
+                stiffness: structure.building.stiffness(),
+                base: 4 + 2 * n + slots.count(),
+                fastest,
+                peak_ground: structure.ground.as_ref().map_or(0.0, |g| g.peak()),
+            }
+        });
+        if let Some(f) = &floors {
+            h_max = h_max.min(2.0 * std::f64::consts::PI / f.fastest / 20.0);
+        }
         System {
             scene,
             n,
@@ -123,11 +188,12 @@ impl<'a> System<'a> {
             length_scale,
             h_max,
             h_floor,
+            floors,
         }
     }
 
     pub(super) fn len(&self) -> usize {
-        4 + 2 * self.n + self.slots.count()
+        4 + 2 * self.n + self.slots.count() + self.floors.as_ref().map_or(0, |f| 2 * (f.count() - 1))
     }
     pub(super) fn x(&self, i: usize) -> usize {
         2 + i
@@ -196,7 +262,9 @@ impl<'a> System<'a> {
         for i in 0..self.n {
             dy[self.v(i)] /= self.mass[i];
         }
-        if self.has_frame() {
+        if let Some(floors) = &self.floors {
+            self.floors_rhs(floors, t, y, dy, frame_contact);
+        } else if self.has_frame() {
             let (xs, vs) = (y[XS], y[VS]);
             dy[XS] = vs;
             dy[VS] = (self.scene.frame_force(t, xs, vs) + frame_contact) / self.frame_mass;
@@ -205,9 +273,32 @@ impl<'a> System<'a> {
         }
     }
 
+    /// The floors' part of the derivative: the carrying floor's absolute acceleration with the
+    /// balls' contact force `contact` on it, the other floors' relative ones, the storeys'
+    /// dissipation and the excitation's power (docs/MODEL.md §16).
+    fn floors_rhs(&self, floors: &Floors, t: f64, y: &[f64], dy: &mut [f64], contact: f64) {
+        let structure = floors.structure;
+        let (d, n) = (structure.floor, floors.count());
+        let (xg, vg, ag) = self.scene.ground_motion(t);
+        let (u, v) = floors.relative(|i| y[i], (xg, vg));
+        let restoring = structure.building.restoring_forces(&u, &v);
+        let force = self.scene.forcing.map_or(0.0, |g| g.force(t));
+        for j in 0..n {
+            dy[floors.x(j)] = y[floors.v(j)];
+            let m = structure.building.masses[j];
+            dy[floors.v(j)] = if j == d { (restoring[j] + contact + force) / m } else { restoring[j] / m - ag };
+        }
+        dy[self.damping_work()] = structure.building.damping_power(&v);
+        dy[self.forcing_work()] = vg * restoring.iter().sum::<f64>() + force * y[VS];
+    }
+
     /// A bound on the frame's smooth acceleration over the next while: now, plus what the
     /// spring and damper can give at the frame's amplitude, plus the largest excitation.
-    pub(super) fn frame_accel_bound(&self, t: f64, xs: f64, vs: f64) -> f64 {
+    pub(super) fn frame_accel_bound(&self, t: f64, y: &[f64]) -> f64 {
+        if let Some(floors) = &self.floors {
+            return self.floor_accel_bound(floors, t, y);
+        }
+        let (xs, vs) = (y[XS], y[VS]);
         let Some(f) = self.scene.frame else { return 0.0 };
         let w0sq = f.stiffness / f.mass;
         let amp = if w0sq > 0.0 { (xs * xs + vs * vs / w0sq).sqrt() } else { xs.abs() };
@@ -218,9 +309,46 @@ impl<'a> System<'a> {
         self.scene.frame_acceleration(t, xs, vs).abs() + w0sq * amp + (f.damping * vs.abs() + forcing) / f.mass
     }
 
+    /// [`System::frame_accel_bound`] on a structure: the carrying floor's acceleration now, plus
+    /// what its storeys can give with the floors anywhere their relative energy `E` lets them
+    /// be (each storey's drift at most `sqrt(2 E / k_min)`, so `|u_j| <= n` times that, and
+    /// `|v_j| <= sqrt(2 E / m_j)`),
+    /// plus the ground's and the sine's largest.
+    fn floor_accel_bound(&self, floors: &Floors, t: f64, y: &[f64]) -> f64 {
+        let structure = floors.structure;
+        let b = &structure.building;
+        let (d, n) = (structure.floor, floors.count());
+        let (xg, vg, ag) = self.scene.ground_motion(t);
+        let (u, v) = floors.relative(|i| y[i], (xg, vg));
+        let m = b.masses[d];
+        let energy = structure.energy(&u, &v, 0.0);
+        let k_min = b.stiffnesses.iter().fold(f64::INFINITY, |a, k| a.min(*k));
+        let u_max = (n as f64) * (2.0 * energy / k_min).sqrt();
+        let spring = (0..n).map(|j| floors.stiffness[(d, j)].abs()).sum::<f64>() * u_max;
+        let damper: f64 = (0..n).map(|j| b.damping[(d, j)].abs() * (2.0 * energy / b.masses[j]).sqrt()).sum();
+        let force = self.scene.forcing.map_or(0.0, |g| if g.kind == crate::scene::ForcingKind::Force { g.amplitude } else { 0.0 });
+        let base = self.scene.forcing.map_or(0.0, |g| {
+            if g.kind == crate::scene::ForcingKind::Base {
+                g.amplitude * g.omega() * g.omega()
+            } else {
+                0.0
+            }
+        });
+        let now = self.scene.floor_accelerations(t, &u, &v)[d];
+        now.abs() + (spring + damper + force) / m + ag.abs().max(floors.peak_ground) + base
+    }
+
     /// Mechanical energy: frame, balls, and elastic energy in open contacts.
     pub(super) fn energy(&self, t: f64, y: &[f64]) -> f64 {
-        let frame = if self.has_frame() { self.scene.frame_energy(t, y[XS], y[VS]) } else { 0.0 };
+        let frame = match &self.floors {
+            Some(floors) => {
+                let (xg, vg, _) = self.scene.ground_motion(t);
+                let (u, v) = floors.relative(|i| y[i], (xg, vg));
+                floors.structure.energy(&u, &v, vg)
+            }
+            None if self.has_frame() => self.scene.frame_energy(t, y[XS], y[VS]),
+            None => 0.0,
+        };
         let balls: f64 = (0..self.n).map(|i| 0.5 * self.mass[i] * y[self.v(i)] * y[self.v(i)]).sum();
         let elastic: f64 = self.pairs.iter().map(|p| contact::elastic_energy(p.k, self.overlap(p, |i| y[i]).0)).sum();
         frame + balls + elastic

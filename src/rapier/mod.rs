@@ -55,7 +55,7 @@ pub struct Rapier;
 
 /// Why the model refuses a structure of several storeys or a ground-motion record.
 const STRUCTURES_NOT_YET: &str =
-    "it moves a frame of one storey under free vibration or a sine; structures of several storeys and ground-motion records run with the reference model";
+    "it moves a frame of one storey under free vibration or a sine; structures of several storeys and ground-motion records run with the reference and compliant models";
 
 impl Simulator for Rapier {
     fn model(&self) -> Model {

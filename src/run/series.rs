@@ -392,6 +392,45 @@ impl Recorder {
             tally.add(t, xs, a, energy);
         }
     }
+    /// The sample at `t` of a scene with a structure, in the ground's frame as
+    /// [`Recorder::sample_interval_with_floors`] writes it: the floors at `u` and moving at `v`
+    /// relative to the ground, the ground at `(xg, vg)`, and each ball at its inertial `(x, v)`
+    /// from `ball(i)`.
+    pub fn sample_floors(
+        &mut self,
+        scene: &Scene,
+        t: f64,
+        (u, v): (&[f64], &[f64]),
+        (xg, vg): (f64, f64),
+        ball: impl Fn(usize) -> (f64, f64),
+    ) {
+        let s = scene.structure.as_deref().expect("floors come with a structure");
+        let a = scene.floor_accelerations(t, u, v);
+        if let Some(series) = &mut self.series {
+            series.floor_count = s.floors();
+            if self.taken.is_multiple_of(series.every.max(1)) {
+                series.floors.extend_from_slice(u);
+                series.floors.extend_from_slice(v);
+                series.floors.extend_from_slice(&a);
+            }
+        }
+        let energy = s.energy(u, v, 0.0);
+        let d = s.floor;
+        self.sample_with(
+            t,
+            u[d],
+            v[d],
+            a[d],
+            |_, _, _| energy,
+            |i| {
+                let (x, w) = ball(i);
+                (x - xg, w - vg)
+            },
+        );
+        if let Some(tally) = &mut self.tally {
+            tally.add_floors(t, u);
+        }
+    }
     /// The balls' centres across the motion, `[y, z]` from `across(i)`, at the sample
     /// [`Recorder::sample`] has just taken (kept with it, or not at all).
     pub fn sample_across(&mut self, across: impl Fn(usize) -> [f64; 2]) {

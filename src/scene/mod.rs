@@ -251,6 +251,25 @@ impl Scene {
         }
     }
 
+    /// The ground's displacement, velocity and acceleration under a structure at `t`: its
+    /// record's exact integrals plus a sine base motion `Y sin w t`, m, m/s and m/s^2 (zero when
+    /// neither moves it). The ground every model moves a structure's floors against.
+    pub fn ground_motion(&self, t: f64) -> (f64, f64, f64) {
+        let (mut x, mut v, mut a) = match self.structure.as_ref().and_then(|s| s.ground.as_ref()) {
+            Some(record) => {
+                let stretch = record.stretch(t);
+                stretch.at(t - stretch.start)
+            }
+            None => (0.0, 0.0, 0.0),
+        };
+        if let Some(g) = self.forcing.filter(|g| g.kind == ForcingKind::Base) {
+            let (y, yd) = g.ground(t);
+            x += y;
+            v += yd;
+            a -= g.omega() * g.omega() * y;
+        }
+        (x, v, a)
+    }
     /// A structure's floors' absolute accelerations at `t` without impulses and contact
     /// forces, with the floors at `u` and moving at `v` relative to the ground: the storeys'
     /// `-M^-1 (C v + K u)` plus a sine force on the carrying floor, m/s^2.

@@ -2,7 +2,7 @@
 //! acceleration without the force. The recorder took the floors' accelerations from the
 //! storeys' springs and dampers alone; it now takes them from the scene's one rule,
 //! `Scene::floor_accelerations`, which adds the force. Checked against the derivative of the
-//! floor's own velocity.
+//! floor's own velocity, for both models that move floors.
 
 use lpc_damper::model::{Model, RunOptions};
 
@@ -16,7 +16,7 @@ fn a_forced_floor_reports_the_force_in_its_acceleration() {
     let (omegas, _) = structure.building.undamped_modes();
     let fastest = omegas.iter().fold(0.0f64, |m, w| m.max(*w));
     let dt = scene.sample_dt;
-    for model in [Model::Reference] {
+    for model in [Model::Reference, Model::Compliant] {
         let run = model.simulate(&scene, &RunOptions::default()).unwrap();
         let s = &run.series;
         let (v, a) = (s.vs(), s.a());
