@@ -52,6 +52,44 @@ pub struct FrfPoint {
     pub impacts_per_period: Option<f64>,
     /// Why a run at this frequency failed, when one did.
     pub error: Option<String>,
+    /// A structure's every floor's steady amplitude relative to the ground with the damper,
+    /// bottom to top, m, read over the window the carrying floor's is (absent for a frame).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub floors: Option<Vec<f64>>,
+    /// The same without the damper.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub floors_no_damper: Option<Vec<f64>>,
+}
+
+/// One floor at one frequency of a structure's response (a row of `lpc frf`'s `frf-floors.csv`).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct FloorAmplitude {
+    /// Forcing frequency, Hz.
+    pub frequency: f64,
+    /// Floor, 1 at the bottom.
+    pub floor: usize,
+    /// Steady amplitude relative to the ground with the damper, m.
+    pub amplitude: Option<f64>,
+    /// Without the damper, m.
+    pub amplitude_no_damper: Option<f64>,
+}
+
+/// The floors of `points`, a row per frequency and floor (empty for a frame).
+pub fn floor_rows(points: &[FrfPoint]) -> Vec<FloorAmplitude> {
+    let mut rows = Vec::new();
+    for p in points {
+        let count = p.floors.as_ref().or(p.floors_no_damper.as_ref()).map_or(0, |f| f.len());
+        for i in 0..count {
+            let at = |f: &Option<Vec<f64>>| f.as_ref().and_then(|f| f.get(i).copied());
+            rows.push(FloorAmplitude {
+                frequency: p.frequency,
+                floor: i + 1,
+                amplitude: at(&p.floors),
+                amplitude_no_damper: at(&p.floors_no_damper),
+            });
+        }
+    }
+    rows
 }
 
 /// The steady-state reading of one run.
@@ -116,6 +154,44 @@ pub fn steady_run(scene: &Scene, model: Model, limits: Limits) -> Result<(Steady
 
 /// [`steady_run`], with the per-period peaks of the last two blocks of the last run.
 pub fn steady_peaks(scene: &Scene, model: Model, limits: Limits) -> Result<(SteadyState, f64, Vec<f64>), ModelError> {
+    steady_runs(scene, model, limits).map(|(reading, horizon, peaks, _)| (reading, horizon, peaks))
+}
+
+/// A steady reading, the horizon it took, and each floor's amplitude (empty for a frame).
+pub type FloorsReading = (SteadyState, f64, Vec<f64>);
+
+/// [`steady_run`], with every floor's amplitude of a structure (empty for a frame): over the
+/// carrying floor's measuring window, each floor's mean peak when the response is steady and
+/// its largest otherwise, as for the carrying floor.
+pub fn steady_floors(scene: &Scene, model: Model, limits: Limits) -> Result<FloorsReading, ModelError> {
+    let period = 1.0 / scene.forcing.expect("a forced scene").frequency;
+    let (reading, horizon, _, run) = steady_runs(scene, model, limits)?;
+    let s = &run.series;
+    let periods = (run.horizon / period).floor() as usize;
+    let window = periods.min(BLOCK_PERIODS);
+    let floors = (0..s.floor_count())
+        .map(|i| {
+            let mut peaks = vec![0.0f64; window];
+            for (k, t) in s.t().iter().enumerate() {
+                let j = (t / period) as usize;
+                if (periods - window..periods).contains(&j) {
+                    let (u, _, _) = s.floor(i, k).expect("a structure's series has its floors");
+                    peaks[j + window - periods] = peaks[j + window - periods].max(u.abs());
+                }
+            }
+            let largest = peaks.iter().fold(0.0, |m: f64, p| m.max(*p));
+            if reading.steady {
+                peaks.iter().sum::<f64>() / window as f64
+            } else {
+                largest
+            }
+        })
+        .collect();
+    Ok((reading, horizon, floors))
+}
+
+/// [`steady_peaks`], with the last run.
+fn steady_runs(scene: &Scene, model: Model, limits: Limits) -> Result<(SteadyState, f64, Vec<f64>, Run), ModelError> {
     let period = 1.0 / scene.forcing.expect("a forced scene").frequency;
     let mut s = scene.clone();
     for doubling in 0..=MAX_DOUBLINGS {
@@ -133,7 +209,7 @@ pub fn steady_peaks(scene: &Scene, model: Model, limits: Limits) -> Result<(Stea
         let reading = steady_reading(&run, &peaks, period);
         if reading.steady || doubling == MAX_DOUBLINGS {
             let last = peaks[peaks.len().saturating_sub(2 * BLOCK_PERIODS)..].to_vec();
-            return Ok((reading, s.horizon, last));
+            return Ok((reading, s.horizon, last, run));
         }
         s.horizon *= 2.0;
     }
@@ -256,11 +332,11 @@ pub fn frequencies(from: f64, to: f64, steps: usize) -> Vec<f64> {
 pub fn frf(scene: &Scene, frequencies: &[f64], model: Model, limits: Limits, progress: &(dyn Fn() + Sync)) -> Vec<FrfPoint> {
     let bare = scene.without_damper();
     let jobs: Vec<(usize, bool)> = (0..frequencies.len()).flat_map(|k| [(k, true), (k, false)]).collect();
-    let results: Vec<Result<(SteadyState, f64), ModelError>> = jobs
+    let results: Vec<Result<FloorsReading, ModelError>> = jobs
         .par_iter()
         .map(|&(k, damper)| {
             let base = if damper { scene } else { &bare };
-            let r = steady_run(&forced_at(base, frequencies[k]), model, limits);
+            let r = steady_floors(&forced_at(base, frequencies[k]), model, limits);
             progress();
             r
         })
@@ -271,15 +347,19 @@ pub fn frf(scene: &Scene, frequencies: &[f64], model: Model, limits: Limits, pro
         .map(|(k, &frequency)| {
             let (with, without) = (&results[2 * k], &results[2 * k + 1]);
             let error = [with, without].iter().find_map(|r| r.as_ref().err()).map(|e| e.to_string());
+            let floors =
+                |r: &Result<(SteadyState, f64, Vec<f64>), ModelError>| r.as_ref().ok().map(|(_, _, f)| f.clone()).filter(|f| !f.is_empty());
             FrfPoint {
                 frequency,
-                amplitude: with.as_ref().ok().map(|(r, _)| r.amplitude),
-                amplitude_no_damper: without.as_ref().ok().map(|(r, _)| r.amplitude),
-                steady: with.as_ref().is_ok_and(|(r, _)| r.steady),
-                steady_no_damper: without.as_ref().is_ok_and(|(r, _)| r.steady),
-                horizon: with.as_ref().map_or(0.0, |(_, h)| *h),
-                impacts_per_period: with.as_ref().ok().map(|(r, _)| r.impacts_per_period),
+                amplitude: with.as_ref().ok().map(|(r, _, _)| r.amplitude),
+                amplitude_no_damper: without.as_ref().ok().map(|(r, _, _)| r.amplitude),
+                steady: with.as_ref().is_ok_and(|(r, _, _)| r.steady),
+                steady_no_damper: without.as_ref().is_ok_and(|(r, _, _)| r.steady),
+                horizon: with.as_ref().map_or(0.0, |(_, h, _)| *h),
+                impacts_per_period: with.as_ref().ok().map(|(r, _, _)| r.impacts_per_period),
                 error,
+                floors: floors(with),
+                floors_no_damper: floors(without),
             }
         })
         .collect()

@@ -99,11 +99,21 @@ pub fn run(a: Args) -> Result<ExitStatus> {
     let elapsed = start.elapsed().as_secs_f64();
     if let Some(dir) = &a.out {
         write_atomic(&dir.join("frf.json"), &serde_json::to_vec_pretty(&points)?).with_context(|| format!("writing {}", dir.display()))?;
+        // The carrying floor's columns; a structure's every floor goes to frf-floors.csv, a row
+        // per frequency and floor.
         let mut w = csv::Writer::from_writer(Vec::new());
         for p in &points {
-            w.serialize(p)?;
+            w.serialize(lpc_damper::studies::frf::FrfPoint { floors: None, floors_no_damper: None, ..p.clone() })?;
         }
         write_atomic(&dir.join("frf.csv"), &w.into_inner()?).with_context(|| format!("writing {}", dir.display()))?;
+        let floor_rows = lpc_damper::studies::frf::floor_rows(&points);
+        if !floor_rows.is_empty() {
+            let mut w = csv::Writer::from_writer(Vec::new());
+            for row in &floor_rows {
+                w.serialize(row)?;
+            }
+            write_atomic(&dir.join("frf-floors.csv"), &w.into_inner()?).with_context(|| format!("writing {}", dir.display()))?;
+        }
         let fig = lpc_damper::output::figures::frf_chart(&points, &scene.name, a.model.name());
         lpc_damper::output::figures::write(&fig, dir, (900, 560))?;
     }
@@ -143,11 +153,26 @@ pub fn run(a: Args) -> Result<ExitStatus> {
                     format!("{}/{}", if p.steady { "yes" } else { "no" }, if p.steady_no_damper { "yes" } else { "no" }),
                 ]);
             }
+            let floor_rows = lpc_damper::studies::frf::floor_rows(&points);
+            if !floor_rows.is_empty() {
+                println!("every floor's steady amplitude relative to the ground (floor 1 at the bottom)");
+                let table = Table::new(vec![right("f Hz", 10), right("floor", 6), right("amp mm", 14), right("no damper mm", 14)]);
+                table.print_header();
+                for row in &floor_rows {
+                    table.print_row(&[
+                        format!("{:.4}", row.frequency),
+                        row.floor.to_string(),
+                        mm(row.amplitude),
+                        mm(row.amplitude_no_damper),
+                    ]);
+                }
+            }
             for p in points.iter().filter(|p| p.error.is_some()) {
                 println!("{} Hz failed: {}", lpc_damper::scene::human(p.frequency), p.error.as_deref().unwrap_or_default());
             }
             if let Some(dir) = &a.out {
-                println!("wrote frf.json, frf.csv, frf.png, frf.svg to {}", dir.display());
+                let floors = if floor_rows.is_empty() { "" } else { "frf-floors.csv, " };
+                println!("wrote frf.json, frf.csv, {floors}frf.png, frf.svg to {}", dir.display());
             }
         }
     }
