@@ -17,6 +17,16 @@ pub type C64 = Complex<f64>;
 /// structure whose modes are (nearly) critically damped has no basis of modes to this accuracy.
 const DECOMPOSITION_RESIDUAL: f64 = 1e-9;
 
+/// What a piecewise-linear record drives: the ground's acceleration `ag` under every floor
+/// (`M u'' + C u' + K u = -M 1 ag`), or a force `f` on one floor (`... = e_j f`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Load {
+    /// The ground accelerates.
+    Ground,
+    /// A force acts on this floor (0 at the bottom).
+    Floor(usize),
+}
+
 /// How the storeys dissipate.
 #[derive(Debug, Clone, PartialEq)]
 pub enum StoreyDamping {
@@ -147,14 +157,15 @@ impl Building {
         u.iter().all(|x| x.re.is_finite() && x.im.is_finite()).then(|| u.iter().copied().collect())
     }
 
-    /// The state matrix's modes with `added` kg on floor `floor` (balls the floor carries).
-    pub fn modes(&self, floor: usize, added: f64) -> Result<Modes, String> {
-        Modes::new(self, floor, added)
+    /// The state matrix's modes with `added` kg on floor `floor` (balls the floor carries), and
+    /// the static responses to `load`.
+    pub fn modes(&self, floor: usize, added: f64, load: Load) -> Result<Modes, String> {
+        Modes::new(self, floor, added, load)
     }
 }
 
 /// The eigen-decomposition of a building's state matrix, and the static responses that give the
-/// particular solution under a linear ground acceleration.
+/// particular solution under a load (a ground acceleration or a floor's force) linear in time.
 #[derive(Debug, Clone)]
 pub struct Modes {
     /// Floors.
@@ -166,9 +177,10 @@ pub struct Modes {
     /// Eigenvectors, one column per eigenvalue (`2n x 2n`).
     pub vectors: DMatrix<C64>,
     inverse: DMatrix<C64>,
-    /// `r = K^-1 M 1`: the static displacement under a unit ground acceleration is `-r`.
+    /// The static displacement under a unit load is `-r`: `r = K^-1 M 1` for the ground's
+    /// acceleration, `r = -K^-1 e_j` for a force on floor `j`.
     pub influence: Vec<f64>,
-    /// `K^-1 C r`: the lag of the response to a ground acceleration that grows linearly.
+    /// `K^-1 C r`: the lag of the response to a load that grows linearly.
     pub lag: Vec<f64>,
     /// Largest `|L|`, 1/s.
     pub rate: f64,
@@ -179,7 +191,7 @@ pub struct Modes {
 }
 
 impl Modes {
-    fn new(b: &Building, floor: usize, added: f64) -> Result<Modes, String> {
+    fn new(b: &Building, floor: usize, added: f64, load: Load) -> Result<Modes, String> {
         let n = b.floors();
         let mut masses = b.masses.clone();
         masses[floor] += added;
@@ -228,7 +240,11 @@ impl Modes {
             inverse.column_mut(i).scale_mut(s);
         }
         let kinv = k.clone().try_inverse().ok_or("the structure has a storey without stiffness")?;
-        let influence: Vec<f64> = (kinv.clone() * DVector::from_vec(masses.clone())).iter().copied().collect();
+        let pattern = match load {
+            Load::Ground => DVector::from_vec(masses.clone()),
+            Load::Floor(j) => DVector::from_fn(n, |i, _| if i == j { -1.0 } else { 0.0 }),
+        };
+        let influence: Vec<f64> = (kinv.clone() * pattern).iter().copied().collect();
         let lag: Vec<f64> = (kinv * &b.damping * DVector::from_vec(influence.clone())).iter().copied().collect();
         let rate = lambda.iter().map(|l| l.norm()).fold(0.0, f64::max);
         let periods = lambda.iter().filter(|l| l.im > 0.0).map(|l| 2.0 * std::f64::consts::PI / l.im);
@@ -247,15 +263,15 @@ impl Modes {
         })
     }
 
-    /// The particular solution `(u, u')` of floor `i` a time `s` into a stretch with ground
-    /// acceleration `g0 + g1 s`: `u = -r (g0 + g1 s) + K^-1 C r g1`, `u' = -r g1`.
+    /// The particular solution `(u, u')` of floor `i` a time `s` into a stretch with load
+    /// `g0 + g1 s`: `u = -r (g0 + g1 s) + K^-1 C r g1`, `u' = -r g1`.
     #[inline]
     pub fn particular(&self, i: usize, g0: f64, g1: f64, s: f64) -> (f64, f64) {
         (-self.influence[i] * (g0 + g1 * s) + self.lag[i] * g1, -self.influence[i] * g1)
     }
 
     /// The modal coefficients `V^-1 h` of the state `z` (`[u; u']`) less the particular
-    /// solution at the start of a stretch with ground acceleration `g0 + g1 s`.
+    /// solution at the start of a stretch with load `g0 + g1 s`.
     pub fn coefficients(&self, z: &[f64], g0: f64, g1: f64) -> Vec<C64> {
         let n = self.n;
         let h = DVector::<C64>::from_fn(2 * n, |i, _| {
@@ -327,7 +343,7 @@ mod tests {
     fn the_modal_motion_is_the_matrix_exponential() {
         for damping in [StoreyDamping::Rayleigh { mass: 0.4, stiffness: 0.002 }, StoreyDamping::Modal(vec![0.02, 0.05, 0.1])] {
             let b = three_storeys(damping);
-            let modes = b.modes(2, 0.0).unwrap();
+            let modes = b.modes(2, 0.0, Load::Ground).unwrap();
             let z0 = [0.01, -0.02, 0.03, 0.1, 0.0, -0.3];
             let (g0, g1) = (1.5, -4.0);
             let c = modes.coefficients(&z0, g0, g1);
@@ -346,7 +362,7 @@ mod tests {
     fn modal_damping_gives_each_mode_its_ratio() {
         let b = three_storeys(StoreyDamping::Modal(vec![0.02, 0.05, 0.1]));
         let (omegas, _) = b.undamped_modes();
-        let modes = b.modes(0, 0.0).unwrap();
+        let modes = b.modes(0, 0.0, Load::Ground).unwrap();
         let mut ratios: Vec<(f64, f64)> = modes.lambda.iter().filter(|l| l.im > 0.0).map(|l| (l.norm(), -l.re / l.norm())).collect();
         ratios.sort_by(|a, b| a.0.total_cmp(&b.0));
         for ((w, zeta), (w0, z0)) in ratios.iter().zip(omegas.iter().zip([0.02, 0.05, 0.1])) {
@@ -357,8 +373,8 @@ mod tests {
     #[test]
     fn a_mass_on_a_floor_changes_the_modes_but_not_the_static_balance() {
         let b = three_storeys(StoreyDamping::Rayleigh { mass: 0.4, stiffness: 0.0 });
-        let bare = b.modes(2, 0.0).unwrap();
-        let loaded = b.modes(2, 0.5).unwrap();
+        let bare = b.modes(2, 0.0, Load::Ground).unwrap();
+        let loaded = b.modes(2, 0.5, Load::Ground).unwrap();
         assert!(loaded.longest_period > bare.longest_period);
         // The static response to a steady ground acceleration is -r ag, and K r = M 1.
         let k = b.stiffness();

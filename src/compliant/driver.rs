@@ -118,8 +118,8 @@ impl<'s, 'a> Driver<'s, 'a> {
         // Only the excitation depends on time: a central difference over a ten-thousandth of
         // its radian period (or of the fastest floor's, for a record linear between its points)
         // is exact to about 1e-9 of it.
-        let moving_ground = sys.floors.as_ref().filter(|f| f.structure.ground.is_some());
-        let time_step = match (sys.scene.forcing, moving_ground) {
+        let recorded = sys.floors.as_ref().filter(|f| f.structure.is_recorded());
+        let time_step = match (sys.scene.forcing, recorded) {
             (Some(g), _) => Some(1e-4 / g.omega()),
             (None, Some(f)) => Some(1e-4 / f.fastest),
             (None, None) => None,

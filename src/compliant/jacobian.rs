@@ -193,7 +193,7 @@ impl System<'_> {
     /// The floors' stage matrix `M / hg + hg K + C`, with `contacts` (the balls' contact terms
     /// less their Schur complement) added on the carrying floor, factored; and the partials of
     /// the storeys' dissipation `v^T C v` and of the excitation's power
-    /// `vg sum(-(K u + C v)) + F vs`.
+    /// `vg sum(-(K u + C v)) + F vs + f (v_j + vg)` (a recorded force `f` on floor `j`).
     fn factor_floors(&self, floors: &Floors, t: f64, y: &[f64], hg: f64, contacts: f64) -> FloorStage {
         let structure = floors.structure;
         let b = &structure.building;
@@ -208,7 +208,10 @@ impl System<'_> {
         let damping_dv = (0..n).map(|k| 2.0 * (0..n).map(|j| b.damping[(k, j)] * v[j]).sum::<f64>()).collect();
         let forcing_dx = (0..n).map(|k| -vg * floors.stiffness.column(k).sum()).collect();
         let force = self.scene.forcing.map_or(0.0, |g| g.force(t));
-        let forcing_dv = (0..n).map(|k| -vg * b.damping.column(k).sum() + if k == d { force } else { 0.0 }).collect();
+        let recorded = structure.force.as_ref().map_or((n, 0.0), |f| (f.floor, structure.recorded_force(t)));
+        let forcing_dv = (0..n)
+            .map(|k| -vg * b.damping.column(k).sum() + if k == d { force } else { 0.0 } + if k == recorded.0 { recorded.1 } else { 0.0 })
+            .collect();
         FloorStage { lu: matrix.lu(), damping_dv, forcing_dx, forcing_dv }
     }
 

@@ -283,13 +283,16 @@ impl<'a> System<'a> {
         let (u, v) = floors.relative(|i| y[i], (xg, vg));
         let restoring = structure.building.restoring_forces(&u, &v);
         let force = self.scene.forcing.map_or(0.0, |g| g.force(t));
+        let recorded = structure.force.as_ref().map(|f| (f.floor, structure.recorded_force(t)));
         for j in 0..n {
             dy[floors.x(j)] = y[floors.v(j)];
             let m = structure.building.masses[j];
-            dy[floors.v(j)] = if j == d { (restoring[j] + contact + force) / m } else { restoring[j] / m - ag };
+            let external = recorded.filter(|r| r.0 == j).map_or(0.0, |r| r.1);
+            dy[floors.v(j)] = if j == d { (restoring[j] + contact + force + external) / m } else { (restoring[j] + external) / m - ag };
         }
         dy[self.damping_work()] = structure.building.damping_power(&v);
-        dy[self.forcing_work()] = vg * restoring.iter().sum::<f64>() + force * y[VS];
+        let recorded_power = recorded.map_or(0.0, |(j, f)| f * (v[j] + vg));
+        dy[self.forcing_work()] = vg * restoring.iter().sum::<f64>() + force * y[VS] + recorded_power;
     }
 
     /// A bound on the frame's smooth acceleration over the next while: now, plus what the
@@ -326,7 +329,9 @@ impl<'a> System<'a> {
         let u_max = (n as f64) * (2.0 * energy / k_min).sqrt();
         let spring = (0..n).map(|j| floors.stiffness[(d, j)].abs()).sum::<f64>() * u_max;
         let damper: f64 = (0..n).map(|j| b.damping[(d, j)].abs() * (2.0 * energy / b.masses[j]).sqrt()).sum();
-        let force = self.scene.forcing.map_or(0.0, |g| if g.kind == crate::scene::ForcingKind::Force { g.amplitude } else { 0.0 });
+        let sine = self.scene.forcing.map_or(0.0, |g| if g.kind == crate::scene::ForcingKind::Force { g.amplitude } else { 0.0 });
+        // A recorded force reaches the carrying floor at most whole.
+        let force = sine + structure.force.as_ref().map_or(0.0, |f| f.record.peak());
         let base = self.scene.forcing.map_or(0.0, |g| {
             if g.kind == crate::scene::ForcingKind::Base {
                 g.amplitude * g.omega() * g.omega()

@@ -5,7 +5,8 @@
 //! the one-storey frame's are.
 //!
 //! On a stretch the carrying floor's absolute acceleration is `a(s) = Re sum_k w_k L_k^2
-//! e^{L_k s} + g0 + g1 s`, plus `Re H e^{i w t}` under a sine: with damping `>= 0` every
+//! e^{L_k s} + a0 + a1 s` (the ground's line; zero under a force record), plus `Re H e^{i w t}`
+//! under a sine: with damping `>= 0` every
 //! `|e^{L_k s}| <= 1`, so its `n`-th derivative is bounded by `B_n = sum_k |w_k| |L_k|^n` (the
 //! ground's line adds to the first only, a sine `|H| w^n` to each), and the scan that clears an
 //! interval of sign changes uses those bounds.
@@ -23,14 +24,20 @@ use nalgebra::DMatrix;
 
 use super::ROUNDOFF_RELATIVE;
 
-/// One stretch of the segment: on `[start, end)` the ground accelerates as `g0 + g1 (t - start)`.
+/// One stretch of the segment: on `[start, end)` the record's load (the ground's acceleration
+/// or a floor's force) is `g0 + g1 (t - start)`.
 #[derive(Debug, Clone)]
 struct Piece {
     start: f64,
     end: f64,
+    /// The ground's stretch (a still one under a force record).
     ground: Stretch,
     g0: f64,
     g1: f64,
+    /// The ground's acceleration `a0 + a1 (t - start)`: the load's line when it is the ground's,
+    /// zero under a force record.
+    a0: f64,
+    a1: f64,
     /// Modal coefficients at `start`.
     c: Vec<C64>,
     /// The carrying floor's displacement as `Re sum w_k e^{L_k s}` (plus the particular part).
@@ -46,6 +53,9 @@ struct Probe {
     a: f64,
     jerk: f64,
 }
+
+/// The stretch of no load and a still ground.
+const STILL: Stretch = Stretch { index: 0, start: 0.0, end: f64::INFINITY, g0: 0.0, g1: 0.0, x0: 0.0, v0: 0.0 };
 
 /// A sum with Neumaier's compensation of the rounding of each addition.
 #[derive(Debug, Default, Clone, Copy)]
@@ -113,7 +123,7 @@ pub(super) struct StoreyMotion {
 
 impl StoreyMotion {
     pub(super) fn new(structure: Arc<Structure>, forcing: Option<Forcing>, horizon: f64) -> Result<Self, String> {
-        let modes = Rc::new(structure.building.modes(structure.floor, 0.0)?);
+        let modes = Rc::new(structure.building.modes(structure.floor, 0.0, structure.load())?);
         let structure_stiffness = structure.building.stiffness();
         let z0 = structure.initial_displacements.iter().chain(&structure.initial_velocities).copied().collect();
         let mut m = StoreyMotion {
@@ -182,18 +192,27 @@ impl StoreyMotion {
         self.modes.n
     }
 
-    /// The ground's stretch that holds `t`: the record's, or one of a still ground.
+    /// The record's stretch that holds `t` (the ground's acceleration or a floor's force), or
+    /// one of no load.
     fn stretch(&self, t: f64) -> Stretch {
-        match &self.structure.ground {
-            Some(g) => g.stretch(t),
-            None => Stretch { index: 0, start: 0.0, end: f64::INFINITY, g0: 0.0, g1: 0.0, x0: 0.0, v0: 0.0 },
+        match (&self.structure.ground, &self.structure.force) {
+            (Some(g), _) => g.stretch(t),
+            (None, Some(f)) => f.record.stretch(t),
+            (None, None) => STILL,
         }
+    }
+
+    /// The ground's stretch that holds `t`: the record's, or one of a still ground.
+    fn ground_stretch(&self, t: f64) -> Stretch {
+        self.structure.ground.as_ref().map_or(STILL, |g| g.stretch(t))
     }
 
     /// The piece that starts at `start` from the state `z`.
     fn piece(&self, start: f64, z: &[f64]) -> Piece {
-        let ground = self.stretch(start);
-        let (g0, g1) = (ground.g0 + ground.g1 * (start - ground.start), ground.g1);
+        let load = self.stretch(start);
+        let (g0, g1) = (load.g0 + load.g1 * (start - load.start), load.g1);
+        let ground = self.ground_stretch(start);
+        let (a0, a1) = if self.structure.ground.is_some() { (g0, g1) } else { (0.0, 0.0) };
         let steady = self.sine_state(start);
         let departure: Vec<f64> = z.iter().zip(&steady).map(|(z, s)| z - s).collect();
         let c = self.modes.coefficients(&departure, g0, g1);
@@ -207,7 +226,7 @@ impl StoreyMotion {
                 *b += if n < 2 { shift * s.omega.powi(n as i32) } else { s.h.norm() * s.omega.powi(n as i32 - 2) };
             }
         }
-        Piece { start, end: ground.end, ground, g0, g1, c, w, bounds }
+        Piece { start, end: load.end, ground, g0, g1, a0, a1, c, w, bounds }
     }
 
     /// Drops the pieces and sign changes of the last segment and starts from `(t0, z0)`.
@@ -259,7 +278,7 @@ impl StoreyMotion {
 
     /// The ground's displacement and velocity at `t`.
     pub(super) fn ground(&self, t: f64) -> (f64, f64) {
-        let g = self.stretch(t);
+        let g = self.ground_stretch(t);
         let (x, v, _) = g.at(t - g.start);
         let (xs, vs) = self.sine_ground(t);
         (x + xs, v + vs)
@@ -320,7 +339,7 @@ impl StoreyMotion {
                 e *= i_w;
             }
         }
-        [(d[0] + p.g0 + p.g1 * s, p.bounds[2] + (p.g0 + p.g1 * s).abs()), (d[1] + p.g1, p.bounds[3] + p.g1.abs()), (d[2], p.bounds[4])]
+        [(d[0] + p.a0 + p.a1 * s, p.bounds[2] + (p.a0 + p.a1 * s).abs()), (d[1] + p.a1, p.bounds[3] + p.a1.abs()), (d[2], p.bounds[4])]
     }
 
     fn probe(&self, p: &Piece, t: f64) -> Probe {
@@ -342,10 +361,20 @@ impl StoreyMotion {
         let (z, _) = self.floors(t);
         let (u, v) = z.split_at(n);
         // The external force on the carrying floor and its rate, and the ground's acceleration.
+        let mut elsewhere = None;
         let (force, force_rate, ag) = {
             let stretch = self.stretch(t);
             let s = t - stretch.start;
-            let (mut f, mut fr, mut g) = (0.0, 0.0, stretch.g0 + stretch.g1 * s);
+            let line = (stretch.g0 + stretch.g1 * s, stretch.g1);
+            let (mut f, mut fr, mut g) = match self.structure.force.as_ref().map(|f| f.floor) {
+                None => (0.0, 0.0, line.0),
+                Some(j) if j == d => (line.0, line.1, 0.0),
+                Some(j) => {
+                    // A force on another floor moves the carrying floor through that floor.
+                    elsewhere = Some((j, line.0));
+                    (0.0, 0.0, 0.0)
+                }
+            };
             if let Some(sine) = &self.sine {
                 let (sin, cos) = (sine.omega * t).sin_cos();
                 let w = sine.omega;
@@ -357,6 +386,9 @@ impl StoreyMotion {
         };
         let mut forces = b.restoring_forces(u, v);
         forces[d] += force;
+        if let Some((j, f)) = elsewhere {
+            forces[j] += f;
+        }
         let row = |j: usize| (self.stiffness[(d, j)], b.damping[(d, j)]);
         let size: f64 = (0..n).map(|j| row(j).0.abs() * u[j].abs() + row(j).1.abs() * v[j].abs()).sum::<f64>() + force.abs();
         let a = forces[d] / m[d];
@@ -466,7 +498,7 @@ impl StoreyMotion {
     /// carrying floor evaluated at `t` on piece `p` (at most `t` into it).
     fn roundoff(&self, p: &Piece, t: f64, order: usize) -> f64 {
         let s = t - p.start;
-        let line = if order == 0 { p.g0.abs() + p.g1.abs() * s } else { p.g1.abs() };
+        let line = if order == 0 { p.a0.abs() + p.a1.abs() * s } else { p.a1.abs() };
         let phase = self.sine.as_ref().map_or(0.0, |sine| sine.omega * t.abs());
         ROUNDOFF_ULPS * f64::EPSILON * ((2.0 + self.modes.rate * s + phase) * p.bounds[order + 2] + line)
     }
@@ -515,7 +547,7 @@ impl StoreyMotion {
         if let Some((_, m)) = self.cache.iter().find(|(mass, _)| *mass == held) {
             self.modes = m.clone();
         } else {
-            match self.structure.building.modes(d, held) {
+            match self.structure.building.modes(d, held, self.structure.load()) {
                 Ok(m) => {
                     let m = Rc::new(m);
                     self.cache.push((held, m.clone()));
@@ -555,6 +587,7 @@ impl StoreyMotion {
         let last = self.index(t);
         let b_ = &self.structure.building;
         let floor = self.structure.floor;
+        let recorded = self.structure.force.as_ref().map(|f| f.floor);
         let n = self.n();
         // Each sub-piece's integral is added with Neumaier's compensation, so that the sum of
         // a long segment's thousands of them adds no round-off of its own.
@@ -571,7 +604,8 @@ impl StoreyMotion {
                     let (u, v) = z.split_at(n);
                     let vg = p.ground.at(s - p.ground.start).1 + self.sine_ground(s).1;
                     let force = self.sine.as_ref().map_or(0.0, |sine| sine.force * (sine.omega * s).sin() * (v[floor] + vg));
-                    [b_.damping_power(v), -vg * b_.base_shear(u, v) + force]
+                    let recorded = recorded.map_or(0.0, |j| (p.g0 + p.g1 * (s - p.start)) * (v[j] + vg));
+                    [b_.damping_power(v), -vg * b_.base_shear(u, v) + force + recorded]
                 });
                 sums[0].add(d);
                 sums[1].add(w);
@@ -583,6 +617,6 @@ impl StoreyMotion {
 
     /// Whether the ground moves or a force acts (then they do work).
     pub(super) fn is_driven(&self) -> bool {
-        self.structure.ground.is_some() || self.sine.is_some()
+        self.structure.is_recorded() || self.sine.is_some()
     }
 }

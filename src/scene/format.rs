@@ -309,6 +309,9 @@ pub enum ExcitationKind {
     /// The ground accelerates as Kanai-Tajimi filtered white noise drawn from `seed`
     /// (docs/MODEL.md §17): each ensemble member draws its own.
     Random,
+    /// A force recorded in `file` (time in s, force in N) acts on `floor` (docs/MODEL.md §17).
+    #[serde(rename = "force_record")]
+    ForceRecord,
 }
 
 impl From<ForcingKind> for ExcitationKind {
@@ -324,7 +327,7 @@ impl From<ForcingKind> for ExcitationKind {
 #[derive(Debug, Clone, Deserialize, Serialize, Default)]
 #[serde(deny_unknown_fields)]
 pub struct ForcingFile {
-    /// `"force"`, `"base"` or `"record"`.
+    /// `"force"`, `"base"`, `"record"`, `"random"` or `"force_record"`.
     pub kind: ExcitationKind,
     /// `F0` in N (force) or `Y` in m (base).
     pub amplitude: Option<f64>,
@@ -335,6 +338,8 @@ pub struct ForcingFile {
     pub file: Option<String>,
     /// A factor on the record's accelerations (default 1).
     pub scale: Option<f64>,
+    /// A force record: the floor it acts on, 1 at the bottom (default: the damper's).
+    pub floor: Option<u32>,
     /// Random ground motion: the soil's frequency `fg`, Hz.
     pub ground_frequency: Option<f64>,
     /// Random ground motion: the soil's damping ratio `zeta_g`.

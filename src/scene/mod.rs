@@ -27,7 +27,7 @@ pub use record::GroundRecord;
 pub use rules::{from_file, validate_sample_dt};
 pub use settings::{CompliantSettings, RapierSettings, DEFAULT_COMPLIANT_TOLERANCE};
 pub use space::Space;
-pub use structure::{Frame, Structure};
+pub use structure::{FloorForce, Frame, Structure};
 
 /// Default simulated time, s (docs/MODEL.md §8).
 pub const DEFAULT_HORIZON: f64 = 5.0;
@@ -118,7 +118,7 @@ impl Scene {
     /// Whether something drives the structure (a sine or a moving ground): then energy is put
     /// in, and dissipation times mean nothing.
     pub fn is_driven(&self) -> bool {
-        self.forcing.is_some() || self.structure.as_ref().is_some_and(|s| s.ground.is_some())
+        self.forcing.is_some() || self.structure.as_ref().is_some_and(|s| s.is_recorded())
     }
 
     /// Initial mechanical energy: spring energy plus balls' kinetic energy.
@@ -164,7 +164,12 @@ impl Scene {
                 let (omegas, _) = s.building.undamped_modes();
                 fastest + g.peak() / omegas[0]
             });
-            own + ground
+            // A recorded force: the static drift it gives the fundamental mode, at its rate.
+            let force = s.force.as_ref().map_or(0.0, |f| {
+                let (omegas, _) = s.building.undamped_modes();
+                f.record.peak() / (s.building.masses[f.floor] * omegas[0])
+            });
+            own + ground + force
         });
         let across = self.space.lateral_velocities.iter().fold(0.0, |m: f64, [vy, vz]| m.max(vy.hypot(*vz)));
         self.initial_velocities.iter().fold(frame.max(across).max(structure), |m: f64, v| m.max(v.abs()))
@@ -272,12 +277,16 @@ impl Scene {
     }
     /// A structure's floors' absolute accelerations at `t` without impulses and contact
     /// forces, with the floors at `u` and moving at `v` relative to the ground: the storeys'
-    /// `-M^-1 (C v + K u)` plus a sine force on the carrying floor, m/s^2.
+    /// `-M^-1 (C v + K u)` plus a sine force on the carrying floor and a recorded force on its
+    /// floor, m/s^2.
     pub fn floor_accelerations(&self, t: f64, u: &[f64], v: &[f64]) -> Vec<f64> {
         let Some(s) = self.structure.as_deref() else { return Vec::new() };
         let mut a = s.accelerations(u, v);
         if let Some(g) = self.forcing.filter(|g| g.kind == ForcingKind::Force) {
             a[s.floor] += g.force(t) / s.building.masses[s.floor];
+        }
+        if let Some(f) = &s.force {
+            a[f.floor] += s.recorded_force(t) / s.building.masses[f.floor];
         }
         a
     }

@@ -113,7 +113,7 @@ pub fn with_settings_of(file: &SceneFile, scene: &Scene) -> SceneFile {
             poisson_ratio: Some(scene.compliant.poisson_ratio),
             tolerance: Some(scene.compliant.tolerance),
         },
-        // A ground motion stays as the file gives it (the scene keeps it with its structure).
+        // A record or a random ground motion stays as the file gives it (the scene keeps it with its structure).
         forcing: match scene.forcing {
             Some(g) => Some(format::ForcingFile {
                 kind: g.kind.into(),
@@ -121,7 +121,9 @@ pub fn with_settings_of(file: &SceneFile, scene: &Scene) -> SceneFile {
                 frequency: Some(g.frequency),
                 ..Default::default()
             }),
-            None => file.forcing.clone().filter(|g| matches!(g.kind, format::ExcitationKind::Record | format::ExcitationKind::Random)),
+            None => file.forcing.clone().filter(|g| {
+                matches!(g.kind, format::ExcitationKind::Record | format::ExcitationKind::Random | format::ExcitationKind::ForceRecord)
+            }),
         },
         ..file.clone()
     }

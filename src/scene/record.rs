@@ -180,7 +180,7 @@ impl KanaiTajimi {
 /// accelerations, or the rule the text breaks.
 pub fn read_points(text: &str) -> Result<(Vec<f64>, Vec<f64>), String> {
     let lines: Vec<&str> = text.lines().collect();
-    if let Some(k) = lines.iter().take(8).position(|l| l.to_ascii_uppercase().contains("NPTS")) {
+    if let Some(k) = at2_header(&lines) {
         return read_at2(&lines, k);
     }
     let (mut times, mut accel) = (Vec::new(), Vec::new());
@@ -203,6 +203,16 @@ pub fn read_points(text: &str) -> Result<(Vec<f64>, Vec<f64>), String> {
     }
     check_points(&times, &accel)?;
     Ok((times, accel))
+}
+
+/// The line of a PEER `.AT2` header that gives `NPTS`, when `lines` are one.
+fn at2_header(lines: &[&str]) -> Option<usize> {
+    lines.iter().take(8).position(|l| l.to_ascii_uppercase().contains("NPTS"))
+}
+
+/// Whether `text` is a PEER `.AT2` record (ground accelerations in g).
+pub fn is_at2(text: &str) -> bool {
+    at2_header(&text.lines().collect::<Vec<_>>()).is_some()
 }
 
 /// The PEER format: a header whose line `k` gives `NPTS` and `DT`, then the accelerations in g.

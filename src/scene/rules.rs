@@ -7,12 +7,12 @@ use super::format::{self, Arrangement, Length, SceneFile};
 use super::format::{ExcitationKind, ForcingKind};
 use super::geometry::{ball_radius, Ball, BallKind, Container};
 use super::parameters::{Parameter, Tolerances};
-use super::record::{read_points, GroundRecord, KanaiTajimi};
+use super::record::{is_at2, read_points, GroundRecord, KanaiTajimi};
 use super::settings::{CompliantSettings, RapierSettings};
 use super::space::Space;
-use super::structure::{Frame, Structure};
+use super::structure::{FloorForce, Frame, Structure};
 use super::{human, ChainCase, Loaded, Scene, SceneError, CHAIN_HORIZON, DEFAULT_HORIZON, DEFAULT_SAMPLE_DT, MAX_SAMPLES};
-use crate::storeys::{Building, StoreyDamping};
+use crate::storeys::{Building, Load, StoreyDamping};
 use std::sync::Arc;
 
 /// Validates an already parsed file.
@@ -145,18 +145,26 @@ pub fn validate_sample_dt(horizon: f64, dt: f64) -> Result<(), String> {
 
 pub(super) fn build_damper(f: &SceneFile, name: &str, v: &Validator) -> Result<Scene, SceneError> {
     let record = match &f.forcing {
-        Some(g) if g.kind == ExcitationKind::Record => Some(Arc::new(ground_record(g, v)?)),
+        Some(g) if g.kind == ExcitationKind::Record => Some(Arc::new(ground_record(g, "record", &["file", "scale"], v)?)),
         Some(g) if g.kind == ExcitationKind::Random => Some(Arc::new(random_ground(g, v)?.record(g.seed.unwrap_or(1)))),
         _ => None,
     };
+    let force = match &f.forcing {
+        Some(g) if g.kind == ExcitationKind::ForceRecord => {
+            Some((g.floor, Arc::new(ground_record(g, "force_record", &["file", "scale", "floor"], v)?)))
+        }
+        _ => None,
+    };
     let Some(st) = &f.structure else {
-        let Some(record) = record else { return build_frame_damper(f, name, v) };
+        if record.is_none() && force.is_none() {
+            return build_frame_damper(f, name, v);
+        }
         // A frame under a record: a structure of one storey.
         let plain = SceneFile { forcing: None, ..f.clone() };
         let mut scene = build_frame_damper(&plain, name, v)?;
         let fr = scene.frame.expect("a damper scene has a frame");
         if fr.stiffness <= 0.0 {
-            return Err(v.err("frame.stiffness", "must be positive under a ground-motion record (the frame must stand on the ground)"));
+            return Err(v.err("frame.stiffness", "must be positive under a record (the frame must stand on the ground)"));
         }
         let mut building = Building::new(vec![fr.mass], vec![fr.stiffness], &StoreyDamping::Rayleigh { mass: 0.0, stiffness: 0.0 });
         building.damping[(0, 0)] = fr.damping;
@@ -165,14 +173,18 @@ pub(super) fn build_damper(f: &SceneFile, name: &str, v: &Validator) -> Result<S
             floor: 0,
             initial_displacements: vec![scene.initial_displacement],
             initial_velocities: vec![0.0],
-            ground: Some(record),
+            ground: record,
+            force: force.map(|(floor, record)| floor_force(floor, record, 1, 0, v)).transpose()?,
         }));
         return Ok(scene);
     };
     if f.frame.is_some() {
         return Err(v.err("structure", "cannot be combined with [frame]: give the primary structure one way"));
     }
-    let structure = structure(st, record, v)?;
+    let mut structure = structure(st, record, v)?;
+    if let Some((floor, record)) = force {
+        structure.force = Some(floor_force(floor, record, structure.floors(), structure.floor, v)?);
+    }
     if let Some(g) = f.forcing.as_ref().filter(|g| matches!(g.kind, ExcitationKind::Force | ExcitationKind::Base)) {
         // A sine drives the structure only where it has a steady response: an undamped
         // building has none at a natural frequency (within 1e-12 relative, the round-off of
@@ -203,10 +215,10 @@ pub(super) fn build_damper(f: &SceneFile, name: &str, v: &Validator) -> Result<S
         damping: b.damping[(d, d)],
         initial_displacement: Length::Metres(structure.initial_displacements[d]),
     };
-    let forcing = if structure.ground.is_some() { None } else { f.forcing.clone() };
+    let forcing = if structure.is_recorded() { None } else { f.forcing.clone() };
     let plain = SceneFile { structure: None, frame: Some(frame), forcing, ..f.clone() };
     let mut scene = build_frame_damper(&plain, name, v)?;
-    let one_storey_at_rest = structure.floors() == 1 && structure.ground.is_none() && structure.initial_velocities[0] == 0.0;
+    let one_storey_at_rest = structure.floors() == 1 && !structure.is_recorded() && structure.initial_velocities[0] == 0.0;
     if !one_storey_at_rest {
         scene.structure = Some(Arc::new(structure));
     }
@@ -266,8 +278,25 @@ fn structure(st: &format::StructureFile, ground: Option<Arc<GroundRecord>>, v: &
         Some(k) => return Err(v.err("structure.damper_floor", &format!("must name a floor from 1 (bottom) to {n} (got {k})"))),
     };
     let building = Building::new(st.masses.clone(), st.stiffnesses.clone(), &damping);
-    building.modes(floor, 0.0).map_err(|why| v.err("structure", &why))?;
-    Ok(Structure { building, floor, initial_displacements, initial_velocities, ground })
+    building.modes(floor, 0.0, Load::Ground).map_err(|why| v.err("structure", &why))?;
+    Ok(Structure { building, floor, initial_displacements, initial_velocities, ground, force: None })
+}
+
+/// The floor a force record acts on: `floor` (1 at the bottom) of `floors`, or the damper's
+/// (`carrying`, 0 at the bottom) when it names none.
+fn floor_force(
+    floor: Option<u32>,
+    record: Arc<GroundRecord>,
+    floors: usize,
+    carrying: usize,
+    v: &Validator,
+) -> Result<FloorForce, SceneError> {
+    let floor = match floor {
+        None => carrying,
+        Some(k) if (1..=floors as u32).contains(&k) => k as usize - 1,
+        Some(k) => return Err(v.err("forcing.floor", &format!("must name a floor from 1 (bottom) to {floors} (got {k})"))),
+    };
+    Ok(FloorForce { floor, record })
 }
 
 /// Refuses the keys of `[forcing]` that belong to another kind than `kind`.
@@ -284,6 +313,7 @@ fn only_keys_of(g: &format::ForcingFile, kind: &str, keys: &[&str], v: &Validato
         ("step", g.step.is_some()),
         ("envelope", g.envelope.is_some()),
         ("seed", g.seed.is_some()),
+        ("floor", g.floor.is_some()),
     ];
     match given.iter().find(|(key, given)| *given && !keys.contains(key)) {
         Some((key, _)) => Err(v.err(&format!("forcing.{key}"), &format!("does not belong to a forcing of kind `{kind}`"))),
@@ -321,13 +351,20 @@ fn random_ground(g: &format::ForcingFile, v: &Validator) -> Result<KanaiTajimi, 
     Ok(kt)
 }
 
-/// The record a `[forcing]` of kind `record` names, read and scaled.
-fn ground_record(g: &format::ForcingFile, v: &Validator) -> Result<GroundRecord, SceneError> {
-    only_keys_of(g, "record", &["file", "scale"], v)?;
+/// The record a `[forcing]` of kind `kind` (`record` or `force_record`, with its `keys`) names,
+/// read and scaled. A force is two columns: a PEER `.AT2` file is a ground acceleration in g.
+fn ground_record(g: &format::ForcingFile, kind: &str, keys: &[&str], v: &Validator) -> Result<GroundRecord, SceneError> {
+    only_keys_of(g, kind, keys, v)?;
     let file = g.file.as_ref().ok_or_else(|| v.err("forcing.file", "is missing: a record needs its file"))?;
     let scale = v.finite("forcing.scale", g.scale.unwrap_or(1.0))?;
     let path = std::path::Path::new(v.file).parent().unwrap_or(std::path::Path::new("")).join(file);
     let text = std::fs::read_to_string(&path).map_err(|e| v.err("forcing.file", &format!("cannot be read ({}): {e}", path.display())))?;
+    if g.kind == ExcitationKind::ForceRecord && is_at2(&text) {
+        return Err(v.err(
+            "forcing.file",
+            &format!("({}) is a PEER ground acceleration in g; a force record is two columns, time (s) and force (N)", path.display()),
+        ));
+    }
     let (times, accel) = read_points(&text).map_err(|why| v.err("forcing.file", &format!("({}) {why}", path.display())))?;
     Ok(GroundRecord::new(times, accel, scale))
 }
@@ -655,7 +692,9 @@ pub(super) fn forcing(g: &format::ForcingFile, frame: &Frame, v: &Validator) -> 
     let kind = match g.kind {
         ExcitationKind::Force => ForcingKind::Force,
         ExcitationKind::Base => ForcingKind::Base,
-        ExcitationKind::Record | ExcitationKind::Random => return Err(v.err("forcing.kind", "is a ground motion, which is not a sine")),
+        ExcitationKind::Record | ExcitationKind::Random | ExcitationKind::ForceRecord => {
+            return Err(v.err("forcing.kind", "is a record, which is not a sine"))
+        }
     };
     let forcing = Forcing { kind, amplitude, frequency };
     // An undamped frame driven exactly at resonance has no bounded particular solution.

@@ -65,12 +65,38 @@ pub struct Structure {
     pub initial_velocities: Vec<f64>,
     /// The ground's acceleration, when it moves.
     pub ground: Option<std::sync::Arc<GroundRecord>>,
+    /// A recorded force on one floor, when one acts (never with a moving ground).
+    pub force: Option<FloorForce>,
+}
+
+/// A force on one floor, recorded as a ground motion is: linear between its points, N.
+#[derive(Debug, Clone, PartialEq)]
+pub struct FloorForce {
+    /// The floor it acts on, 0 at the bottom.
+    pub floor: usize,
+    /// The force's points (its `accel` is the force, N; its ground integrals mean nothing).
+    pub record: std::sync::Arc<GroundRecord>,
 }
 
 impl Structure {
     /// Number of floors.
     pub fn floors(&self) -> usize {
         self.building.floors()
+    }
+    /// What the structure's record drives ([`Load::Ground`] when it has none).
+    pub fn load(&self) -> Load {
+        self.force.as_ref().map_or(Load::Ground, |f| Load::Floor(f.floor))
+    }
+    /// The recorded force on its floor at `t`, N (0 without one).
+    pub fn recorded_force(&self, t: f64) -> f64 {
+        self.force.as_ref().map_or(0.0, |f| {
+            let stretch = f.record.stretch(t);
+            stretch.g0 + stretch.g1 * (t - stretch.start)
+        })
+    }
+    /// Whether a record drives the structure (its ground or a floor's force).
+    pub fn is_recorded(&self) -> bool {
+        self.ground.is_some() || self.force.is_some()
     }
     /// The floors' mechanical energy with the floors at `u` relative to the ground and moving
     /// at `v` relative to it, the ground at velocity `vg`: kinetic energy in the ground's
@@ -86,4 +112,4 @@ impl Structure {
 }
 
 use super::record::GroundRecord;
-use crate::storeys::Building;
+use crate::storeys::{Building, Load};

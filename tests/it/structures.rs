@@ -77,16 +77,18 @@ fn bordered_state_matrix() -> DMatrix<f64> {
 }
 
 /// The state of the building of [`building_text`] advanced by the matrix exponential of the
-/// state matrix bordered by the ground's line (nalgebra's Pade approximant: nothing of the
-/// modal closed form), record point to record point.
-fn by_matrix_exponential(points: &[(f64, f64)], scale: f64, samples: &[f64]) -> Vec<Vec<f64>> {
+/// state matrix bordered by the record's line (nalgebra's Pade approximant: nothing of the
+/// modal closed form), record point to record point. The record acts on floor `i` as
+/// `pattern[i]` times its value: `-1` on every floor for the ground's acceleration, `1 / m_j`
+/// on floor `j` alone for a force on it.
+fn by_matrix_exponential(points: &[(f64, f64)], scale: f64, samples: &[f64], pattern: [f64; 3]) -> Vec<Vec<f64>> {
     let n = 3;
-    // Augmented state [u; u'; 1; s]: u'' = -M^-1 (C u' + K u) - (g0 + g1 s).
+    // Augmented state [u; u'; 1; s]: u'' = -M^-1 (C u' + K u) + pattern (g0 + g1 s).
     let step = |z: &DVector<f64>, g0: f64, g1: f64, h: f64| -> DVector<f64> {
         let mut aug = bordered_state_matrix();
         for i in 0..n {
-            aug[(n + i, 2 * n)] = -g0;
-            aug[(n + i, 2 * n + 1)] = -g1;
+            aug[(n + i, 2 * n)] = pattern[i] * g0;
+            aug[(n + i, 2 * n + 1)] = pattern[i] * g1;
         }
         aug[(2 * n + 1, 2 * n)] = 1.0;
         let mut x = DVector::<f64>::zeros(2 * n + 2);
@@ -126,10 +128,16 @@ fn by_matrix_exponential(points: &[(f64, f64)], scale: f64, samples: &[f64]) -> 
 /// Every floor of `run` (the building of [`building_text`] shaken by `points`) within
 /// `relative` of the peak displacement and velocity of the matrix exponential's, at every sample.
 fn assert_floors_follow(run: &Run, points: &[(f64, f64)], relative: f64) {
+    assert_floors_follow_load(run, points, relative, [-1.0; 3]);
+}
+
+/// [`assert_floors_follow`] for a record that acts as `pattern` says
+/// ([`by_matrix_exponential`]).
+fn assert_floors_follow_load(run: &Run, points: &[(f64, f64)], relative: f64, pattern: [f64; 3]) {
     let s = &run.series;
     assert_eq!(s.floor_count(), 3);
     let times: Vec<f64> = s.t().to_vec();
-    let exact = by_matrix_exponential(points, 2.0, &times);
+    let exact = by_matrix_exponential(points, 2.0, &times, pattern);
     let peak_u = exact.iter().flat_map(|z| z[..3].to_vec()).fold(0.0, |m: f64, x| m.max(x.abs()));
     let peak_v = exact.iter().flat_map(|z| z[3..].to_vec()).fold(0.0, |m: f64, x| m.max(x.abs()));
     for (k, z) in exact.iter().enumerate() {
@@ -261,6 +269,27 @@ fn a_structure_or_record_that_cannot_exist_is_refused() {
     let stderr = String::from_utf8_lossy(&o.stderr);
     assert_eq!(o.status.code(), Some(2), "{stderr}");
     assert!(stderr.contains("forcing.file") && stderr.contains("must increase"), "{stderr}");
+    // A force record on a floor the building lacks, one in a PEER file (a ground acceleration
+    // in g), and a floor given to a ground record.
+    std::fs::write(dir.path().join("push.txt"), "0 0\n0.1 1\n").unwrap();
+    std::fs::write(dir.path().join("quake.at2"), "PEER\nquake\nACCELERATION TIME SERIES IN UNITS OF G\nNPTS= 2, DT= 0.01 SEC\n0.0 0.1\n")
+        .unwrap();
+    let force = |file: &str, extra: &str| {
+        building_text(file).replace("kind = \"record\"", "kind = \"force_record\"").replace("scale = 2.0", &format!("scale = 2.0{extra}"))
+    };
+    for (text, field, words) in [
+        (force("push.txt", "\nfloor = 4"), "forcing.floor", "from 1"),
+        (force("quake.at2", ""), "forcing.file", "two columns"),
+        (building_text("push.txt").replace("scale = 2.0", "scale = 2.0\nfloor = 1"), "forcing.floor", "does not belong"),
+    ] {
+        std::fs::write(&file, text).unwrap();
+        let out = dir.path().join("out");
+        let o = lpc_command().arg("run").arg(&file).arg("--out").arg(&out).output().unwrap();
+        let stderr = String::from_utf8_lossy(&o.stderr);
+        assert_eq!(o.status.code(), Some(2), "{stderr}");
+        assert!(stderr.contains(field) && stderr.contains(words), "{field}: {stderr}");
+        assert!(!out.exists(), "nothing is written");
+    }
 }
 
 /// The model that moves one storey says so, up front.
@@ -525,4 +554,39 @@ fn the_frequency_response_of_a_building_has_every_floor() {
     let table = std::fs::read_to_string(out.join("frf-floors.csv")).unwrap();
     assert_eq!(table.lines().next(), Some("frequency,floor,amplitude,amplitude_no_damper"));
     assert_eq!(table.lines().count(), 1 + 2 * 3);
+}
+
+/// A force recorded on the middle floor (`kind = "force_record"`, `floor = 2`): both models
+/// against the matrix exponential with the force in the middle floor's row alone, the reference
+/// to 1e-8 and the compliant model to its steps times its tolerance; the balance closes with the
+/// force's work, and the ground stays still.
+#[test]
+fn a_force_recorded_on_a_floor_is_the_matrix_exponential() {
+    let points: Vec<(f64, f64)> = (0..=200).map(|j| (j as f64 * 0.01, 3.0 * (j as f64 * 0.29).sin())).collect();
+    let text = |record: &str| {
+        building_text(record).replace("kind = \"record\"", "kind = \"force_record\"").replace("scale = 2.0", "scale = 2.0\nfloor = 2")
+    };
+    let (_dir, scene) = scene_with_record(text, &points);
+    let pattern = [0.0, 1.0 / 1.6, 0.0];
+    let exact = reference(&scene);
+    assert_floors_follow_load(&exact, &points, 1e-8, pattern);
+    assert!(exact.energy.balance_error.abs() <= 1e-9 * exact.energy.forcing_work.abs(), "{:?}", exact.energy);
+    let soft = compliant(&scene);
+    let bound = soft.events as f64 * scene.compliant.tolerance;
+    assert_floors_follow_load(&soft, &points, bound, pattern);
+    assert!(soft.energy.balance_error.abs() <= bound * soft.energy.forcing_work.abs(), "{:?}", soft.energy);
+    // A force on the top floor (the damper's, by default), where the balls ride.
+    let path = lpc_damper::scene::scenes_dir().join("mdof-3storey.toml");
+    let damper = std::fs::read_to_string(&path).unwrap().replace("horizon = 5.0", "horizon = 2.0");
+    let dir = tempfile::tempdir().unwrap();
+    let record: String = points.iter().map(|(t, a)| format!("{t} {a}\n")).collect();
+    std::fs::write(dir.path().join("push.txt"), record).unwrap();
+    let file = dir.path().join("scene.toml");
+    std::fs::write(&file, format!("{damper}\n[forcing]\nkind = \"force_record\"\nfile = \"push.txt\"\n")).unwrap();
+    let scene = lpc_damper::scene::load_scene(&file).unwrap();
+    assert_eq!(scene.structure.as_ref().unwrap().force.as_ref().unwrap().floor, 2, "the damper's floor by default");
+    let run = reference(&scene);
+    assert_eq!(run.horizon, 2.0);
+    assert!(run.energy.forcing_work != 0.0 && run.energy.balance_error.abs() <= 1e-12, "{:?}", run.energy);
+    assert!(crate::common::min_gap(&scene, &run) >= -1e-12);
 }
