@@ -107,11 +107,11 @@ impl Solver<'_> {
             let d = self.scene.structure.as_ref().map_or(0, |s| s.floor);
             for k in first..end {
                 let ts = k as f64 * dt;
-                let (z, _) = storeys.floors(ts);
+                let (z, at) = storeys.floors(ts);
                 frame.push((z[d], z[n + d]));
                 floors.extend_from_slice(&z);
                 if storeys.is_driven() {
-                    ground.push(storeys.ground(ts));
+                    ground.push(at);
                 }
             }
         } else if self.has_frame() {

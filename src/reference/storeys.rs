@@ -284,12 +284,17 @@ impl StoreyMotion {
         (x + xs, v + vs)
     }
 
-    /// The floors' state `[u; u']` relative to the ground at `t`, and the ground's velocity.
-    pub(super) fn floors(&self, t: f64) -> (Vec<f64>, f64) {
+    /// The floors' state `[u; u']` relative to the ground at `t`, and the ground's displacement
+    /// and velocity.
+    pub(super) fn floors(&self, t: f64) -> (Vec<f64>, (f64, f64)) {
         if t == self.t0 {
-            return (self.z0.clone(), self.ground(t).1);
+            return (self.z0.clone(), self.ground(t));
         }
-        self.with_piece(t, |p| (self.full_state(p, t), p.ground.at(t - p.ground.start).1 + self.sine_ground(t).1))
+        self.with_piece(t, |p| {
+            let (x, v, _) = p.ground.at(t - p.ground.start);
+            let (xs, vs) = self.sine_ground(t);
+            (self.full_state(p, t), (x + xs, v + vs))
+        })
     }
 
     /// The carrying floor's absolute displacement and velocity at `t`.
@@ -541,7 +546,7 @@ impl StoreyMotion {
     /// Starts a new segment at `t`, the carrying floor moving at `v` (absolute) and holding
     /// `held` kg of balls.
     pub(super) fn restart(&mut self, t: f64, v: f64, held: f64) {
-        let (mut z, vg) = self.floors(t);
+        let (mut z, (_, vg)) = self.floors(t);
         let d = self.structure.floor;
         z[self.n() + d] = v - vg;
         if let Some((_, m)) = self.cache.iter().find(|(mass, _)| *mass == held) {
@@ -570,7 +575,7 @@ impl StoreyMotion {
     /// The floors' mechanical energy at `t`: their kinetic energy in the ground's inertial
     /// frame and the storeys' springs (balls held on the carrying floor not included), J.
     pub(super) fn energy(&self, t: f64) -> f64 {
-        let (z, vg) = self.floors(t);
+        let (z, (_, vg)) = self.floors(t);
         let (u, v) = z.split_at(self.n());
         self.structure.energy(u, v, vg)
     }
@@ -592,15 +597,15 @@ impl StoreyMotion {
         // Each sub-piece's integral is added with Neumaier's compensation, so that the sum of
         // a long segment's thousands of them adds no round-off of its own.
         let mut sums = [Compensated::default(), Compensated::default()];
-        for k in 0..=last {
-            let p = self.pieces.borrow()[k].clone();
+        let pieces = self.pieces.borrow();
+        for p in &pieces[..=last] {
             let (a, b) = (p.start, p.end.min(t));
             let count = ((b - a) / sub).ceil().max(1.0);
             let h = (b - a) / count;
             for j in 0..count as usize {
                 let (lo, hi) = (a + j as f64 * h, if j + 1 == count as usize { b } else { a + (j + 1) as f64 * h });
                 let [d, w] = gauss_legendre(lo, hi, hi - lo, |s| {
-                    let z = self.full_state(&p, s);
+                    let z = self.full_state(p, s);
                     let (u, v) = z.split_at(n);
                     let vg = p.ground.at(s - p.ground.start).1 + self.sine_ground(s).1;
                     let force = self.sine.as_ref().map_or(0.0, |sine| sine.force * (sine.omega * s).sin() * (v[floor] + vg));
