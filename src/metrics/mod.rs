@@ -60,6 +60,10 @@ metrics! {
     ImpactRate = "impact_rate",
     /// A structure's largest interstorey drift for `t >= T`, m.
     PeakDrift = "peak_drift",
+    /// A structure's top floor's largest displacement relative to the ground for `t >= T`, m.
+    PeakRoofDisplacement = "peak_roof_displacement",
+    /// The largest absolute acceleration of any of a structure's floors for `t >= T`, m/s^2.
+    PeakFloorAcceleration = "peak_floor_acceleration",
 }
 
 impl std::fmt::Display for Metric {
@@ -122,6 +126,12 @@ pub struct Metrics {
     /// a structure).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub peak_drift: Option<f64>,
+    /// A structure's top floor's largest displacement relative to the ground for t >= T, m.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub peak_roof_displacement: Option<f64>,
+    /// The largest absolute acceleration (without impulses) of any floor for t >= T, m/s^2.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub peak_floor_acceleration: Option<f64>,
 }
 
 /// Mean, 95th percentile and largest of a set of per-impact values.
@@ -204,6 +214,8 @@ pub fn metrics(run: &Run) -> Metrics {
         peak_contact_force: run.impacts.iter().filter_map(|i| i.peak_force).reduce(f64::max),
         peak_true_acceleration: run.peak_true_acceleration,
         peak_drift: m.peak_drift,
+        peak_roof_displacement: m.peak_roof_displacement,
+        peak_floor_acceleration: m.peak_floor_acceleration,
     }
 }
 

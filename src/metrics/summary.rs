@@ -201,6 +201,8 @@ impl Headline {
             Metric::ImpactLoss => Some(self.impact_loss),
             Metric::ImpactRate => Some(self.impact_rate),
             Metric::PeakDrift => m.peak_drift,
+            Metric::PeakRoofDisplacement => m.peak_roof_displacement,
+            Metric::PeakFloorAcceleration => m.peak_floor_acceleration,
         }
     }
     /// Every metric, in [`Metric::ALL`] order.

@@ -190,6 +190,8 @@ impl ExactTally {
             settling_time,
             dissipation_times: self.dissipated,
             peak_drift: None,
+            peak_roof_displacement: None,
+            peak_floor_acceleration: None,
         }
     }
 }

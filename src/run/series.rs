@@ -428,7 +428,7 @@ impl Recorder {
             },
         );
         if let Some(tally) = &mut self.tally {
-            tally.add_floors(t, u);
+            tally.add_floors(t, u, &a);
         }
     }
     /// The balls' centres across the motion, `[y, z]` from `across(i)`, at the sample
@@ -495,9 +495,10 @@ impl Recorder {
                         let (u, v) = floor_state(j);
                         let energy = s.energy(u, v, 0.0);
                         let ball = |i: usize| in_ground_frame(j, &paths[i], paths[i].at(ts, xs, vs));
-                        self.sample_with(ts, xs, vs, structure_acceleration(j), |_, _, _| energy, ball);
+                        let a = scene.floor_accelerations(ts, u, v);
+                        self.sample_with(ts, xs, vs, a[s.floor], |_, _, _| energy, ball);
                         if let Some(tally) = &mut self.tally {
-                            tally.add_floors(ts, u);
+                            tally.add_floors(ts, u, &a);
                         }
                     }
                 }
@@ -552,7 +553,8 @@ impl Recorder {
                 };
                 tally.add(ts, xs, a, energy);
                 if structure.is_some() {
-                    tally.add_floors(ts, floor_state(j).0);
+                    let (u, v) = floor_state(j);
+                    tally.add_floors(ts, u, &scene.floor_accelerations(ts, u, v));
                 }
             }
         }

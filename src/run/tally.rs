@@ -28,6 +28,10 @@ pub struct MotionMetrics {
     /// A structure's largest interstorey drift over its floors for t >= T, m (`None` without
     /// a structure).
     pub peak_drift: Option<f64>,
+    /// A structure's top floor's largest displacement relative to the ground for t >= T, m.
+    pub peak_roof_displacement: Option<f64>,
+    /// The largest absolute acceleration of any floor for t >= T, m/s^2.
+    pub peak_floor_acceleration: Option<f64>,
 }
 
 /// Energy fractions left at which the dissipation times are read: 10 % and 1 %.
@@ -54,6 +58,8 @@ pub struct SampleTally {
     last_is_outside: bool,
     dissipated: [Option<f64>; 2],
     peak_drift: Option<f64>,
+    peak_roof_displacement: Option<f64>,
+    peak_floor_acceleration: Option<f64>,
 }
 
 impl SampleTally {
@@ -105,20 +111,29 @@ impl SampleTally {
             settling_time: self.settling_time(),
             dissipation_times: self.dissipated,
             peak_drift: self.peak_drift,
+            peak_roof_displacement: self.peak_roof_displacement,
+            peak_floor_acceleration: self.peak_floor_acceleration,
         }
     }
-    /// Adds a structure's floors at `t`, relative to the ground, bottom to top.
+    /// Adds a structure's floors at `t`, bottom to top: displacements `u` relative to the
+    /// ground, absolute accelerations `a`.
     #[inline]
-    pub fn add_floors(&mut self, t: f64, u: &[f64]) {
+    pub fn add_floors(&mut self, t: f64, u: &[f64], a: &[f64]) {
         let mut drift = self.peak_drift.unwrap_or(0.0);
+        let mut roof = self.peak_roof_displacement.unwrap_or(0.0);
+        let mut accel = self.peak_floor_acceleration.unwrap_or(0.0);
         if t >= self.from {
             let mut below = 0.0;
             for &x in u {
                 drift = drift.max((x - below).abs());
                 below = x;
             }
+            roof = roof.max(below.abs());
+            accel = a.iter().fold(accel, |m, a| m.max(a.abs()));
         }
         self.peak_drift = Some(drift);
+        self.peak_roof_displacement = Some(roof);
+        self.peak_floor_acceleration = Some(accel);
     }
     /// The last sampled time at which `|xs| >= 5 % |xs0|`, or `None` if the last sample still
     /// is (not settled within the horizon). A series that never reaches the band settles at 0.

@@ -377,29 +377,44 @@ fn each_member_shakes_with_its_own_random_ground() {
     assert_eq!(all.columns.last().map(String::as_str), Some("ground_seed"));
 }
 
-/// The largest interstorey drift is tallied as the run goes, so a run without a series has it
-/// too: it is the series' largest drift from one period on, and a frame has none.
+/// The largest interstorey drift, the roof's largest displacement and the largest floor
+/// acceleration are tallied as the run goes, so a run without a series has them too: they are
+/// the series' from one period on (the acceleration with the sine force on the top floor), and
+/// a frame has none.
 #[test]
 fn the_peak_drift_is_the_largest_drift_of_the_floors() {
-    let scene = lpc_damper::scene::load_scene(lpc_damper::scene::scenes_dir().join("mdof-3storey.toml")).unwrap();
-    let run = reference(&scene);
-    let s = &run.series;
-    let from = scene.frame.unwrap().damped_period();
-    let mut largest: f64 = 0.0;
-    for k in (0..s.len()).filter(|&k| s.t()[k] >= from) {
-        let mut below = 0.0;
-        for i in 0..3 {
-            let u = s.floor(i, k).unwrap().0;
-            largest = largest.max((u - below).abs());
-            below = u;
+    let path = lpc_damper::scene::scenes_dir().join("mdof-3storey.toml");
+    let forced = std::fs::read_to_string(&path).unwrap() + "\n[forcing]\nkind = \"force\"\namplitude = 2.0\nfrequency = 3.0\n";
+    let scenes = [
+        lpc_damper::scene::load_scene(&path).unwrap(),
+        lpc_damper::scene::parse(&forced, path.to_str().unwrap(), "forced").unwrap().scene.unwrap(),
+    ];
+    for scene in scenes {
+        for model in [Model::Reference, Model::Compliant] {
+            let run = model.simulate(&scene, &RunOptions::default()).unwrap();
+            let s = &run.series;
+            let from = scene.frame.unwrap().damped_period();
+            let (mut drift, mut roof, mut accel) = (0.0f64, 0.0f64, 0.0f64);
+            for k in (0..s.len()).filter(|&k| s.t()[k] >= from) {
+                let mut below = 0.0;
+                for i in 0..3 {
+                    let (u, _, a) = s.floor(i, k).unwrap();
+                    drift = drift.max((u - below).abs());
+                    accel = accel.max(a.abs());
+                    below = u;
+                }
+                roof = roof.max(below.abs());
+            }
+            let quiet = model.simulate(&scene, &RunOptions::metrics_only()).unwrap();
+            for m in [lpc_damper::metrics::metrics(&run), lpc_damper::metrics::metrics(&quiet)] {
+                assert_eq!(m.peak_drift, Some(drift), "{model:?} {}", scene.name);
+                assert_eq!(m.peak_roof_displacement, Some(roof), "{model:?} {}", scene.name);
+                assert_eq!(m.peak_floor_acceleration, Some(accel), "{model:?} {}", scene.name);
+            }
         }
     }
-    let metrics = lpc_damper::metrics::metrics(&run);
-    assert_eq!(metrics.peak_drift, Some(largest));
-    let quiet = Model::Reference.simulate(&scene, &RunOptions::metrics_only()).unwrap();
-    assert_eq!(lpc_damper::metrics::metrics(&quiet).peak_drift, Some(largest));
-    let frame = crate::common::scene_from_toml(LSL_TOML);
-    assert_eq!(lpc_damper::metrics::metrics(&reference(&frame)).peak_drift, None);
+    let frame = lpc_damper::metrics::metrics(&reference(&crate::common::scene_from_toml(LSL_TOML)));
+    assert_eq!((frame.peak_drift, frame.peak_roof_displacement, frame.peak_floor_acceleration), (None, None, None));
 }
 
 /// `lpc sweep` varies the floor that carries the damper, and refuses a floor the building has
@@ -413,7 +428,9 @@ fn a_sweep_moves_the_damper_from_floor_to_floor() {
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     let out: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
     let text = out.to_string();
-    assert!(text.contains("damper_floor") && text.contains("peak_drift"), "{text}");
+    for name in ["damper_floor", "peak_drift", "peak_roof_displacement", "peak_floor_acceleration"] {
+        assert!(text.contains(name), "{name}: {text}");
+    }
     let o = lpc_command().args(["sweep", "scenes/mdof-3storey-record.toml", "--x", "damper_floor=1,4"]).output().unwrap();
     let stderr = String::from_utf8_lossy(&o.stderr);
     assert_eq!(o.status.code(), Some(2), "{stderr}");
