@@ -98,9 +98,15 @@ pub fn table_csv(header: &[String], rows: impl IntoIterator<Item = Vec<Option<f6
 
 /// Writes `series.csv`, `impacts.csv` and `summary.json` of `run` into `dir`.
 pub fn write_run_dir(run: &Run, dir: &Path) -> std::io::Result<()> {
+    write_run_dir_with(run, &RunSummary::of(run), dir)
+}
+
+/// [`write_run_dir`] with the run's `summary` as the caller completed it (a structure's floors
+/// without the damper).
+pub fn write_run_dir_with(run: &Run, summary: &RunSummary, dir: &Path) -> std::io::Result<()> {
     std::fs::create_dir_all(dir)?;
     write_atomic_with(&dir.join("series.csv"), |w| write_series_csv(run, w))?;
     write_atomic(&dir.join("impacts.csv"), &impacts_csv(run))?;
-    let json = serde_json::to_vec_pretty(&RunSummary::of(run)).expect("summary serialises");
+    let json = serde_json::to_vec_pretty(summary).expect("summary serialises");
     write_atomic(&dir.join("summary.json"), &json)
 }

@@ -18,5 +18,6 @@ mod series_beyond_memory;
 mod squeezed_ball_stops;
 mod stale_impulse_bounce;
 mod stiff_frame_rapier_step;
+mod summary_without_bare_floors;
 mod valid_input_panics;
 mod zero_time_event_loop;

@@ -11,7 +11,7 @@ use lpc_damper::model::RunOptions;
 use lpc_damper::files::write_atomic;
 use lpc_damper::metrics::{Metric, RunSummary};
 use lpc_damper::output::parquet::{provenance, table_parquet};
-use lpc_damper::output::{table_csv, text_summary, write_run_dir};
+use lpc_damper::output::{table_csv, text_summary, write_run_dir, write_run_dir_with};
 use lpc_damper::studies::ensemble::{self, Ensemble, EnsembleSummary, ShardInfo};
 use lpc_damper::Model;
 
@@ -79,7 +79,7 @@ pub fn run(a: Args) -> Result<ExitStatus> {
         summary.floors_without_damper = lpc_damper::metrics::FloorSummary::of(&bare.series);
     }
     if let Some(dir) = &a.out {
-        write_run_dir(&run, dir).with_context(|| format!("writing outputs to {}", dir.display()))?;
+        write_run_dir_with(&run, &summary, dir).with_context(|| format!("writing outputs to {}", dir.display()))?;
     }
     match a.format {
         Format::Json => print_json(&summary)?,
