@@ -290,8 +290,9 @@ pub fn time_histories(with: &Run, without: Option<&Run>) -> Vec<Figure> {
 
 /// A structure's floors: each floor's displacement relative to the ground against time (with
 /// the damper), and the drift profile, each storey's peak interstorey drift against its
-/// height, with and without the damper. None without floors.
-pub fn floor_responses(with: &Run, without: Option<&Run>) -> Vec<Figure> {
+/// height, with the damper and, when given, without it (`without`, each floor's summary).
+/// None without floors.
+pub fn floor_responses(with: &Run, without: Option<&[crate::metrics::FloorSummary]>) -> Vec<Figure> {
     let s = &with.series;
     let n = s.floor_count();
     if n == 0 {
@@ -304,16 +305,13 @@ pub fn floor_responses(with: &Run, without: Option<&Run>) -> Vec<Figure> {
             y: (0..s.len()).map(|k| s.floor(i, k).map_or(f64::NAN, |f| f.0 * 1e3)).collect(),
         })
         .collect();
-    let profile = |run: &Run, label: &str| {
-        let storeys = crate::metrics::FloorSummary::of(&run.series);
-        Curve {
-            label: label.into(),
-            x: storeys.iter().map(|f| f.peak_drift * 1e3).collect(),
-            y: storeys.iter().map(|f| f.floor as f64).collect(),
-        }
+    let profile = |storeys: &[crate::metrics::FloorSummary], label: &str| Curve {
+        label: label.into(),
+        x: storeys.iter().map(|f| f.peak_drift * 1e3).collect(),
+        y: storeys.iter().map(|f| f.floor as f64).collect(),
     };
-    let mut drift = vec![profile(with, &format!("with damper ({})", with.model))];
-    if let Some(w) = without.filter(|w| w.series.floor_count() == n) {
+    let mut drift = vec![profile(&crate::metrics::FloorSummary::of(s), &format!("with damper ({})", with.model))];
+    if let Some(w) = without.filter(|w| w.len() == n) {
         drift.insert(0, profile(w, "without damper"));
     }
     vec![
@@ -496,18 +494,35 @@ pub fn read_series_csv(path: &Path) -> Result<Series, FigureError> {
     let fail = |reason: String| FigureError { path: path.display().to_string(), reason };
     let mut r = csv::Reader::from_path(path).map_err(|e| fail(e.to_string()))?;
     let header = r.headers().map_err(|e| fail(e.to_string()))?.clone();
-    // A structure's floors (`xs1, vs1, ...`) come last; the plots read the carrying floor.
+    // A structure's floors (`xs1, vs1, ...`, then `as1, ...`) come last.
     let cols = header.iter().position(|h| h == "xs1").unwrap_or(header.len());
     if cols < 4 || &header[0] != "t" || &header[1] != "xs" || (cols - 4) % 2 != 0 {
         return Err(fail("is not a series.csv (expected columns t, xs, vs, a, x1, v1, ...)".into()));
     }
     let balls = (cols - 4) / 2;
+    // Each floor's `xs<i>, vs<i>` and `as<i>`, found by name.
+    let floor_count = (1..).take_while(|i| header.iter().any(|h| h == format!("as{i}"))).count();
+    let find = |name: String| header.iter().position(|h| h == name).ok_or_else(|| fail(format!("has no column `{name}`")));
+    let mut floor_columns = Vec::with_capacity(3 * floor_count);
+    for prefix in ["xs", "vs", "as"] {
+        for i in 1..=floor_count {
+            floor_columns.push(find(format!("{prefix}{i}"))?);
+        }
+    }
     let mut columns: Vec<Vec<f64>> = vec![vec![]; cols];
+    let mut floors = Vec::new();
+    let number = |rec: &csv::StringRecord, k: usize, line: usize| {
+        rec.get(k)
+            .and_then(|v| v.parse::<f64>().ok())
+            .ok_or_else(|| fail(format!("row {}: column `{}` is not a number", line + 2, &header[k])))
+    };
     for (line, rec) in r.records().enumerate() {
         let rec = rec.map_err(|e| fail(e.to_string()))?;
         for (k, column) in columns.iter_mut().enumerate() {
-            let value = rec.get(k).and_then(|v| v.parse::<f64>().ok());
-            column.push(value.ok_or_else(|| fail(format!("row {}: column `{}` is not a number", line + 2, &header[k])))?);
+            column.push(number(&rec, k, line)?);
+        }
+        for &k in &floor_columns {
+            floors.push(number(&rec, k, line)?);
         }
     }
     let mut columns = columns.into_iter();
@@ -519,7 +534,7 @@ pub fn read_series_csv(path: &Path) -> Result<Series, FigureError> {
         v.push(next());
     }
     let s = Series::from_columns(t, xs, vs, a, x, v);
-    Ok(s)
+    Ok(if floor_count > 0 { s.with_floors(floor_count, floors) } else { s })
 }
 
 /// Reads the `band.csv` of `lpc run --ensemble --out` (`t, xs_p05, xs_median, xs_p95, env_p95`).

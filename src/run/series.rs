@@ -77,6 +77,14 @@ impl Series {
         }
         s
     }
+    /// This series with a structure's `count` floors: `floors` holds, sample after sample,
+    /// `u1, ..., un, v1, ..., vn, a1, ..., an` (as [`Series::floor`] reads them).
+    pub fn with_floors(mut self, count: usize, floors: Vec<f64>) -> Self {
+        assert_eq!(floors.len(), 3 * count * self.len, "every sample has each floor's u, v and a");
+        self.floor_count = count;
+        self.floors = floors;
+        self
+    }
     /// Number of samples.
     pub fn len(&self) -> usize {
         self.len

@@ -444,7 +444,7 @@ fn a_structure_plots_its_floors_and_drift_profile() {
     use lpc_damper::output::figures::floor_responses;
     let scene = lpc_damper::scene::load_scene(lpc_damper::scene::scenes_dir().join("mdof-3storey.toml")).unwrap();
     let (with, without) = (reference(&scene), reference(&scene.without_damper()));
-    let figs = floor_responses(&with, Some(&without));
+    let figs = floor_responses(&with, Some(&lpc_damper::metrics::FloorSummary::of(&without.series)));
     assert_eq!(figs.iter().map(|f| f.name.as_str()).collect::<Vec<_>>(), ["floors", "drift-profile"]);
     assert_eq!(figs[0].curves.len(), 3);
     let profile = &figs[1].curves;
@@ -454,6 +454,26 @@ fn a_structure_plots_its_floors_and_drift_profile() {
     assert_eq!(profile[1].y, vec![1.0, 2.0, 3.0]);
     let frame = crate::common::scene_from_toml(LSL_TOML);
     assert!(floor_responses(&reference(&frame), None).is_empty());
+    // From a run's directory: series.csv gives the floors back exactly, summary.json the bare
+    // building's, and `lpc plot` draws both figures.
+    let dir = tempfile::tempdir().unwrap();
+    let (run_dir, figures) = (dir.path().join("run"), dir.path().join("figures"));
+    let o = lpc_command().args(["run", "scenes/mdof-3storey.toml", "--out", run_dir.to_str().unwrap()]).output().unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let read = lpc_damper::output::figures::read_series_csv(&run_dir.join("series.csv")).unwrap();
+    assert_eq!(read.floor_count(), 3);
+    for k in [0, read.len() / 2, read.len() - 1] {
+        for i in 0..3 {
+            assert_eq!(read.floor(i, k), with.series.floor(i, k), "floor {} at sample {k}", i + 1);
+        }
+    }
+    let summary: serde_json::Value = serde_json::from_slice(&std::fs::read(run_dir.join("summary.json")).unwrap()).unwrap();
+    assert_eq!(summary["floors_without_damper"].as_array().map(|f| f.len()), Some(3));
+    let o = lpc_command().args(["plot", run_dir.to_str().unwrap(), "--out", figures.to_str().unwrap()]).output().unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    for name in ["floors.png", "drift-profile.svg"] {
+        assert!(figures.join(name).is_file(), "{name}");
+    }
 }
 
 /// Under a sine (the ground moving as `Y sin w t`, or a force on the top floor), the floors of

@@ -50,6 +50,13 @@ pub fn run(a: Args) -> Result<ExitStatus> {
             let mut run = lpc_damper::run::Run::empty(&name_of(&a.input, "scene").unwrap_or_else(|| "run".into()), model);
             run.series = s;
             figs.extend(figures::time_histories(&run, None));
+            // A structure's floors, with the bare building's drift profile from its summary.
+            let bare: Option<Vec<lpc_damper::metrics::FloorSummary>> = std::fs::read(a.input.join("summary.json"))
+                .ok()
+                .and_then(|text| serde_json::from_slice::<serde_json::Value>(&text).ok())
+                .and_then(|v| serde_json::from_value(v.get("floors_without_damper")?.clone()).ok())
+                .filter(|f: &Vec<_>| !f.is_empty());
+            figs.extend(figures::floor_responses(&run, bare.as_deref()));
             figs.extend(figures::ball_positions(&run, None, &[]));
             // `lpc run --ensemble --out`: the members' band over the nominal run.
             let band = a.input.join("band.csv");
@@ -109,7 +116,8 @@ pub fn run(a: Args) -> Result<ExitStatus> {
             let run = crate::watch::watched(a.model, &s, RunOptions::limited(limits), None)?;
             let bare = crate::watch::watched(lpc_damper::Model::Reference, &s.without_damper(), RunOptions::limited(limits), None)?;
             figs.extend(figures::time_histories(&run, (!s.balls.is_empty()).then_some(&bare)));
-            figs.extend(figures::floor_responses(&run, (!s.balls.is_empty()).then_some(&bare)));
+            let bare_floors = lpc_damper::metrics::FloorSummary::of(&bare.series);
+            figs.extend(figures::floor_responses(&run, (!s.balls.is_empty()).then_some(&bare_floors[..])));
             if !s.balls.is_empty() {
                 let chains: Vec<_> = (0..s.space.chains()).map(|k| s.space.chain(k, s.balls.len())).collect();
                 figs.extend(figures::ball_positions(&run, s.container.map(|c| c.length), &chains));
