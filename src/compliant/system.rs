@@ -63,9 +63,10 @@ pub(super) struct System<'a> {
     pub(super) floors: Option<Floors<'a>>,
 }
 
-/// A structure of several storeys (or one under a ground record) as the ODE carries it. The
-/// carrying floor is the frame (`XS`, `VS`: absolute, as the balls are); every other floor's
-/// displacement and velocity relative to the ground follow the contact dissipations.
+/// A structure of several storeys (or one under a record) as the ODE carries it. The carrying
+/// floor is the frame (`XS`, `VS`: absolute, as the balls are); every other floor's
+/// displacement and velocity relative to the ground come after the contacts' dissipation
+/// integrals in the state.
 pub(super) struct Floors<'a> {
     pub(super) structure: &'a Structure,
     /// `K`, N/m.
