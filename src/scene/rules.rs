@@ -146,7 +146,11 @@ pub fn validate_sample_dt(horizon: f64, dt: f64) -> Result<(), String> {
 pub(super) fn build_damper(f: &SceneFile, name: &str, v: &Validator) -> Result<Scene, SceneError> {
     let record = match &f.forcing {
         Some(g) if g.kind == ExcitationKind::Record => Some(Arc::new(ground_record(g, "record", &["file", "scale"], v)?)),
-        Some(g) if g.kind == ExcitationKind::Random => Some(Arc::new(random_ground(g, v)?.record(g.seed.unwrap_or(1)))),
+        Some(g) if g.kind == ExcitationKind::Random => {
+            let record = random_ground(g, v)?.record(g.seed.unwrap_or(1));
+            within_range(&record, "forcing.intensity", v)?;
+            Some(Arc::new(record))
+        }
         _ => None,
     };
     let force = match &f.forcing {
@@ -366,7 +370,29 @@ fn ground_record(g: &format::ForcingFile, kind: &str, keys: &[&str], v: &Validat
         ));
     }
     let (times, accel) = read_points(&text).map_err(|why| v.err("forcing.file", &format!("({}) {why}", path.display())))?;
-    Ok(GroundRecord::new(times, accel, scale))
+    let record = GroundRecord::new(times, accel, scale);
+    within_range(&record, "forcing.scale", v)?;
+    Ok(record)
+}
+
+/// The largest value a record may reach (m/s^2 or N): the energies it puts in grow as its
+/// square, and beyond this they would leave the range of double precision.
+const RECORD_LIMIT: f64 = 1e100;
+
+/// Refuses a record (read, or drawn at random) whose values reach [`RECORD_LIMIT`].
+fn within_range(record: &GroundRecord, field: &str, v: &Validator) -> Result<(), SceneError> {
+    let peak = record.peak();
+    if !(peak <= RECORD_LIMIT) {
+        return Err(v.err(
+            field,
+            &format!(
+                "puts the record's peak at {}, beyond {}: the energy it gives grows as its square and would leave the range of double precision",
+                human(peak),
+                human(RECORD_LIMIT)
+            ),
+        ));
+    }
+    Ok(())
 }
 
 fn build_frame_damper(f: &SceneFile, name: &str, v: &Validator) -> Result<Scene, SceneError> {

@@ -13,6 +13,7 @@ mod issue_14_touching_chain;
 mod loaded_contact_sinks;
 mod overdamped_bed_balance;
 mod plugin_driven_by_app_update;
+mod record_beyond_double_range;
 mod resting_ball_without_energy;
 mod series_beyond_memory;
 mod squeezed_ball_stops;
