@@ -167,23 +167,14 @@ pub fn steady_floors(scene: &Scene, model: Model, limits: Limits) -> Result<Floo
     let period = 1.0 / scene.forcing.expect("a forced scene").frequency;
     let (reading, horizon, _, run) = steady_runs(scene, model, limits)?;
     let s = &run.series;
-    let periods = (run.horizon / period).floor() as usize;
-    let window = periods.min(BLOCK_PERIODS);
     let floors = (0..s.floor_count())
         .map(|i| {
-            let mut peaks = vec![0.0f64; window];
-            for (k, t) in s.t().iter().enumerate() {
-                let j = (t / period) as usize;
-                if (periods - window..periods).contains(&j) {
-                    let (u, _, _) = s.floor(i, k).expect("a structure's series has its floors");
-                    peaks[j + window - periods] = peaks[j + window - periods].max(u.abs());
-                }
-            }
-            let largest = peaks.iter().fold(0.0, |m: f64, p| m.max(*p));
+            let peaks = peaks_of(&run, period, |k| s.floor(i, k).expect("a structure's series has its floors").0);
+            let last = &peaks[peaks.len() - peaks.len().min(BLOCK_PERIODS)..];
             if reading.steady {
-                peaks.iter().sum::<f64>() / window as f64
+                last.iter().sum::<f64>() / last.len() as f64
             } else {
-                largest
+                last.iter().fold(0.0, |m: f64, p| m.max(*p))
             }
         })
         .collect();
@@ -218,13 +209,17 @@ fn steady_runs(scene: &Scene, model: Model, limits: Limits) -> Result<(SteadySta
 
 /// The peak of `|xs|` in each whole forcing period of `run`.
 pub fn period_peaks(run: &Run, period: f64) -> Vec<f64> {
-    let s = &run.series;
+    peaks_of(run, period, |k| run.series.xs()[k])
+}
+
+/// The peak of `|value(k)|` over the samples `k` of each whole forcing period of `run`.
+fn peaks_of(run: &Run, period: f64, value: impl Fn(usize) -> f64) -> Vec<f64> {
     let periods = (run.horizon / period).floor() as usize;
     let mut peaks = vec![0.0f64; periods];
-    for (t, x) in s.t().iter().zip(s.xs()) {
-        let k = (t / period) as usize;
-        if k < periods {
-            peaks[k] = peaks[k].max(x.abs());
+    for (k, t) in run.series.t().iter().enumerate() {
+        let j = (t / period) as usize;
+        if j < periods {
+            peaks[j] = peaks[j].max(value(k).abs());
         }
     }
     peaks
