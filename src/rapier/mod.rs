@@ -53,19 +53,12 @@ pub fn headless_app_recording(scene: &Scene, settings: StepSettings, record: Rec
 #[derive(Debug, Clone, Copy)]
 pub struct Rapier;
 
-/// Why the model refuses a structure of several storeys or a ground-motion record.
-const STRUCTURES_NOT_YET: &str =
-    "it moves a frame of one storey under free vibration or a sine; structures of several storeys and ground-motion records run with the reference and compliant models";
-
 impl Simulator for Rapier {
     fn model(&self) -> Model {
         Model::Rapier
     }
 
     fn supports(&self, scene: &Scene) -> Result<(), String> {
-        if scene.structure.is_some() {
-            return Err(STRUCTURES_NOT_YET.into());
-        }
         // Several chains, or balls beyond lines, go to the spatial path (`spatial`).
         if spatial::needs_spatial(scene) {
             return spatial::refusal(scene).map_or(Ok(()), Err);
@@ -122,6 +115,9 @@ pub fn simulate_with(scene: &Scene, settings: StepSettings, options: &RunOptions
     // first step; the rest run the lean step schedule alone.
     app.update();
     let world = app.world_mut();
+    if let Some(failure) = frame_failure(world, scene) {
+        return Err(failure);
+    }
     loop {
         let clock = *world.resource::<StepClock>();
         if clock.t >= scene.horizon * (1.0 - 1e-12) {
@@ -150,6 +146,9 @@ pub fn simulate_with(scene: &Scene, settings: StepSettings, options: &RunOptions
             })));
         }
         world.run_schedule(DamperStep);
+        if let Some(failure) = frame_failure(world, scene) {
+            return Err(failure);
+        }
         if let Some(reason) = world.resource::<Recording>().failure.clone() {
             let t = world.resource::<StepClock>().t;
             return Err(ModelError::Unstable {
@@ -167,20 +166,23 @@ pub fn simulate_with(scene: &Scene, settings: StepSettings, options: &RunOptions
     Ok(run)
 }
 
+/// Why the frame cannot move on, when it cannot: a structure whose floors have no modes with
+/// the balls they hold, which no model can run either.
+fn frame_failure(world: &World, scene: &Scene) -> Option<ModelError> {
+    let reason = world.get_resource::<FrameState>()?.failure.clone()?;
+    Some(ModelError::Unstable { scene: scene.name.clone(), model: Model::Rapier, t: world.resource::<StepClock>().t, reason })
+}
+
 /// The [`Run`] recorded in `world`, up to time `t` (the horizon, or where a budget stopped it).
 pub fn collect(world: &mut World, scene: &Scene, t: f64, steps: u64) -> Run {
     let rec = world.remove_resource::<Recording>().expect("recording");
-    let frame = world.get_resource::<FrameState>().copied();
-    let (xs, vs) = frame.map_or((0.0, 0.0), |f| f.now);
+    let (frame_energy, damping_loss, forcing_work) = match world.get_resource_mut::<FrameState>() {
+        Some(mut frame) => (frame.energy(scene, t), frame.damping_loss, frame.forcing_work),
+        None => (scene.frame_energy(t, 0.0, 0.0), 0.0, 0.0),
+    };
     let f = scene.frame;
-    let final_ = scene.frame_energy(t, xs, vs) + scene.balls.iter().zip(&rec.v).map(|(b, v)| 0.5 * b.mass * v * v).sum::<f64>();
-    let energy = EnergyAccount::forced(
-        scene.initial_energy(),
-        final_,
-        frame.map_or(0.0, |f| f.damping_loss),
-        rec.impact_loss,
-        frame.map_or(0.0, |f| f.forcing_work),
-    );
+    let final_ = frame_energy + scene.balls.iter().zip(&rec.v).map(|(b, v)| 0.5 * b.mass * v * v).sum::<f64>();
+    let energy = EnergyAccount::forced(scene.initial_energy(), final_, damping_loss, rec.impact_loss, forcing_work);
     let (series, motion) = rec.recorder.finish();
     Run {
         scene: scene.name.clone(),

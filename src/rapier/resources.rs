@@ -4,9 +4,12 @@
 
 use bevy::prelude::*;
 
+use std::sync::{Mutex, PoisonError};
+
 use crate::oscillator::Driven;
 use crate::run::{Impact, Record, Recorder};
 use crate::scene::{Scene, Stepping};
+use crate::storeys::FloorMotion;
 
 /// Rapier's length unit: the balls are centimetres, so are the tolerances.
 pub const LENGTH_UNIT: f32 = 0.01;
@@ -61,7 +64,9 @@ pub struct Bodies {
 pub struct FrameBody;
 
 /// The frame's exact state (f64), advanced in closed form; impacts arrive as velocity jumps.
-#[derive(Resource, Debug, Clone, Copy)]
+/// On a structure of several storeys the frame is the carrying floor, and the structure's
+/// floors move it in place of the oscillator.
+#[derive(Resource, Debug)]
 pub struct FrameState {
     /// The bare frame's oscillator, with the scene's harmonic load.
     pub bare: Driven,
@@ -83,6 +88,75 @@ pub struct FrameState {
     pub damping_loss: f64,
     /// Work done by the excitation so far, J.
     pub forcing_work: f64,
+    /// A structure's floors since the step's start, in closed form. The lock is there only so
+    /// that the state can be a resource: the systems that hold it run one at a time.
+    pub floors: Option<Mutex<FloorMotion>>,
+    /// Why the frame cannot move on: its floors have no modes with the balls they hold.
+    pub failure: Option<String>,
+}
+
+impl FrameState {
+    /// The structure's floors, when the frame is a structure's carrying floor.
+    pub fn floors_mut(&mut self) -> Option<&mut FloorMotion> {
+        self.floors.as_mut().map(|m| m.get_mut().unwrap_or_else(PoisonError::into_inner))
+    }
+
+    /// Moves a structure's floors over the step from `t0` to `t0 + h` from where the frame is
+    /// now, the carrying floor holding `held` kg of balls: the frame's state at the step's end
+    /// before its impulses, and the storeys' loss and the excitation's work over the step.
+    /// Returns whether the frame is a structure's floor (otherwise nothing is done).
+    pub fn advance_floors(&mut self, t0: f64, h: f64, held: f64) -> bool {
+        let v = self.now.1;
+        let Some(floors) = self.floors.as_mut().map(|m| m.get_mut().unwrap_or_else(PoisonError::into_inner)) else { return false };
+        if let Err(why) = floors.restart(t0, v, held) {
+            self.failure.get_or_insert(why);
+        }
+        let t1 = t0 + h;
+        self.before_impulses = floors.state(t1);
+        let (damping, work) = floors.segment_energy(t1);
+        self.damping_loss += damping;
+        self.forcing_work += work;
+        true
+    }
+
+    /// The floors' state `[u; u']` relative to the ground at `t` in the current step, with the
+    /// carrying floor moving at the frame's velocity now (its impulses included) and the
+    /// ground's displacement and velocity; `None` for a frame of one storey.
+    pub fn floors_now(&mut self, t: f64) -> Option<(Vec<f64>, (f64, f64))> {
+        let v = self.now.1;
+        let floors = self.floors_mut()?;
+        let (mut z, ground) = floors.floors(t);
+        let d = floors.structure.floor;
+        let n = z.len() / 2;
+        z[n + d] = v - ground.1;
+        Some((z, ground))
+    }
+
+    /// The smooth force on the frame at `t` as it is now (springs, dampers and excitation;
+    /// impulses and contact forces excluded), N.
+    pub fn smooth_force(&mut self, scene: &Scene, t: f64) -> f64 {
+        let (xs, vs) = self.now;
+        match (self.floors_now(t), scene.structure.as_deref()) {
+            (Some((z, _)), Some(s)) => {
+                let (u, v) = z.split_at(z.len() / 2);
+                scene.floor_accelerations(t, u, v)[s.floor] * s.building.masses[s.floor]
+            }
+            _ => scene.frame_force(t, xs, vs),
+        }
+    }
+
+    /// The mechanical energy of the frame (or of the structure it is a floor of) at `t` as it
+    /// is now, J.
+    pub fn energy(&mut self, scene: &Scene, t: f64) -> f64 {
+        let (xs, vs) = self.now;
+        match (self.floors_now(t), scene.structure.as_deref()) {
+            (Some((z, (_, vg))), Some(s)) => {
+                let (u, v) = z.split_at(z.len() / 2);
+                s.energy(u, v, vg)
+            }
+            _ => scene.frame_energy(t, xs, vs),
+        }
+    }
 }
 
 /// The balls `held` (counted from the left and the right wall, as [`FrameState::held`]) of a

@@ -31,6 +31,9 @@ pub const WALL_CHORD_ERROR: f64 = 1e-5;
 /// The frame's largest acceleration to expect: its spring at the larger of the initial
 /// displacement and the steady forced amplitude, plus the excitation's load, m/s^2.
 pub fn peak_frame_acceleration(scene: &Scene) -> f64 {
+    if let Some(s) = scene.structure.as_deref() {
+        return peak_floor_acceleration(scene, s);
+    }
     let Some(f) = scene.frame else { return 0.0 };
     let (steady, load) = scene.harmonic_load().map_or((0.0, 0.0), |(p, q, w)| {
         let osc = crate::oscillator::Oscillator::new(f.mass, f.damping, f.stiffness);
@@ -39,20 +42,40 @@ pub fn peak_frame_acceleration(scene: &Scene) -> f64 {
     (f.stiffness * scene.initial_displacement.abs().max(steady) + load) / f.mass
 }
 
+/// A structure's carrying floor's largest acceleration to expect: the scene's speed scale at
+/// the fastest mode's frequency, plus the record's peak (the ground's acceleration, or a
+/// floor's force over its mass) and a sine's, m/s^2.
+fn peak_floor_acceleration(scene: &Scene, s: &crate::scene::Structure) -> f64 {
+    let fastest = s.building.undamped_modes().0.into_iter().fold(0.0, f64::max);
+    let ground = s.ground.as_ref().map_or(0.0, |g| g.peak());
+    let force = s.force.as_ref().map_or(0.0, |f| f.record.peak() / s.building.masses[f.floor]);
+    let sine = scene.forcing.map_or(0.0, |g| match g.kind {
+        crate::scene::ForcingKind::Base => g.amplitude * g.omega() * g.omega(),
+        crate::scene::ForcingKind::Force => g.amplitude / s.building.masses[s.floor],
+    });
+    scene.motion_speed() * fastest + ground + force + sine
+}
+
+/// The shortest natural period of what carries the container: the frame's, or a structure's
+/// fastest mode's, s.
+fn shortest_period(scene: &Scene) -> f64 {
+    let two_pi = 2.0 * std::f64::consts::PI;
+    match scene.structure.as_deref() {
+        Some(s) => two_pi / s.building.undamped_modes().0.into_iter().fold(0.0, f64::max),
+        None => scene.frame.filter(|f| f.stiffness > 0.0).map_or(f64::INFINITY, |f| two_pi * (f.mass / f.stiffness).sqrt()),
+    }
+}
+
 /// The stepping a scene asks for, with the defaults filled in and the step kept inside the
-/// stable region: at most a 40th of the frame's natural period and of the forcing period, and
-/// short enough that the walls' straight path over a step stays within [`WALL_CHORD_ERROR`]
-/// of the frame's (`a h^2 / 8`).
+/// stable region: at most a 40th of the frame's natural period (a structure's shortest) and of
+/// the forcing period, and short enough that the walls' straight path over a step stays within
+/// [`WALL_CHORD_ERROR`] of the frame's (`a h^2 / 8`).
 pub fn settings(scene: &Scene) -> StepSettings {
     let dt = scene.rapier.dt.unwrap_or(DEFAULT_DT);
     let a = peak_frame_acceleration(scene);
     let chord_bound = if a > 0.0 { (8.0 * WALL_CHORD_ERROR / a).sqrt() } else { f64::INFINITY };
     let forcing_bound = scene.forcing.map_or(f64::INFINITY, |g| 1.0 / (g.frequency * STEPS_PER_FRAME_PERIOD));
-    let period_bound = scene
-        .frame
-        .filter(|f| f.stiffness > 0.0)
-        .map_or(f64::INFINITY, |f| 2.0 * std::f64::consts::PI * (f.mass / f.stiffness).sqrt() / STEPS_PER_FRAME_PERIOD)
-        .min(forcing_bound);
+    let period_bound = (shortest_period(scene) / STEPS_PER_FRAME_PERIOD).min(forcing_bound);
     StepSettings {
         stepping: scene.rapier.stepping.unwrap_or(DEFAULT_STEPPING),
         dt: dt.min(period_bound).min(chord_bound),

@@ -131,13 +131,15 @@ pub fn feedback(
         step_impulses(scene, v_new, &rec.v, active, dp, j);
     }
     let forcing_work = frame.as_ref().map_or(0.0, |f| f.forcing_work);
-    let (frame_pre, frame_post) = match frame {
+    let t1 = t0 + plan.h;
+    let (frame_pre, frame_post, frame_energy) = match frame {
         Some(mut f) => {
-            let fed = feed_frame(&mut f, scene, dp);
-            f.held = held_runs(scene, x_new, v_new, (f.now, t0 + plan.h, plan.h));
-            fed
+            let (pre, post) = feed_frame(&mut f, scene, dp);
+            let force = f.smooth_force(scene, t1);
+            f.held = held_runs(scene, x_new, v_new, f.now, force, plan.h);
+            (pre, post, f.energy(scene, t1))
         }
-        None => (0.0, 0.0),
+        None => (0.0, 0.0, 0.0),
     };
     let step = StepVelocities { before: &rec.v, after: v_new, frame_before: frame_pre, frame_after: frame_post };
     rec.impact_loss += step.kinetic_energy_lost(scene);
@@ -154,7 +156,7 @@ pub fn feedback(
         attribute_impacts(ledger, scene, &step, &start, &rec.x, active, j, shares);
     }
     if settings.safeguards && rec.failure.is_none() {
-        rec.failure = self_check(scene, rec, x_new, v_new, frame_end.0, frame_post, forcing_work, t0 + plan.h);
+        rec.failure = self_check(scene, rec, (x_new, v_new), frame_end.0, frame_energy, forcing_work, t1);
     }
     std::mem::swap(&mut rec.prev_x, &mut rec.x);
     std::mem::swap(&mut rec.prev_v, &mut rec.v);
@@ -303,11 +305,10 @@ fn share_frame_impulse(scene: &Scene, carried: [usize; 2], frame_v: f64, dp: &[f
 
 /// Phase 6: the balls the walls hold next step: from each wall, the touching run of balls that
 /// moves with the frame (within what its acceleration builds in a step) while the frame's
-/// smooth force pushes the wall into it (docs/MODEL.md §4).
-fn held_runs(scene: &Scene, x: &[f64], v: &[f64], ((xs, vs), t, h): ((f64, f64), f64, f64)) -> [usize; 2] {
+/// smooth force `force` pushes the wall into it (docs/MODEL.md §4).
+fn held_runs(scene: &Scene, x: &[f64], v: &[f64], (xs, vs): (f64, f64), force: f64, h: f64) -> [usize; 2] {
     let (Some(f), Some(c)) = (scene.frame, scene.container) else { return [0, 0] };
     let n = x.len();
-    let force = scene.frame_force(t, xs, vs);
     let stick = contacts::sticking_speed(scene, force / f.mass, h);
     let walls = Some((xs, c.length));
     let holds =
@@ -552,8 +553,15 @@ fn attribute_impacts(
 /// What the contact model cannot have done, checked after every step: a ball deeper in a wall
 /// than Rapier's allowed overlap (pushed through: projection only lifts shallow overlaps), an
 /// impact that gained energy, or more energy in the system than was put in. Returns the reason.
-#[allow(clippy::too_many_arguments)]
-fn self_check(scene: &Scene, rec: &Recording, x: &[f64], v: &[f64], xs: f64, vs: f64, forcing_work: f64, t: f64) -> Option<String> {
+fn self_check(
+    scene: &Scene,
+    rec: &Recording,
+    (x, v): (&[f64], &[f64]),
+    xs: f64,
+    frame_energy: f64,
+    forcing_work: f64,
+    t: f64,
+) -> Option<String> {
     if let Some(c) = scene.container {
         for (i, b) in scene.balls.iter().enumerate() {
             let (left, right) = (x[i] - b.radius - xs, xs + c.length - x[i] - b.radius);
@@ -590,7 +598,7 @@ fn self_check(scene: &Scene, rec: &Recording, x: &[f64], v: &[f64], xs: f64, vs:
             }
         }
     }
-    let now = scene.frame_energy(t, xs, vs) + scene.balls.iter().zip(v).map(|(b, v)| 0.5 * b.mass * v * v).sum::<f64>();
+    let now = frame_energy + scene.balls.iter().zip(v).map(|(b, v)| 0.5 * b.mass * v * v).sum::<f64>();
     if now > energy_in * (1.0 + ENERGY_GAIN_TOLERANCE) + rec.energy_floor {
         return Some(format!("at t = {t:.6e} s the system holds {now:.6e} J, more than the {energy_in:.6e} J put in"));
     }

@@ -36,7 +36,7 @@ pub fn resolve_impacts(
     let floor = approach_floor(scene);
     // What the frame's acceleration now builds over the last step: a slower approach of a
     // loaded pair is the wall or the chain pressing on, not a new impact.
-    let acceleration = frame.as_deref().zip(scene.frame).map_or(0.0, |(f, sf)| scene.frame_force(clock.t, f.now.0, f.now.1) / sf.mass);
+    let acceleration = frame.as_deref_mut().zip(scene.frame).map_or(0.0, |(f, sf)| f.smooth_force(scene, clock.t) / sf.mass);
     let stick = sticking_speed(scene, acceleration, plan.h);
     let Recording { x, v, last_impulse, impulse_floor, impacts, last_impact, struck_at, impact_loss, .. } = &mut *rec;
     // Pairs within a run the walls hold ride the frame: persistent too.

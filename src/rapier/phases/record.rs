@@ -18,7 +18,7 @@ pub fn record_samples(
     clock: Res<StepClock>,
     plan: Res<StepPlan>,
     scene: Res<DamperScene>,
-    frame: Option<Res<FrameState>>,
+    mut frame: Option<ResMut<FrameState>>,
     mut rec: ResMut<Recording>,
 ) {
     let scene = &scene.0;
@@ -34,14 +34,8 @@ pub fn record_samples(
         if ts > t1 && !at_end {
             break;
         }
-        let (xs, vs) = match &frame {
-            Some(_) if k == 0 => (scene.initial_displacement, 0.0),
-            Some(fr) if at_end => fr.now,
-            Some(fr) => fr.motion.state(fr.start.0, fr.start.1, fr.t_start, ts.max(fr.t_start)),
-            None => (0.0, 0.0),
-        };
         let (x, v, prev_x, prev_v) = (&rec.x, &rec.v, &rec.prev_x, &rec.prev_v);
-        rec.recorder.sample(scene, ts, xs, vs, |i| {
+        let ball = |i: usize| {
             if k == 0 {
                 (scene.initial_positions[i], scene.initial_velocities[i])
             } else if at_end {
@@ -51,7 +45,34 @@ pub fn record_samples(
                 let w = ((ts - t0) / dt).clamp(0.0, 1.0);
                 (prev_x[i] + w * (x[i] - prev_x[i]), prev_v[i])
             }
-        });
+        };
+        match (frame.as_deref_mut(), scene.structure.as_deref()) {
+            (Some(fr), Some(s)) if fr.floors.is_some() => {
+                // The floors relative to the ground: as they start, as the closed form moves
+                // them inside the step, or with the carrying floor's impulses at its end.
+                let (z, ground) = if k == 0 {
+                    let z = s.initial_displacements.iter().chain(&s.initial_velocities).copied().collect();
+                    let (xg, vg, _) = scene.ground_motion(0.0);
+                    (z, (xg, vg))
+                } else if at_end {
+                    fr.floors_now(ts).expect("a structure has floors")
+                } else {
+                    let from = fr.t_start;
+                    fr.floors_mut().expect("a structure has floors").floors(ts.max(from))
+                };
+                let (u, v) = z.split_at(z.len() / 2);
+                rec.recorder.sample_floors(scene, ts, (u, v), ground, ball);
+            }
+            (fr, _) => {
+                let (xs, vs) = match fr {
+                    Some(_) if k == 0 => (scene.initial_displacement, 0.0),
+                    Some(fr) if at_end => fr.now,
+                    Some(fr) => fr.motion.state(fr.start.0, fr.start.1, fr.t_start, ts.max(fr.t_start)),
+                    None => (0.0, 0.0),
+                };
+                rec.recorder.sample(scene, ts, xs, vs, ball);
+            }
+        }
         rec.next_sample += 1;
     }
 }

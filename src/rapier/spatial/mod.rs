@@ -59,6 +59,12 @@ pub fn needs_spatial(scene: &Scene) -> bool {
 
 /// Why the spatial path cannot run `scene`, or `None` when it can.
 pub fn refusal(scene: &Scene) -> Option<String> {
+    if scene.structure.is_some() {
+        return Some(
+            "it moves several chains and balls beyond their lines on a frame of one storey only; on a structure of several storeys or under a ground-motion record its balls must stay on one line"
+                .into(),
+        );
+    }
     if scene.frame.is_none() {
         return Some("the scene has no frame; the spatial contact model needs a container on a frame".into());
     }
