@@ -4,7 +4,8 @@
 # paper's 4.03 Hz, every mode damped 1.6 %) with the paper's LSL damper on its top floor, shaken
 # for 20 s by records/synthetic-kt.csv scaled to 0.5 m/s^2; the computing time of each run
 # (best of three) against N, per simulated second and per impact, and the same building alone.
-# MODEL (default reference) may be compliant, which integrates the floors with its balls.
+# MODEL (default reference) may be compliant, which integrates the floors with its balls, or
+# rapier, which moves its container with the closed form step by step.
 #   bash benches/storeys.sh [LPC] [STOREYS] [MODEL]   (default: target/release/lpc, "1 2 3 5 10 20", reference)
 set -euo pipefail
 lpc=${1:-target/release/lpc}

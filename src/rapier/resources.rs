@@ -93,6 +93,8 @@ pub struct FrameState {
     pub floors: Option<Mutex<FloorMotion>>,
     /// Why the frame cannot move on: its floors have no modes with the balls they hold.
     pub failure: Option<String>,
+    /// The mass of balls the floors' current closed form carries on the carrying floor, kg.
+    pub floors_held: f64,
 }
 
 impl FrameState {
@@ -107,13 +109,19 @@ impl FrameState {
     /// Returns whether the frame is a structure's floor (otherwise nothing is done).
     pub fn advance_floors(&mut self, t0: f64, h: f64, held: f64) -> bool {
         let v = self.now.1;
+        // The closed form goes on until an impulse changes the carrying floor's velocity or
+        // what the floor holds changes.
+        let (kept, held_before) = (self.now == self.before_impulses, self.floors_held);
         let Some(floors) = self.floors.as_mut().map(|m| m.get_mut().unwrap_or_else(PoisonError::into_inner)) else { return false };
-        if let Err(why) = floors.restart(t0, v, held) {
-            self.failure.get_or_insert(why);
+        if !(kept && held == held_before) {
+            if let Err(why) = floors.restart(t0, v, held) {
+                self.failure.get_or_insert(why);
+            }
+            self.floors_held = held;
         }
         let t1 = t0 + h;
         self.before_impulses = floors.state(t1);
-        let (damping, work) = floors.segment_energy(t1);
+        let (damping, work) = floors.energy_between(t0, t1);
         self.damping_loss += damping;
         self.forcing_work += work;
         true

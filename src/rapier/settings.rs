@@ -56,26 +56,21 @@ fn peak_floor_acceleration(scene: &Scene, s: &crate::scene::Structure) -> f64 {
     scene.motion_speed() * fastest + ground + force + sine
 }
 
-/// The shortest natural period of what carries the container: the frame's, or a structure's
-/// fastest mode's, s.
-fn shortest_period(scene: &Scene) -> f64 {
-    let two_pi = 2.0 * std::f64::consts::PI;
-    match scene.structure.as_deref() {
-        Some(s) => two_pi / s.building.undamped_modes().0.into_iter().fold(0.0, f64::max),
-        None => scene.frame.filter(|f| f.stiffness > 0.0).map_or(f64::INFINITY, |f| two_pi * (f.mass / f.stiffness).sqrt()),
-    }
-}
-
 /// The stepping a scene asks for, with the defaults filled in and the step kept inside the
-/// stable region: at most a 40th of the frame's natural period (a structure's shortest) and of
-/// the forcing period, and short enough that the walls' straight path over a step stays within
-/// [`WALL_CHORD_ERROR`] of the frame's (`a h^2 / 8`).
+/// stable region: at most a 40th of the frame's natural period (a structure's fundamental one)
+/// and of the forcing period, and short enough that the walls' straight path over a step stays
+/// within [`WALL_CHORD_ERROR`] of the frame's (`a h^2 / 8`, where a structure's faster modes
+/// count).
 pub fn settings(scene: &Scene) -> StepSettings {
     let dt = scene.rapier.dt.unwrap_or(DEFAULT_DT);
     let a = peak_frame_acceleration(scene);
     let chord_bound = if a > 0.0 { (8.0 * WALL_CHORD_ERROR / a).sqrt() } else { f64::INFINITY };
     let forcing_bound = scene.forcing.map_or(f64::INFINITY, |g| 1.0 / (g.frequency * STEPS_PER_FRAME_PERIOD));
-    let period_bound = (shortest_period(scene) / STEPS_PER_FRAME_PERIOD).min(forcing_bound);
+    let period_bound = scene
+        .frame
+        .filter(|f| f.stiffness > 0.0)
+        .map_or(f64::INFINITY, |f| 2.0 * std::f64::consts::PI * (f.mass / f.stiffness).sqrt() / STEPS_PER_FRAME_PERIOD)
+        .min(forcing_bound);
     StepSettings {
         stepping: scene.rapier.stepping.unwrap_or(DEFAULT_STEPPING),
         dt: dt.min(period_bound).min(chord_bound),

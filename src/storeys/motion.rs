@@ -327,7 +327,12 @@ impl FloorMotion {
     /// to `t`: Gauss-Legendre on each piece, on sub-pieces short enough that it is exact to
     /// round-off (the integrands turn at up to twice the fastest mode's rate).
     pub fn segment_energy(&self, t: f64) -> (f64, f64) {
-        if !(t > self.t0) {
+        self.energy_between(self.t0, t)
+    }
+
+    /// [`FloorMotion::segment_energy`] from `from` (within the segment) to `t`.
+    pub fn energy_between(&self, from: f64, t: f64) -> (f64, f64) {
+        if !(t > from && from >= self.t0) {
             return (0.0, 0.0);
         }
         let fastest = self.modes.rate.max(self.sine.as_ref().map_or(0.0, |s| s.omega));
@@ -341,8 +346,8 @@ impl FloorMotion {
         // a long segment's thousands of them adds no round-off of its own.
         let mut sums = [Compensated::default(), Compensated::default()];
         let pieces = self.pieces.borrow();
-        for p in &pieces[..=last] {
-            let (a, b) = (p.start, p.end.min(t));
+        for p in pieces[..=last].iter().filter(|p| p.end > from) {
+            let (a, b) = (p.start.max(from), p.end.min(t));
             let count = ((b - a) / sub).ceil().max(1.0);
             let h = (b - a) / count;
             for j in 0..count as usize {

@@ -34,6 +34,7 @@ pub fn init_frame(mut commands: Commands, scene: Res<DamperScene>) {
             forcing_work: 0.0,
             floors: floors.map(Mutex::new),
             failure,
+            floors_held: 0.0,
         });
     }
 }
