@@ -5,6 +5,7 @@ mod ball_struck_on_the_floor;
 mod balls_sliding_together;
 mod check_bad_scene_exit_status;
 mod closed_pipe;
+mod driven_sweep_energy_left;
 mod ensemble_without_tolerances;
 mod floor_starting_from_rest;
 mod forced_ball_through_wall;

@@ -116,6 +116,11 @@ pub fn run(a: Args) -> Result<ExitStatus> {
                 right("settle s", 10),
                 right("E left %", 9),
             ]);
+            // A structure's designs on different floors are compared by the whole building.
+            let building = points.iter().any(|p| p.summary.metrics.peak_drift.is_some());
+            if building {
+                columns.extend([right("drift mm", 10), right("roof mm", 10), right("floor a m/s2", 13)]);
+            }
             let table = Table::new(columns);
             table.print_header();
             for p in &points {
@@ -128,8 +133,12 @@ pub fn run(a: Args) -> Result<ExitStatus> {
                     format!("{:.4}", m.peak_acceleration),
                     format!("{:.4}", m.rms_displacement * 1e3),
                     m.settling_time.map_or("-".into(), |t| format!("{t:.3}")),
-                    format!("{:.3}", m.energy_remaining.unwrap_or(f64::NAN) * 100.0),
+                    m.energy_remaining.map_or("-".into(), |e| format!("{:.3}", e * 100.0)),
                 ]);
+                if building {
+                    let show = |x: Option<f64>, unit: f64| x.map_or("-".into(), |x| format!("{:.4}", x * unit));
+                    cells.extend([show(m.peak_drift, 1e3), show(m.peak_roof_displacement, 1e3), show(m.peak_floor_acceleration, 1.0)]);
+                }
                 table.print_row(&cells);
             }
             if let (Some(dir), 2) = (&a.out, axes.len()) {
