@@ -494,8 +494,9 @@ pub fn read_series_csv(path: &Path) -> Result<Series, FigureError> {
     let fail = |reason: String| FigureError { path: path.display().to_string(), reason };
     let mut r = csv::Reader::from_path(path).map_err(|e| fail(e.to_string()))?;
     let header = r.headers().map_err(|e| fail(e.to_string()))?.clone();
-    // A structure's floors (`xs1, vs1, ...`, then `as1, ...`) come last.
-    let cols = header.iter().position(|h| h == "xs1").unwrap_or(header.len());
+    // The balls' places across the motion (`y1, z1, ...`) and then a structure's floors
+    // (`xs1, vs1, ...`, then `as1, ...`) come after the balls'.
+    let cols = header.iter().position(|h| h == "y1" || h == "xs1").unwrap_or(header.len());
     if cols < 4 || &header[0] != "t" || &header[1] != "xs" || (cols - 4) % 2 != 0 {
         return Err(fail("is not a series.csv (expected columns t, xs, vs, a, x1, v1, ...)".into()));
     }
@@ -503,6 +504,11 @@ pub fn read_series_csv(path: &Path) -> Result<Series, FigureError> {
     // Each floor's `xs<i>, vs<i>` and `as<i>`, found by name.
     let floor_count = (1..).take_while(|i| header.iter().any(|h| h == format!("as{i}"))).count();
     let find = |name: String| header.iter().position(|h| h == name).ok_or_else(|| fail(format!("has no column `{name}`")));
+    let across_columns: Vec<usize> = if header.iter().any(|h| h == "y1") {
+        (1..=balls).flat_map(|i| [find(format!("y{i}")), find(format!("z{i}"))]).collect::<Result<_, _>>()?
+    } else {
+        vec![]
+    };
     let mut floor_columns = Vec::with_capacity(3 * floor_count);
     for prefix in ["xs", "vs", "as"] {
         for i in 1..=floor_count {
@@ -511,6 +517,7 @@ pub fn read_series_csv(path: &Path) -> Result<Series, FigureError> {
     }
     let mut columns: Vec<Vec<f64>> = vec![vec![]; cols];
     let mut floors = Vec::new();
+    let mut across = Vec::new();
     let number = |rec: &csv::StringRecord, k: usize, line: usize| {
         rec.get(k)
             .and_then(|v| v.parse::<f64>().ok())
@@ -520,6 +527,9 @@ pub fn read_series_csv(path: &Path) -> Result<Series, FigureError> {
         let rec = rec.map_err(|e| fail(e.to_string()))?;
         for (k, column) in columns.iter_mut().enumerate() {
             column.push(number(&rec, k, line)?);
+        }
+        for &k in &across_columns {
+            across.push(number(&rec, k, line)?);
         }
         for &k in &floor_columns {
             floors.push(number(&rec, k, line)?);
@@ -534,6 +544,7 @@ pub fn read_series_csv(path: &Path) -> Result<Series, FigureError> {
         v.push(next());
     }
     let s = Series::from_columns(t, xs, vs, a, x, v);
+    let s = if across_columns.is_empty() { s } else { s.with_across(across) };
     Ok(if floor_count > 0 { s.with_floors(floor_count, floors) } else { s })
 }
 

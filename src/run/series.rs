@@ -77,6 +77,13 @@ impl Series {
         }
         s
     }
+    /// This series with the balls' centres across the motion: `across` holds, sample after
+    /// sample, `y1, z1, y2, z2, ...` (as [`Series::across`] reads them).
+    pub fn with_across(mut self, across: Vec<f64>) -> Self {
+        assert_eq!(across.len(), 2 * self.balls * self.len, "every sample has each ball's y and z");
+        self.across = across;
+        self
+    }
     /// This series with a structure's `count` floors: `floors` holds, sample after sample,
     /// `u1, ..., un, v1, ..., vn, a1, ..., an` (as [`Series::floor`] reads them).
     pub fn with_floors(mut self, count: usize, floors: Vec<f64>) -> Self {

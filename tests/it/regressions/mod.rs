@@ -18,6 +18,7 @@ mod plugin_driven_by_app_update;
 mod record_beyond_double_range;
 mod resting_ball_without_energy;
 mod series_beyond_memory;
+mod spatial_series_read_back;
 mod squeezed_ball_stops;
 mod stale_impulse_bounce;
 mod stiff_frame_rapier_step;
