@@ -85,16 +85,22 @@ impl Layout {
         Vec3::new(x as f32, self.ball_y + across[1] as f32, across[0] as f32)
     }
 
-    /// The point the camera looks at: mid-container, a little below the balls.
+    /// The height of the container's top above the ground.
+    fn top(&self) -> f32 {
+        self.ball_y + 0.5 * self.height
+    }
+
+    /// The point the camera looks at: mid-container, a little below the balls (below the
+    /// middle of a tall box's inside).
     pub fn camera_target(&self) -> Vec3 {
-        Vec3::new(0.5 * self.length, 0.6 * self.ball_y, 0.0)
+        Vec3::new(0.5 * self.length, 0.6 * self.top(), 0.0)
     }
 
     /// The camera: in front of the structure, a little above and to the right, framing it
     /// from the ground to the container's top.
     pub fn camera(&self) -> Transform {
         let target = self.camera_target();
-        let span = (self.length + 2.0 * self.overhang).max(self.ball_y);
+        let span = (self.length + 2.0 * self.overhang).max(self.top());
         let eye = target + Vec3::new(0.1 * span, 0.3 * span, 1.1 * span);
         Transform::from_translation(eye).looking_at(target, Vec3::Y)
     }

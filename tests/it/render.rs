@@ -27,6 +27,11 @@ fn is_large(p: [u8; 3]) -> bool {
 fn is_small(p: [u8; 3]) -> bool {
     p[2] > 90 && p[2] as i32 > p[0] as i32 + 50 && p[2] as i32 > p[1] as i32 + 20
 }
+/// A large ball deep in a pile, in the shade of the balls around it: darker, red still leads
+/// by far more than the grey walls, the floor or the sky let it.
+fn is_shaded_large(p: [u8; 3]) -> bool {
+    p[0] as i32 > p[1].max(p[2]) as i32 + 25
+}
 
 const FPS: f64 = 20.0;
 const SIZE: (u32, u32) = (480, 270);
@@ -166,4 +171,100 @@ fn view_without_a_display_is_an_error_not_a_panic() {
     let stderr = String::from_utf8_lossy(&o.stderr);
     assert_eq!(o.status.code(), Some(1), "{stderr}");
     assert!(stderr.contains("no display") && !stderr.contains("panicked"), "{stderr}");
+}
+
+/// A box of three hundred balls (issue 30): every frame of the animation draws every ball, each
+/// ball's centre showing a ball's colour (its own, or that of a ball in front of it).
+#[test]
+fn a_box_of_balls_is_drawn_ball_by_ball() {
+    let out = tempfile::tempdir().unwrap();
+    let dir = out.path().to_str().unwrap();
+    let size = (640, 360);
+    let o = lpc([
+        "render",
+        "scenes/particle-box.toml",
+        "--model",
+        "rapier",
+        "--out",
+        dir,
+        "--horizon",
+        "0.1",
+        "--fps",
+        "20",
+        "--size",
+        "640x360",
+    ]);
+    assert!(o.status.success(), "{}\n{}", String::from_utf8_lossy(&o.stdout), String::from_utf8_lossy(&o.stderr));
+    let scene = load_scene("scenes/particle-box.toml").unwrap();
+    assert!(scene.balls.len() >= 300);
+    let layout = Layout::of(&scene);
+    let series = read_series_csv(&out.path().join("series.csv")).unwrap();
+    assert!(series.has_across(), "a box's series holds the balls' places across the motion");
+    let (_, per_frame) = lpc_damper::run::frame_sampling(FPS, scene.sample_dt);
+    for k in 0..=2 {
+        let (w, h, px, channels) = decode(&out.path().join(format!("frame_{k:05}.png")));
+        assert_eq!((w, h), size);
+        let sample = k * per_frame;
+        let at = |p: bevy::math::Vec2| {
+            assert!(p.x >= 0.0 && p.y >= 0.0 && p.x < w as f32 && p.y < h as f32, "frame {k}: pixel {p} is out of the picture");
+            let i = ((p.y.round() as usize) * w as usize + p.x.round() as usize) * channels;
+            [px[i], px[i + 1], px[i + 2]]
+        };
+        for i in 0..scene.balls.len() {
+            let centre = layout.ball(series.x(i)[sample], series.across(i, sample));
+            let p = layout.project(size, centre);
+            let r_px = layout.projected_radius(size, centre, scene.balls[i].radius as f32);
+            assert!(r_px > 3.0, "ball{} is {r_px} px across: too small to check", i + 1);
+            // The light's highlight may whiten one spot of a ball: most of a ball's middle is
+            // its colour (or that of a ball in front of it).
+            let offsets = [(0.0, 0.0), (0.4, 0.0), (-0.4, 0.0), (0.0, 0.4), (0.0, -0.4)];
+            let coloured = offsets
+                .iter()
+                .filter(|(dx, dy)| {
+                    let c = at(p + bevy::math::Vec2::new(dx * r_px, dy * r_px));
+                    is_shaded_large(c) || is_small(c)
+                })
+                .count();
+            assert!(coloured >= 3, "frame {k}: ball{} at pixel {p} ({r_px} px) is not drawn", i + 1);
+        }
+    }
+}
+
+/// A building's damper renders (issue 32): the contact model moves the container with the
+/// carrying floor, and the rendered run's physics is the headless run's.
+#[test]
+fn a_damper_on_a_building_renders() {
+    let out = tempfile::tempdir().unwrap();
+    let (rendered, headless) = (out.path().join("rendered"), out.path().join("headless"));
+    let o = lpc([
+        "render",
+        "scenes/mdof-3storey.toml",
+        "--model",
+        "rapier",
+        "--out",
+        rendered.to_str().unwrap(),
+        "--horizon",
+        "0.2",
+        "--fps",
+        "20",
+        "--size",
+        "160x100",
+    ]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    assert!(rendered.join("frame_00004.png").exists());
+    let (sample_dt, _) = lpc_damper::run::frame_sampling(FPS, 0.001);
+    let o = lpc([
+        "run",
+        "scenes/mdof-3storey.toml",
+        "--model",
+        "rapier",
+        "--out",
+        headless.to_str().unwrap(),
+        "--horizon",
+        "0.2",
+        "--sample-dt",
+        &format!("{sample_dt}"),
+    ]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    assert!(std::fs::read(rendered.join("series.csv")).unwrap() == std::fs::read(headless.join("series.csv")).unwrap());
 }
