@@ -11,7 +11,7 @@ use serde::Serialize;
 
 use crate::model::{Limits, Model, ModelError, RunOptions};
 use crate::run::Run;
-use crate::scene::format::{BallsFile, BedFile, ContainerFile, ForcingFile, FrameFile, Placement, RunFile, WorldFile};
+use crate::scene::format::{BallsFile, BedFile, ContainerFile, ForcingFile, FrameFile, Placement, RunFile, StructureFile, WorldFile};
 use crate::scene::{self, Arrangement, ForcingKind, Length, Scene, SceneFile};
 
 /// How a run failed.
@@ -63,6 +63,8 @@ pub struct Draws {
     pub chains: bool,
     /// Each scene's balls as a bed in a box, under gravity and friction ([`with_bed`]).
     pub beds: bool,
+    /// Each scene's frame as a floor of a building of 1 to 5 storeys ([`with_structure`]).
+    pub structures: bool,
 }
 
 /// `file` with its balls as a bed, drawn from a stream of its own (seeded from `seed` alone):
@@ -95,6 +97,58 @@ pub fn with_bed(mut file: SceneFile, seed: u64) -> SceneFile {
     if let Some(frame) = file.frame.as_mut() {
         frame.initial_displacement = Length::Metres(frame.initial_displacement.metres(crate::scene::ball_radius(0.11, 8000.0)));
     }
+    file
+}
+
+/// `file` with its frame as a floor of a shear building, drawn from a stream of its own (seeded
+/// from `seed` alone): 1 to 5 storeys whose floors weigh 0.3 to 3 times the frame's mass and
+/// whose storeys are 0.3 to 3 times its stiffness (a free frame's: a period of 0.05 to 2 s),
+/// damped by Rayleigh coefficients of 0 to 5 % of the fundamental's critical damping each; the
+/// container on a floor drawn at random, displaced as the frame was, the others at rest. A
+/// scene without forcing is shaken by random ground motion one time in three.
+pub fn with_structure(mut file: SceneFile, seed: u64) -> SceneFile {
+    let mut rng = Pcg64::seed_from_u64(seed ^ 0x5707_e400_0000_0000);
+    let Some(frame) = file.frame.take() else { return file };
+    let storeys = rng.random_range(1..=5usize);
+    let stiffness = if frame.stiffness > 0.0 {
+        frame.stiffness
+    } else {
+        let period: f64 = (rng.random_range(0.05f64.ln()..2f64.ln())).exp();
+        frame.mass * (2.0 * std::f64::consts::PI / period).powi(2)
+    };
+    let masses: Vec<f64> = (0..storeys).map(|_| frame.mass * rng.random_range(0.3..3.0)).collect();
+    let stiffnesses: Vec<f64> = (0..storeys).map(|_| stiffness * rng.random_range(0.3..3.0)).collect();
+    // Rayleigh terms each up to 5 % of critical at the frame's own frequency.
+    let omega = (stiffness / frame.mass).sqrt();
+    let rayleigh = [rng.random_range(0.0..0.1) * omega, rng.random_range(0.0..0.1) / omega];
+    let floor = rng.random_range(0..storeys);
+    let rr = crate::scene::ball_radius(0.11, 8000.0);
+    let mut displacements = vec![0.0; storeys];
+    displacements[floor] = frame.initial_displacement.metres(rr);
+    if file.forcing.is_none() && rng.random_bool(1.0 / 3.0) {
+        // Kanai-Tajimi ground motion about the building's own frequency, up to 1 g or so.
+        let frequency = omega / (2.0 * std::f64::consts::PI) * rng.random_range(0.3..3.0);
+        let horizon = file.run.horizon.unwrap_or(1.0);
+        file.forcing = Some(ForcingFile {
+            kind: crate::scene::format::ExcitationKind::Random,
+            ground_frequency: Some(frequency),
+            ground_damping: Some(rng.random_range(0.2..0.8)),
+            intensity: Some((rng.random_range(1e-6f64.ln()..1e-2f64.ln())).exp()),
+            duration: Some(horizon),
+            step: Some((0.05 / frequency).min(horizon / 10.0)),
+            seed: Some(seed),
+            ..Default::default()
+        });
+    }
+    file.structure = Some(StructureFile {
+        masses,
+        stiffnesses,
+        rayleigh: Some(rayleigh),
+        damping_ratios: None,
+        initial_displacements: Some(displacements),
+        initial_velocities: None,
+        damper_floor: Some(floor as u32 + 1),
+    });
     file
 }
 
@@ -462,6 +516,7 @@ pub fn stress(model: Model, seed: u64, count: u64, draws: Draws, progress: &(dyn
             };
             let file = if draws.chains { with_chains(file, s) } else { file };
             let file = if draws.beds { with_bed(file, s) } else { file };
+            let file = if draws.structures { with_structure(file, s) } else { file };
             let start = std::time::Instant::now();
             let outcome = |failure: Option<Failure>, minimal_scene, refused, refused_during_run, stopped, wall_s| Outcome {
                 seed: s,

@@ -39,6 +39,11 @@ pub struct Args {
     /// sizes, on a lattice or at random, gravity three times in four, friction 0-0.5).
     #[arg(long, conflicts_with_all = ["extreme", "chains"])]
     beds: bool,
+    /// Draw each plausible scene's frame as a floor of a building of 1 to 5 storeys (floors of
+    /// 0.3-3 times its mass, storeys of 0.3-3 times its stiffness, Rayleigh damping), shaken
+    /// by random ground motion a third of the time when not forced.
+    #[arg(long, conflicts_with = "extreme")]
+    structures: bool,
     /// Seconds of computing each run may take; a run that takes longer stops (a typed stop,
     /// counted apart from passes and failures). Default: none, 10 s with --extreme.
     #[arg(long, value_name = "S")]
@@ -72,6 +77,7 @@ pub fn run(a: Args) -> Result<ExitStatus> {
         extreme: a.extreme,
         chains: a.chains,
         beds: a.beds,
+        structures: a.structures,
         max_wall_s: a.max_wall_time.or(a.extreme.then_some(10.0)),
     };
     let mut outcomes = Vec::new();
