@@ -479,8 +479,31 @@ fn simplifications(f: &SceneFile) -> Vec<SceneFile> {
     tweak(&|g| g.balls.as_mut().unwrap().restitution = 0.9);
     tweak(&|g| g.balls.as_mut().unwrap().gap = Length::Rr(0.25));
     tweak(&|g| g.balls.as_mut().unwrap().clearance = Some(Length::Rr(1.0)));
-    tweak(&|g| g.frame.as_mut().unwrap().damping = 0.0);
+    tweak(&|g| {
+        if let Some(frame) = g.frame.as_mut() {
+            frame.damping = 0.0;
+        }
+    });
     tweak(&|g| g.balls.as_mut().unwrap().chains = None);
+    // A building: without its ground motion, and with its top storey taken off while the
+    // container stays below it.
+    tweak(&|g| {
+        if g.structure.is_some() {
+            g.forcing = None;
+        }
+    });
+    tweak(&|g| {
+        if let Some(s) = g.structure.as_mut() {
+            let floor = s.damper_floor.unwrap_or(s.masses.len() as u32);
+            if s.masses.len() > 1 && (floor as usize) < s.masses.len() {
+                s.masses.pop();
+                s.stiffnesses.pop();
+                if let Some(x) = s.initial_displacements.as_mut() {
+                    x.pop();
+                }
+            }
+        }
+    });
     out
 }
 
