@@ -35,6 +35,7 @@ pub(super) struct Driver<'s, 'a> {
     pub(super) stage: jacobian::Stage,
     pub(super) ft: Vec<f64>,
     pub(super) ft_ahead: Vec<f64>,
+    pub(super) ft_now: Vec<f64>,
     /// Whether the last attempted step was a RODAS4 step.
     pub(super) stiff: bool,
     /// Accepted RODAS4 steps.
@@ -87,6 +88,7 @@ impl<'s, 'a> Driver<'s, 'a> {
             stage: jacobian::Stage::default(),
             ft: vec![0.0; sys.len()],
             ft_ahead: vec![0.0; sys.len()],
+            ft_now: vec![0.0; sys.len()],
             stiff: false,
             stiff_steps: 0,
             t: 0.0,
@@ -124,7 +126,20 @@ impl<'s, 'a> Driver<'s, 'a> {
             (None, Some(f)) => Some(1e-4 / f.fastest),
             (None, None) => None,
         };
+        // A step starting on a record's point sees only the stretch ahead (steps end on the
+        // points): there the difference is one-sided, of the same order.
+        let at_point =
+            recorded.and_then(|f| f.structure.record_stretch(self.t)).is_some_and(|s| s.start > self.t - time_step.unwrap_or(0.0));
         let ft = match time_step {
+            Some(dt) if at_point => {
+                sys.rhs(self.t, &self.y, &mut self.ft_now, v_max);
+                sys.rhs(self.t + dt, &self.y, &mut self.ft_ahead, v_max);
+                sys.rhs(self.t + 2.0 * dt, &self.y, &mut self.ft, v_max);
+                for ((d, a), f) in self.ft.iter_mut().zip(&self.ft_ahead).zip(&self.ft_now) {
+                    *d = (4.0 * a - *d - 3.0 * f) / (2.0 * dt);
+                }
+                Some(&self.ft[..])
+            }
             Some(dt) => {
                 sys.rhs(self.t + dt, &self.y, &mut self.ft_ahead, v_max);
                 sys.rhs(self.t - dt, &self.y, &mut self.ft, v_max);
@@ -273,7 +288,10 @@ impl<'s, 'a> Driver<'s, 'a> {
                     partial,
                 })));
             }
-            let remaining = horizon - self.t;
+            // A record's load is linear between its points, with kinks at them: steps end on
+            // them, so that the error estimate sees a smooth load.
+            let point = sys.floors.as_ref().and_then(|f| f.structure.record_stretch(self.t)).map_or(f64::INFINITY, |s| s.end);
+            let remaining = (horizon - self.t).min(point - self.t);
             let (explicit_bound, implicit_bound) = self.step_bound();
             let h_explicit = h.min(explicit_bound).min(remaining);
             // A contact damped faster than the explicit method's stability allows at this step
@@ -322,7 +340,11 @@ impl<'s, 'a> Driver<'s, 'a> {
                 let stepper = if self.stiff { Active::Implicit(&self.rodas) } else { Active::Explicit(&self.rk) };
                 self.y.copy_from_slice(stepper.solution());
                 self.dy.copy_from_slice(stepper.end_derivative());
-                self.t = if event.is_none() && h_try == remaining { horizon } else { t0 + h_done };
+                self.t = match (event, h_try == remaining) {
+                    (None, true) if point < horizon => point,
+                    (None, true) => horizon,
+                    _ => t0 + h_done,
+                };
                 if sys.has_frame() && self.t >= period {
                     self.peak_true_acceleration = self.peak_true_acceleration.max(self.dy[VS].abs());
                 }

@@ -87,6 +87,15 @@ impl Structure {
     pub fn load(&self) -> Load {
         self.force.as_ref().map_or(Load::Ground, |f| Load::Floor(f.floor))
     }
+    /// The stretch of the structure's record (the ground's acceleration or a floor's force)
+    /// that holds `t`, when a record drives it: the load is linear on it.
+    pub fn record_stretch(&self, t: f64) -> Option<super::record::Stretch> {
+        match (&self.ground, &self.force) {
+            (Some(g), _) => Some(g.stretch(t)),
+            (None, Some(f)) => Some(f.record.stretch(t)),
+            (None, None) => None,
+        }
+    }
     /// The recorded force on its floor at `t`, N (0 without one).
     pub fn recorded_force(&self, t: f64) -> f64 {
         self.force.as_ref().map_or(0.0, |f| {

@@ -16,6 +16,7 @@ mod loaded_contact_sinks;
 mod overdamped_bed_balance;
 mod plugin_driven_by_app_update;
 mod record_beyond_double_range;
+mod record_point_inside_step;
 mod resting_ball_without_energy;
 mod series_beyond_memory;
 mod spatial_series_read_back;
