@@ -88,8 +88,9 @@ pub struct FrameState {
     pub damping_loss: f64,
     /// Work done by the excitation so far, J.
     pub forcing_work: f64,
-    /// A structure's floors since the step's start, in closed form. The lock is there only so
-    /// that the state can be a resource: the systems that hold it run one at a time.
+    /// A structure's floors since the last impulse on the carrying floor (or change of what it
+    /// holds), in closed form. The lock is there only so that the state can be a resource: the
+    /// systems that hold it run one at a time.
     pub floors: Option<Mutex<FloorMotion>>,
     /// Why the frame cannot move on: its floors have no modes with the balls they hold.
     pub failure: Option<String>,
