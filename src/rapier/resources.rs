@@ -142,29 +142,27 @@ impl FrameState {
     }
 
     /// The smooth force on the frame at `t` as it is now (springs, dampers and excitation;
-    /// impulses and contact forces excluded), N.
-    pub fn smooth_force(&mut self, scene: &Scene, t: f64) -> f64 {
-        let (xs, vs) = self.now;
-        match (self.floors_now(t), scene.structure.as_deref()) {
-            (Some((z, _)), Some(s)) => {
-                let (u, v) = z.split_at(z.len() / 2);
-                scene.floor_accelerations(t, u, v)[s.floor] * s.building.masses[s.floor]
-            }
-            _ => scene.frame_force(t, xs, vs),
-        }
-    }
-
-    /// The mechanical energy of the frame (or of the structure it is a floor of) at `t` as it
-    /// is now, J.
-    pub fn energy(&mut self, scene: &Scene, t: f64) -> f64 {
+    /// impulses and contact forces excluded), N, and the mechanical energy of the frame (or of
+    /// the structure it is a floor of), J: one evaluation of a structure's floors for both.
+    pub fn force_and_energy(&mut self, scene: &Scene, t: f64) -> (f64, f64) {
         let (xs, vs) = self.now;
         match (self.floors_now(t), scene.structure.as_deref()) {
             (Some((z, (_, vg))), Some(s)) => {
                 let (u, v) = z.split_at(z.len() / 2);
-                s.energy(u, v, vg)
+                (scene.floor_accelerations(t, u, v)[s.floor] * s.building.masses[s.floor], s.energy(u, v, vg))
             }
-            _ => scene.frame_energy(t, xs, vs),
+            _ => (scene.frame_force(t, xs, vs), scene.frame_energy(t, xs, vs)),
         }
+    }
+
+    /// The smooth force of [`FrameState::force_and_energy`], N.
+    pub fn smooth_force(&mut self, scene: &Scene, t: f64) -> f64 {
+        self.force_and_energy(scene, t).0
+    }
+
+    /// The mechanical energy of [`FrameState::force_and_energy`], J.
+    pub fn energy(&mut self, scene: &Scene, t: f64) -> f64 {
+        self.force_and_energy(scene, t).1
     }
 }
 

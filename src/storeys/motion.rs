@@ -155,11 +155,7 @@ impl FloorMotion {
     /// The record's stretch that holds `t` (the ground's acceleration or a floor's force), or
     /// one of no load.
     pub(crate) fn stretch(&self, t: f64) -> Stretch {
-        match (&self.structure.ground, &self.structure.force) {
-            (Some(g), _) => g.stretch(t),
-            (None, Some(f)) => f.record.stretch(t),
-            (None, None) => STILL,
-        }
+        self.structure.record_stretch(t).unwrap_or(STILL)
     }
 
     /// The ground's stretch that holds `t`: the record's, or one of a still ground.

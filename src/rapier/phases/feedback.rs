@@ -135,9 +135,9 @@ pub fn feedback(
     let (frame_pre, frame_post, frame_energy) = match frame {
         Some(mut f) => {
             let (pre, post) = feed_frame(&mut f, scene, dp);
-            let force = f.smooth_force(scene, t1);
+            let (force, energy) = f.force_and_energy(scene, t1);
             f.held = held_runs(scene, x_new, v_new, f.now, force, plan.h);
-            (pre, post, f.energy(scene, t1))
+            (pre, post, energy)
         }
         None => (0.0, 0.0, 0.0),
     };
