@@ -150,6 +150,9 @@ pub struct TolerancesFile {
     pub forcing_amplitude: Option<Length>,
     /// Forcing frequency, Hz.
     pub forcing_frequency: Option<Length>,
+    /// Each ball's centre in a `[bed]` or `[[ball]]` scene, drawn independently along x, y and
+    /// z (across gravity only, so that a ball resting on the floor stays on it), m.
+    pub position: Option<Length>,
     /// `"uniform"` (default; the value is the half-width) or `"normal"` (the standard deviation).
     #[serde(default)]
     pub distribution: Distribution,

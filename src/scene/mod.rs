@@ -22,7 +22,7 @@ pub use format::{Arrangement, Distribution, ForcingKind, Length, SceneFile, Step
 pub use geometry::{ball_radius, pair_bodies, pair_gap, pair_range, Ball, BallKind, Body, Container, Pairs};
 pub use overrides::{with_settings_of, Overrides};
 pub use parameters::{Parameter, Tolerances};
-pub use placement::MAX_BED_BALLS;
+pub use placement::{move_placed_balls, MAX_BED_BALLS};
 pub use record::GroundRecord;
 pub use rules::{from_file, validate_sample_dt};
 pub use settings::{CompliantSettings, RapierSettings, DEFAULT_COMPLIANT_TOLERANCE};

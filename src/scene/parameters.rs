@@ -208,6 +208,8 @@ pub struct Tolerances {
     /// Each parameter given, in [`Parameter::ALL`] order, with its spread in the parameter's
     /// unit (lengths in metres): the half-width, or the standard deviation when normal.
     pub spreads: Vec<(Parameter, f64)>,
+    /// The spread of each ball's centre in a scene of balls placed in a box, m, per axis.
+    pub position: Option<f64>,
     /// How the spreads are drawn.
     pub distribution: Distribution,
     /// Seed of the draws.

@@ -8,9 +8,9 @@ use rand::{Rng, SeedableRng};
 use rand_pcg::Pcg64;
 
 use super::format::{BedFile, ExplicitBallFile, Placement};
-use super::geometry::{ball_radius, Ball, BallKind};
+use super::geometry::{ball_radius, Ball, BallKind, Body};
 use super::rules::Validator;
-use super::{human, SceneError};
+use super::{human, Scene, SceneError};
 
 /// Most balls a bed may hold: a run keeps every ball's state, and a scene this size already
 /// takes minutes per simulated second in the cheapest model.
@@ -54,6 +54,33 @@ pub(super) fn first_overlap(balls: &[Ball], centres: &[[f64; 3]]) -> Option<(usi
         }
     }
     None
+}
+
+/// Moves each ball of `scene`, placed in its box, by `by[i]` (`[dx, dy, dz]`, m, in the
+/// container's frame): the rule broken, with nothing moved, when a ball would leave the box or
+/// overlap another.
+pub fn move_placed_balls(scene: &mut Scene, by: &[[f64; 3]]) -> Result<(), String> {
+    let length = scene.container.map_or(0.0, |c| c.length);
+    let size = [length, scene.space.section[0], scene.space.section[1]];
+    let xs0 = scene.initial_displacement;
+    let x: Vec<f64> = scene.initial_positions.iter().zip(by).map(|(x, d)| x + d[0]).collect();
+    let centres: Vec<[f64; 3]> = (0..scene.balls.len())
+        .map(|i| {
+            let [y, z] = scene.space.lateral_of(i);
+            [x[i] - xs0, y + by[i][1], z + by[i][2]]
+        })
+        .collect();
+    for (i, (c, b)) in centres.iter().zip(&scene.balls).enumerate() {
+        if let Some(a) = outside(*c, b.radius, size) {
+            return Err(format!("moves {} outside the container along {}", Body::Ball(i).name(), ["x", "y", "z"][a]));
+        }
+    }
+    if let Some((i, j)) = first_overlap(&scene.balls, &centres) {
+        return Err(format!("makes {} overlap {}", Body::Ball(j).name(), Body::Ball(i).name()));
+    }
+    scene.initial_positions = x;
+    scene.space.lateral = centres.iter().map(|c| [c[1], c[2]]).collect();
+    Ok(())
 }
 
 /// The explicit balls, checked: positive masses and sizes, inside the box, no overlaps.

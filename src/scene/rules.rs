@@ -898,5 +898,15 @@ pub(super) fn tolerances(t: &format::TolerancesFile, parsed: &SceneFile, scene: 
         parameter.apply(parsed, Length::Metres(0.0)).map_err(|rule| v.err(&field, &rule))?;
         spreads.push((parameter, x));
     }
-    Ok(Tolerances { spreads, distribution: t.distribution, seed: t.seed.unwrap_or(1) })
+    let position = match t.position {
+        None => None,
+        Some(_) if parsed.bed.is_none() && parsed.explicit_balls.is_none() => {
+            return Err(v.err("tolerances.position", "needs balls placed in a box ([bed] or [[ball]]); a chain's balls take `gap`"))
+        }
+        Some(Length::Rr(_)) => {
+            return Err(v.err("tolerances.position", "is given in Rr, which [bed] and [[ball]] scenes do not define: give metres"))
+        }
+        Some(Length::Metres(x)) => Some(v.non_negative("tolerances.position", x)?),
+    };
+    Ok(Tolerances { spreads, position, distribution: t.distribution, seed: t.seed.unwrap_or(1) })
 }

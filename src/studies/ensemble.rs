@@ -71,17 +71,28 @@ pub fn shakes_at_random(file: &SceneFile) -> bool {
     file.forcing.as_ref().is_some_and(|g| g.kind == scene::format::ExcitationKind::Random)
 }
 
-/// A draw that made no valid scene: the parameter to blame and why.
+/// A draw that made no valid scene: the tolerance to blame (a parameter's name, or
+/// `position`) and why.
 struct Failure {
-    parameter: Parameter,
+    tolerance: &'static str,
     rule: String,
 }
+
+impl Failure {
+    fn of(parameter: Parameter, rule: String) -> Failure {
+        Failure { tolerance: parameter.name(), rule }
+    }
+}
+
+/// The name of the ball positions' tolerance, in `[tolerances]` and in the members' table.
+const POSITION: &str = "position";
 
 /// Draws `count` members of `nominal` (built from `file`, perhaps with command-line
 /// overrides) under `tolerances`. A bed placed at random is placed anew in every member, from a
 /// seed drawn from `(seed, k)` (the members' column `bed_seed`), and a random ground motion is
-/// drawn anew likewise (`ground_seed`). Without tolerances, a random bed or a random ground
-/// every member is the nominal scene.
+/// drawn anew likewise (`ground_seed`). A tolerance on the balls' positions moves every ball of
+/// a bed by its own draw (the column `position_rms`, the displacements' root mean square).
+/// Without tolerances, a random bed or a random ground every member is the nominal scene.
 /// A tolerance so wide that a member finds no valid scene in [`MAX_DRAWS_PER_MEMBER`] draws,
 /// or that more draws fail than succeed, is an error naming it.
 pub fn draw(
@@ -117,6 +128,7 @@ pub fn draw_range(
     let count = range.len();
     check_members_memory(nominal, count).map_err(|rule| invalid("--ensemble", rule))?;
     let spreads: &[(Parameter, f64)] = tolerances.map_or(&[], |t| &t.spreads);
+    let position = tolerances.and_then(|t| t.position);
     let normal = tolerances.is_some_and(|t| t.distribution == Distribution::Normal);
     let seed = seed.or(tolerances.map(|t| t.seed)).unwrap_or(DEFAULT_SEED);
     let n = nominal.balls.len();
@@ -130,19 +142,20 @@ pub fn draw_range(
         .flat_map(|&(p, _)| if p == Parameter::Gap { (1..=n).map(|i| format!("gap{i}")).collect() } else { vec![p.to_string()] })
         .chain(random_bed.then(|| "bed_seed".to_string()))
         .chain(random_ground.then(|| "ground_seed".to_string()))
+        .chain(position.map(|_| format!("{POSITION}_rms")))
         .collect();
-    let drawer = Drawer { base, path, nominal, spreads, normal, random_bed, random_ground };
+    let drawer = Drawer { base, path, nominal, spreads, position, normal, random_bed, random_ground };
     let drawn: Vec<(Member, Vec<Failure>)> = range.into_par_iter().map(|k| drawer.member(seed, k)).collect::<Result<_, _>>()?;
     let redraws: u64 = drawn.iter().map(|d| d.1.len() as u64).sum();
     if redraws > count as u64 {
-        let mut blame: BTreeMap<Parameter, (usize, &str)> = BTreeMap::new();
+        let mut blame: BTreeMap<&str, (usize, &str)> = BTreeMap::new();
         for f in drawn.iter().flat_map(|d| &d.1) {
-            let e = blame.entry(f.parameter).or_insert((0, &f.rule));
+            let e = blame.entry(f.tolerance).or_insert((0, &f.rule));
             e.0 += 1;
         }
-        let (parameter, (times, rule)) = blame.into_iter().max_by_key(|b| b.1 .0).unwrap_or((Parameter::Gap, (0, "")));
+        let (tolerance, (times, rule)) = blame.into_iter().max_by_key(|b| b.1 .0).unwrap_or(("gap", (0, "")));
         return Err(invalid(
-            &format!("tolerances.{parameter}"),
+            &format!("tolerances.{tolerance}"),
             format!(
                 "is too wide: {redraws} of {} draws made an invalid scene ({times} by this parameter, e.g. {rule}); narrow it",
                 redraws + count as u64
@@ -234,6 +247,9 @@ struct Drawer<'a> {
     path: &'a str,
     nominal: &'a Scene,
     spreads: &'a [(Parameter, f64)],
+    /// The spread of each ball's centre along each axis, m, when the balls' positions are
+    /// toleranced.
+    position: Option<f64>,
     normal: bool,
     /// Whether the scene places a bed at random: each member then places its own, from a seed
     /// of its own.
@@ -254,10 +270,10 @@ impl Drawer<'_> {
                 Err(f) => failures.push(f),
             }
         }
-        let last = failures.pop().unwrap_or(Failure { parameter: Parameter::Gap, rule: String::new() });
+        let last = failures.pop().unwrap_or(Failure::of(Parameter::Gap, String::new()));
         Err(SceneError::Invalid {
             file: self.path.into(),
-            field: format!("tolerances.{}", last.parameter),
+            field: format!("tolerances.{}", last.tolerance),
             rule: format!(
                 "is too wide: {MAX_DRAWS_PER_MEMBER} draws in a row for member {k} made an invalid scene (the last: {}); narrow it",
                 last.rule
@@ -304,22 +320,22 @@ impl Drawer<'_> {
             let value = p.value(&self.base, self.nominal).unwrap_or(f64::NAN) + d[0];
             values.push(value);
             let f = file.as_ref().unwrap_or(&self.base);
-            file = Some(p.apply(f, Length::Metres(value)).map_err(|rule| Failure { parameter: p, rule })?);
+            file = Some(p.apply(f, Length::Metres(value)).map_err(|rule| Failure::of(p, rule))?);
         }
         let name = format!("{}#{k}", self.nominal.name);
         // A failure the scene's rules cannot pin on a drawn parameter is blamed on the first.
-        let first = self.spreads.first().map_or(Parameter::FillFraction, |s| s.0);
+        let first = self.spreads.first().map_or(POSITION, |s| s.0.name());
         let mut scene = match file {
             None => self.nominal.clone(),
             Some(f) => scene::from_file(f, self.path, &name)
                 .map_err(|e| match e {
                     SceneError::Invalid { field, rule, .. } => {
-                        Failure { parameter: Parameter::of_field(&field).unwrap_or(first), rule: format!("{field} {rule}") }
+                        Failure { tolerance: Parameter::of_field(&field).map_or(first, Parameter::name), rule: format!("{field} {rule}") }
                     }
-                    other => Failure { parameter: first, rule: other.to_string() },
+                    other => Failure { tolerance: first, rule: other.to_string() },
                 })?
                 .scene
-                .ok_or(Failure { parameter: first, rule: "no damper scene".into() })?,
+                .ok_or(Failure { tolerance: first, rule: "no damper scene".into() })?,
         };
         scene.name = name;
         let mut drawn = vec![];
@@ -333,7 +349,32 @@ impl Drawer<'_> {
         }
         drawn.extend(bed_seed.map(|seed| seed as f64));
         drawn.extend(ground_seed.map(|seed| seed as f64));
+        if let Some(spread) = self.position {
+            drawn.push(self.move_balls(rng, &mut scene, spread)?);
+        }
         Ok(Member { index: k, drawn, scene })
+    }
+}
+
+impl Drawer<'_> {
+    /// Moves every ball of `scene` by its own draw along each axis, less the draw's component
+    /// along gravity (a ball resting on the floor stays on it): the displacements' root mean
+    /// square, m, or the failure when a ball would leave the box or overlap another. The
+    /// draws follow the member's scene, whose number of balls a drawn fill fraction sets.
+    fn move_balls(&self, rng: &mut Pcg64, scene: &mut Scene, spread: f64) -> Result<f64, Failure> {
+        let g = scene.space.gravity;
+        let g_norm = g.iter().map(|x| x * x).sum::<f64>().sqrt();
+        let down = if g_norm > 0.0 { g.map(|x| x / g_norm) } else { [0.0; 3] };
+        let by: Vec<[f64; 3]> = (0..scene.balls.len())
+            .map(|_| {
+                let d = [(); 3].map(|_| self.deviation(rng, spread));
+                let along: f64 = (0..3).map(|a| d[a] * down[a]).sum();
+                [0, 1, 2].map(|a| d[a] - along * down[a])
+            })
+            .collect();
+        scene::move_placed_balls(scene, &by).map_err(|rule| Failure { tolerance: POSITION, rule })?;
+        let sum: f64 = by.iter().flatten().map(|x| x * x).sum();
+        Ok((sum / by.len().max(1) as f64).sqrt())
     }
 }
 
@@ -349,16 +390,13 @@ fn shift_gaps(scene: &mut Scene, deviation: &[f64]) -> Result<Vec<f64>, Failure>
     let clearance = chains.iter().map(|c| container.clearance - deviation[c.clone()].iter().sum::<f64>()).fold(f64::INFINITY, f64::min);
     let clearance = if chains.is_empty() { container.clearance } else { clearance };
     if let Some((i, g)) = gaps.iter().enumerate().find(|(_, g)| **g < 0.0) {
-        return Err(Failure {
-            parameter: Parameter::Gap,
-            rule: format!("gap {} of {} m overlaps its neighbours", i + 1, scene::human(*g)),
-        });
+        return Err(Failure::of(Parameter::Gap, format!("gap {} of {} m overlaps its neighbours", i + 1, scene::human(*g))));
     }
     if clearance < 0.0 {
-        return Err(Failure {
-            parameter: Parameter::Gap,
-            rule: format!("the gaps leave a clearance of {} m: the last ball overlaps the wall", scene::human(clearance)),
-        });
+        return Err(Failure::of(
+            Parameter::Gap,
+            format!("the gaps leave a clearance of {} m: the last ball overlaps the wall", scene::human(clearance)),
+        ));
     }
     container.clearance = clearance;
     for chain in chains {

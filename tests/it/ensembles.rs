@@ -458,3 +458,118 @@ fn members_of_a_random_bed_place_their_own_beds() {
         assert_eq!((&placed.space, &placed.initial_positions), (&a.scene.space, &a.scene.initial_positions));
     }
 }
+
+/// Nine balls in the middle of a box, 20 mm apart on a square grid, under `gravity`,
+/// their positions toleranced by `spread` (uniform).
+fn grid_of_balls(gravity: &str, spread: f64) -> String {
+    let mut text = format!(
+        "[frame]\nmass = 1.35\nstiffness = 865.0\ndamping = 1.092\ninitial_displacement = 0.01\n\
+         [container]\nlength = 0.08\nwidth = 0.06\nheight = 0.03\n\
+         [world]\nrestitution = 0.6\ngravity = {gravity}\n[tolerances]\nposition = {spread}\n"
+    );
+    for i in 0..9 {
+        let (x, y) = (0.02 + 0.02 * (i % 3) as f64, -0.02 + 0.02 * (i / 3) as f64);
+        text += &format!("[[ball]]\nposition = [{x}, {y}, 0.0]\nmass = 0.002\nradius = 0.004\n");
+    }
+    text
+}
+
+#[test]
+fn ball_positions_scatter_uniformly_across_gravity() {
+    let w = 1e-3;
+    // Under gravity along -z the balls keep their heights; each moves in x and y by its own
+    // uniform draw on [-w, w), which never brings two balls (12 mm apart) or a wall
+    // (6 mm off) into reach, so no draw is thrown away and the draws are exactly uniform.
+    let l = loaded(&grid_of_balls("[0.0, 0.0, -9.81]", w));
+    let nominal = l.scene.as_ref().unwrap();
+    let members = draw(&l, 200, Some(7));
+    assert_eq!(members.redraws, 0);
+    assert_eq!(members.columns, vec!["position_rms".to_string()]);
+    let mut draws = vec![];
+    for m in &members.members {
+        let mut squares = 0.0;
+        for i in 0..9 {
+            let [y, z] = m.scene.space.lateral[i];
+            let [y0, z0] = nominal.space.lateral[i];
+            assert_eq!(z, z0, "member {}: ball {} left the floor", m.index, i + 1);
+            let d = [m.scene.initial_positions[i] - nominal.initial_positions[i], y - y0];
+            assert!(d.iter().all(|d| d.abs() <= w * (1.0 + 1e-9)), "member {}: {d:?}", m.index);
+            squares += d[0] * d[0] + d[1] * d[1];
+            draws.extend(d);
+        }
+        let rms = (squares / 9.0).sqrt();
+        assert!((m.drawn[0] - rms).abs() <= 1e-9 * w, "member {}: position_rms {} against {rms}", m.index, m.drawn[0]);
+    }
+    // Kolmogorov-Smirnov against the uniform law on [-w, w] at the 1 % level (the critical
+    // distance 1.63 / sqrt(n) for n draws; the positions' rounding, 1e-17 m, is far below it).
+    draws.sort_by(f64::total_cmp);
+    let n = draws.len() as f64;
+    let distance = draws
+        .iter()
+        .enumerate()
+        .map(|(k, d)| {
+            let cdf = (d + w) / (2.0 * w);
+            (cdf - k as f64 / n).abs().max((cdf - (k + 1) as f64 / n).abs())
+        })
+        .fold(0.0, f64::max);
+    assert!(distance < 1.63 / n.sqrt(), "KS distance {distance} over {n} draws");
+    // Members differ, and each runs.
+    assert_ne!(members.members[0].scene.space.lateral, members.members[1].scene.space.lateral);
+    let mut member = members.members[0].scene.clone();
+    member.horizon = 0.05;
+    Model::Reference.simulate(&member, &RunOptions::default()).expect("a moved bed runs");
+}
+
+#[test]
+fn ball_positions_move_along_every_axis_but_gravity() {
+    // Without gravity the balls move along all three axes; under a tilted gravity only across
+    // it, to the rounding of the projection (a few ulps of the spread).
+    let w = 1e-3;
+    for (gravity, across_only) in [("[0.0, 0.0, 0.0]", false), ("[0.0, -3.0, -9.0]", true)] {
+        let l = loaded(&grid_of_balls(gravity, w));
+        let nominal = l.scene.as_ref().unwrap();
+        let members = draw(&l, 20, Some(3));
+        let down = nominal.space.gravity.map(|g| g / 90f64.sqrt());
+        let mut moved_along_z = false;
+        for m in &members.members {
+            for i in 0..9 {
+                let d = [
+                    m.scene.initial_positions[i] - nominal.initial_positions[i],
+                    m.scene.space.lateral[i][0] - nominal.space.lateral[i][0],
+                    m.scene.space.lateral[i][1] - nominal.space.lateral[i][1],
+                ];
+                let along: f64 = (0..3).map(|a| d[a] * down[a]).sum();
+                if across_only {
+                    assert!(along.abs() <= 8.0 * f64::EPSILON * w, "{gravity}: ball {} moved {along} m along gravity", i + 1);
+                }
+                moved_along_z |= d[2] != 0.0;
+            }
+        }
+        assert!(moved_along_z, "{gravity}: no ball moved in z");
+    }
+}
+
+#[test]
+fn position_tolerances_need_room_and_a_bed() {
+    let tmp = tempfile::tempdir().unwrap();
+    let box_scene = std::fs::read_to_string("scenes/particle-box.toml").unwrap();
+    let cases = [
+        // A chain's balls take gaps, not positions.
+        (format!("{LSL}[tolerances]\nposition = 0.001\n"), "needs balls placed in a box"),
+        (grid_of_balls("[0.0, 0.0, -9.81]", -1e-3), "must not be negative"),
+        (grid_of_balls("[0.0, 0.0, -9.81]", 1e-3).replace("position = 0.001", "position = \"0.1 Rr\""), "give metres"),
+        // The particle box's lattice leaves 10 um between neighbours: a millimetre's spread
+        // almost always makes two balls overlap.
+        (format!("{box_scene}[tolerances]\nposition = 0.001\n"), "is too wide"),
+    ];
+    for (text, rule) in cases {
+        let path = tmp.path().join("bad.toml");
+        std::fs::write(&path, text).unwrap();
+        let out_dir = tmp.path().join("out");
+        let out = lpc(["run".as_ref(), path.as_os_str(), "--ensemble".as_ref(), "4".as_ref(), "--out".as_ref(), out_dir.as_os_str()]);
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(2), "{stderr}");
+        assert!(stderr.contains("tolerances.position") && stderr.contains(rule), "{stderr}");
+        assert!(!out_dir.exists(), "something was written: {stderr}");
+    }
+}
