@@ -219,6 +219,9 @@ pub fn simulate_spatial_with(scene: &Scene, solver: SolverSettings, options: &Ru
     let speed_floor = 1e-9 * speed;
     let resting_speed =
         |normal: [f64; 3]| 2.0 * (contacts_dot(g, normal).abs() + normal[0].abs() * frame_acceleration) * solver.dt + speed_floor;
+    let prediction = world.physics.integration_parameters.normalized_prediction_distance;
+    let lu = world.physics.integration_parameters.length_unit;
+    let g_norm = contacts_dot(g, g).sqrt();
     let mut order = Vec::new();
     // How fast pairs may close, m/s: twice the fastest expected speed.
     let reach = 2.0 * speed;
@@ -306,6 +309,14 @@ pub fn simulate_spatial_with(scene: &Scene, solver: SolverSettings, options: &Ru
             forcing_work += work;
         }
         world.physics.bodies[world.frame].set_next_kinematic_translation(Vector::new(x1 as f32, 0.0, 0.0));
+        // Rapier stops a pair at contact only when it predicts it: as far ahead as the scene's
+        // speed carries a body in a step, and further when a ball moves faster than that
+        // relative to the walls (light balls struck by heavy ones), by what any pair can then
+        // close in the step (twice the fastest ball's speed, and gravity's pull).
+        let walls_speed = (x1 - xs) / h;
+        let fastest = now.v.iter().map(|v| ((v[0] - walls_speed).powi(2) + v[1] * v[1] + v[2] * v[2]).sqrt()).fold(0.0, f64::max);
+        let closing = (2.0 * fastest * h + g_norm * h * h) as f32 / lu;
+        world.physics.integration_parameters.normalized_prediction_distance = prediction.max(closing);
         std::mem::swap(&mut before, &mut now);
         world.physics.step();
         now.read(&world.physics.bodies, &world.balls);

@@ -7,6 +7,7 @@ mod check_bad_scene_exit_status;
 mod closed_pipe;
 mod driven_sweep_energy_left;
 mod ensemble_without_tolerances;
+mod fast_ball_into_wall;
 mod floor_starting_from_rest;
 mod forced_ball_through_wall;
 mod forced_floor_acceleration;
