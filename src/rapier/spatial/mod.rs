@@ -436,11 +436,28 @@ pub fn simulate_spatial_with(scene: &Scene, solver: SolverSettings, options: &Ru
                     }
                 }
                 for _ in 0..cap {
-                    let fastest = candidate
-                        .iter()
-                        .map(|&k| (contacts::relative(&found[k], &balls, &frame).0, k))
-                        .filter(|&(w, k)| w < -resting_speed(found[k].normal))
-                        .min_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
+                    // The fastest approaching candidate. A candidate that is not approaching
+                    // faster than a resting contact leaves the list: only a strike on one of
+                    // its balls can change that, and the strike lists it again. Contacts with
+                    // the end walls stay, since every wall impact changes the frame's velocity.
+                    let mut fastest: Option<(f64, usize)> = None;
+                    let mut kept = 0;
+                    for at in 0..candidate.len() {
+                        let k = candidate[at];
+                        let c = &found[k];
+                        let w = contacts::relative(c, &balls, &frame).0;
+                        let approaching = w < -resting_speed(c.normal);
+                        if approaching && fastest.is_none_or(|(fw, fk)| w.total_cmp(&fw).then(k.cmp(&fk)).is_lt()) {
+                            fastest = Some((w, k));
+                        }
+                        if approaching || (matches!(c.other, Other::Wall(_)) && c.normal[0] != 0.0) {
+                            candidate[kept] = k;
+                            kept += 1;
+                        } else {
+                            listed[k] = false;
+                        }
+                    }
+                    candidate.truncate(kept);
                     let Some((w, k)) = fastest else { break };
                     let c = found[k];
                     let lost = contacts::strike(&c, -w, e, &mut balls, &mut frame);
