@@ -48,8 +48,9 @@ pub const RESTING_SINK_FRACTION: f64 = 0.05;
 /// The most the fastest motion of a scene may carry a body in one step, as a fraction of the
 /// smallest ball's radius.
 pub const STEP_TRAVEL: f64 = 0.2;
-/// Steps between two looks at the budgets.
-const BUDGET_STEPS: u64 = 256;
+/// Steps between two looks at the budgets and the progress: every step, since a step of a deep
+/// bed can take a second (a look costs tens of nanoseconds, a step at least microseconds).
+const BUDGET_STEPS: u64 = 1;
 
 /// Whether `scene` goes to the spatial path: several chains, or anything a line cannot hold
 /// (balls off their chain's line, motion across, gravity, friction).
