@@ -324,7 +324,7 @@ impl Drawer<'_> {
         }
         let name = format!("{}#{k}", self.nominal.name);
         // A failure the scene's rules cannot pin on a drawn parameter is blamed on the first.
-        let first = self.spreads.first().map_or(POSITION, |s| s.0.name());
+        let first = self.spreads.first().map(|s| s.0.name()).or(self.position.map(|_| POSITION)).unwrap_or(Parameter::FillFraction.name());
         let mut scene = match file {
             None => self.nominal.clone(),
             Some(f) => scene::from_file(f, self.path, &name)
