@@ -136,6 +136,31 @@ fn an_elastic_head_on_impact_passes_the_whole_momentum() {
     assert!(run.energy.impact_loss == 0.0);
 }
 
+/// A ball striking a resting row of two touching equal balls on the floor with `e = 1`
+/// (Newton's cradle): §3's one pair at a time passes the whole momentum down the row, the
+/// striker and the middle ball stopping and the last leaving at the striker's speed. Rapier's
+/// speculative contact stops the striker at contact at the end of a step, before it touches the
+/// row, so its solve moves no ball of the row, and the impact law and its knock-on then resolve
+/// the row one pair at a time.
+#[test]
+fn a_ball_striking_a_touching_row_passes_the_momentum_down_the_row() {
+    let v0 = 0.5;
+    let mut text = "[frame]\nmass = 1e6\nstiffness = 1e6\ndamping = 0.0\ninitial_displacement = 0.0\n\
+                    [container]\nlength = 0.2\nwidth = 0.02\nheight = 0.02\n\
+                    [world]\nrestitution = 1.0\ngravity = [0.0, 0.0, -9.81]\n\
+                    [run]\nhorizon = 0.1\nsample_dt = 0.001\n"
+        .to_string();
+    for (x, v) in [(0.02, v0), (0.06, 0.0), (0.07, 0.0)] {
+        text += &format!("[[ball]]\nposition = [{x}, 0.0, -0.005]\nmass = 0.0040841\nradius = 0.005\nvelocity = [{v}, 0.0, 0.0]\n");
+    }
+    let scene = scene_from_toml(&text);
+    assert!(spatial::needs_spatial(&scene));
+    let run = simulate_spatial(&scene, &RunOptions::default()).unwrap();
+    let v = &run.final_velocities;
+    assert!(v[0].abs() <= F32_SOLVE * v0 && v[1].abs() <= F32_SOLVE * v0, "striker and middle ball keep {v:?} m/s");
+    assert!((v[2] - v0).abs() <= F32_SOLVE * v0, "the last ball leaves at {} m/s", v[2]);
+}
+
 /// Steps of the chain scenes, s: fixed steps land an impact up to a step late, which moves
 /// the balls by up to their speed (about 0.5 m/s) times the step: 0.05 mm at 0.1 ms, a
 /// quarter of the bound the comparisons use.
