@@ -1,6 +1,6 @@
 //! The reference beyond one line (docs/MODEL.md §14): smooth balls flying in closed form in the
 //! plane or in space under gravity inside the container the frame carries, their impacts by
-//! Eq. 9-10 along the contact normal, found by an event calendar (a binary heap whose stale
+//! Eq. 9-10 along the contact normal, found by an event calendar (binary heaps whose stale
 //! entries are dropped when they surface) over cells as wide as a ball. Ball-ball and
 //! ball-floor times are roots of quadratics; a ball against the walls that move with the frame
 //! is found by the one-line reference's sound root isolation ([`FrameGap`]).
@@ -157,7 +157,12 @@ struct Solver<'a> {
     cells: Cells,
     /// Scratch: the balls of the cells around one ball (kept to spare an allocation an event).
     neighbours: Vec<usize>,
+    /// Every entry but the balls' contacts with the frame's walls.
     calendar: BinaryHeap<Entry>,
+    /// The balls' contacts with the frame's walls, apart: each impact on those walls changes
+    /// the frame's motion, invalidates them all and predicts them all anew, so this calendar is
+    /// emptied then rather than left to carry a stale entry per ball.
+    frame_calendar: BinaryHeap<Entry>,
     gravity: [f64; 3],
     e: f64,
     length: f64,
@@ -282,6 +287,7 @@ impl<'a> Solver<'a> {
             cells,
             neighbours: Vec::new(),
             calendar: BinaryHeap::new(),
+            frame_calendar: BinaryHeap::new(),
             gravity: scene.space.gravity,
             e: scene.restitution,
             length: container.length,
@@ -326,7 +332,21 @@ impl<'a> Solver<'a> {
     fn push(&mut self, t: f64, ball: usize, kind: Kind, other: Option<usize>) {
         if t <= self.horizon {
             let stamps = (self.balls[ball].stamp, other.map_or(0, |j| self.balls[j].stamp));
-            self.calendar.push(Entry { t, ball: ball as u32, kind, stamps, segment: self.frame.segment });
+            let entry = Entry { t, ball: ball as u32, kind, stamps, segment: self.frame.segment };
+            if matches!(kind, Kind::Frame(..)) {
+                self.frame_calendar.push(entry);
+            } else {
+                self.calendar.push(entry);
+            }
+        }
+    }
+
+    /// The earliest entry of the two calendars (at a tie, the other entries' first).
+    fn next_entry(&mut self) -> Option<Entry> {
+        match (self.calendar.peek(), self.frame_calendar.peek()) {
+            (Some(a), Some(f)) if f > a => self.frame_calendar.pop(),
+            (Some(_), _) => self.calendar.pop(),
+            (None, _) => self.frame_calendar.pop(),
         }
     }
 
@@ -423,7 +443,7 @@ impl<'a> Solver<'a> {
         let sample_count = self.scene.sample_count();
         let mut next_sample = 0;
         let mut same_instant = 0u64;
-        while let Some(entry) = self.calendar.pop() {
+        while let Some(entry) = self.next_entry() {
             if !self.valid(&entry) {
                 continue;
             }
@@ -459,9 +479,11 @@ impl<'a> Solver<'a> {
                 return Err(self.stalled(format!("more than {MAX_EVENTS} events")));
             }
             self.resolve(entry)?;
-            if self.calendar.len() > 64 * self.balls.len() + 4096 {
+            if self.calendar.len() + self.frame_calendar.len() > 64 * self.balls.len() + 4096 {
                 let kept: Vec<Entry> = std::mem::take(&mut self.calendar).into_iter().filter(|e| self.valid(e)).collect();
                 self.calendar = kept.into();
+                let kept: Vec<Entry> = std::mem::take(&mut self.frame_calendar).into_iter().filter(|e| self.valid(e)).collect();
+                self.frame_calendar = kept.into();
             }
         }
         self.t = self.horizon;
@@ -640,6 +662,8 @@ impl<'a> Solver<'a> {
                     self.forcing_work += work;
                     if self.frame.exists() {
                         self.frame.restart(self.t, xs, vf);
+                        // Every entry against the frame's walls belongs to the motion just ended.
+                        self.frame_calendar.clear();
                     }
                     self.balls[i].v[0] = vb;
                     self.balls[i].last_impact = self.t;
