@@ -354,9 +354,7 @@ impl Drawer<'_> {
         }
         Ok(Member { index: k, drawn, scene })
     }
-}
 
-impl Drawer<'_> {
     /// Moves every ball of `scene` by its own draw along each axis, less the draw's component
     /// along gravity (a ball resting on the floor stays on it): the displacements' root mean
     /// square, m, or the failure when a ball would leave the box or overlap another. The

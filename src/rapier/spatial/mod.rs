@@ -310,12 +310,13 @@ pub fn simulate_spatial_with(scene: &Scene, solver: SolverSettings, options: &Ru
             forcing_work += work;
         }
         world.physics.bodies[world.frame].set_next_kinematic_translation(Vector::new(x1 as f32, 0.0, 0.0));
+        // The walls' mean velocity over the step: Rapier moves them there in a straight line.
+        let mean_vs = (x1 - xs) / h;
         // Rapier stops a pair at contact only when it predicts it: as far ahead as the scene's
         // speed carries a body in a step, and further when a ball moves faster than that
         // relative to the walls (light balls struck by heavy ones), by what any pair can then
         // close in the step (twice the fastest ball's speed, and gravity's pull).
-        let walls_speed = (x1 - xs) / h;
-        let fastest = now.v.iter().map(|v| ((v[0] - walls_speed).powi(2) + v[1] * v[1] + v[2] * v[2]).sqrt()).fold(0.0, f64::max);
+        let fastest = now.v.iter().map(|v| ((v[0] - mean_vs).powi(2) + v[1] * v[1] + v[2] * v[2]).sqrt()).fold(0.0, f64::max);
         let closing = (2.0 * fastest * h + g_norm * h * h) as f32 / lu;
         world.physics.integration_parameters.normalized_prediction_distance = prediction.max(closing);
         std::mem::swap(&mut before, &mut now);
@@ -329,7 +330,6 @@ pub fn simulate_spatial_with(scene: &Scene, solver: SolverSettings, options: &Ru
         // it touches, within what it closes in a step or two.
         contacts::find(&geometry, &now.x, &radius, x1, touching + reach * h, &mut order, &mut found);
         // Contacts whose approach Rapier stopped, the fastest first.
-        let mean_vs = (x1 - xs) / h;
         let mut new: Vec<Closing> = Vec::new();
         for (k, c) in found.iter().enumerate() {
             report.deepest_overlap = report.deepest_overlap.max(-c.gap);
