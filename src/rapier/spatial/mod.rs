@@ -228,9 +228,7 @@ pub fn simulate_spatial_with(scene: &Scene, solver: SolverSettings, options: &Ru
     let reach = 2.0 * speed;
     let mut found: Vec<Contact> = Vec::new();
     let mut kicked = vec![false; n];
-    // The knock-on cascade's scratch: each ball's touching contacts, the candidates, which are listed.
-    let mut by_ball: Vec<Vec<usize>> = vec![Vec::new(); n];
-    let (mut candidate, mut listed): (Vec<usize>, Vec<bool>) = (Vec::new(), Vec::new());
+    let mut cascade = contacts::Cascade::default();
     let energy_of = |state: &BallState, t: f64, xs: f64, vs: f64| -> f64 {
         let mut e = scene.frame_energy(t, xs, vs);
         for i in 0..n {
@@ -405,73 +403,14 @@ pub fn simulate_spatial_with(scene: &Scene, solver: SolverSettings, options: &Ru
                     kicked[j] = true;
                 }
             }
-            // Touching pairs the impacts set approaching strike in turn, the fastest first (at
-            // a tie the first found). Only contacts of a struck ball can have been set
-            // approaching, so those are the candidates, added as their balls are struck: a
-            // cascade costs what it reaches, not every contact of the bed each time.
-            let cap = 4 * found.len() + 16;
+            // Touching pairs the impacts set approaching strike in turn, the fastest first.
             if !new.is_empty() {
-                by_ball.iter_mut().for_each(|list| list.clear());
-                for (k, c) in found.iter().enumerate() {
-                    if c.gap <= touching {
-                        by_ball[c.ball].push(k);
-                        if let Other::Ball(j) = c.other {
-                            by_ball[j].push(k);
-                        }
-                    }
-                }
-                candidate.clear();
-                listed.clear();
-                listed.resize(found.len(), false);
-                let add = |i: usize, candidate: &mut Vec<usize>, listed: &mut Vec<bool>| {
-                    for &k in &by_ball[i] {
-                        if !listed[k] {
-                            listed[k] = true;
-                            candidate.push(k);
-                        }
-                    }
-                };
-                for i in 0..n {
-                    if kicked[i] {
-                        add(i, &mut candidate, &mut listed);
-                    }
-                }
-                for _ in 0..cap {
-                    // The fastest approaching candidate. A candidate that is not approaching
-                    // faster than a resting contact leaves the list: only a strike on one of
-                    // its balls can change that, and the strike lists it again. Contacts with
-                    // the end walls stay, since every wall impact changes the frame's velocity.
-                    let mut fastest: Option<(f64, usize)> = None;
-                    let mut kept = 0;
-                    for at in 0..candidate.len() {
-                        let k = candidate[at];
-                        let c = &found[k];
-                        let w = contacts::relative(c, &balls, &frame).0;
-                        let approaching = w < -resting_speed(c.normal);
-                        if approaching && fastest.is_none_or(|(fw, fk)| w.total_cmp(&fw).then(k.cmp(&fk)).is_lt()) {
-                            fastest = Some((w, k));
-                        }
-                        if approaching || (matches!(c.other, Other::Wall(_)) && c.normal[0] != 0.0) {
-                            candidate[kept] = k;
-                            kept += 1;
-                        } else {
-                            listed[k] = false;
-                        }
-                    }
-                    candidate.truncate(kept);
-                    let Some((w, k)) = fastest else { break };
-                    let c = found[k];
-                    let lost = contacts::strike(&c, -w, e, &mut balls, &mut frame);
+                cascade.run(&found, touching, &mut kicked, resting_speed, (&mut balls, &mut frame), |c, approach, balls, frame| {
+                    let lost = contacts::strike(c, approach, e, balls, frame);
                     step_impact_loss += lost;
-                    impacts.push(impact_record(t1, &c, -w, lost));
+                    impacts.push(impact_record(t1, c, approach, lost));
                     report.knock_on_impacts += 1;
-                    kicked[c.ball] = true;
-                    add(c.ball, &mut candidate, &mut listed);
-                    if let Other::Ball(j) = c.other {
-                        kicked[j] = true;
-                        add(j, &mut candidate, &mut listed);
-                    }
-                }
+                });
             }
         }
         for (i, &h_ball) in world.balls.iter().enumerate() {

@@ -1,0 +1,36 @@
+#!/bin/bash
+# The contact model's (Rapier's) cost against the number of balls beyond one line: the
+# particle box scaled to N balls (the same proportions of box and bed, 5 mm steel balls on a
+# lattice, gravity, friction 0.3, e 0.6), on a frame whose mass and stiffness are in proportion
+# to the balls' mass (the particle box's frequency and mass ratio), shaken by its initial
+# displacement. Prints a table row per box: steps of 1 ms, impacts and the computing time.
+#   bash benches/spatial_rapier.sh [LPC] [HORIZON] [N...]
+#   (default: target/release/lpc, 0.5 s, 10 100 1000 10000)
+set -euo pipefail
+lpc=${1:-target/release/lpc}
+horizon=${2:-0.5}
+shift 2 || shift $# || true
+counts=${*:-10 100 1000 10000}
+dir=$(mktemp -d)
+printf '| balls | horizon | impacts | computed in | per simulated second | per ball and simulated second |\n|---|---|---|---|---|---|\n'
+for n in $counts; do
+  python3 - "$n" "$horizon" "$dir/box$n.toml" <<'PY'
+import sys
+n, horizon, path = int(sys.argv[1]), float(sys.argv[2]), sys.argv[3]
+scale = (n / 300) ** (1 / 3)
+lines = [f'name = "rapier-box-{n}"', "[frame]", f"mass = {1.35 * n / 300:.6g}", f"stiffness = {865.0 * n / 300:.6g}",
+         "damping = 1.092", "initial_displacement = 0.0185", "[container]", f"length = {0.1 * scale:.6g}",
+         f"width = {0.06 * scale:.6g}", f"height = {0.1 * scale:.6g}", "[world]", "gravity = [0.0, 0.0, -9.81]",
+         "friction = 0.3", "restitution = 0.6", "[bed]", f"count = {n}", "radii = [0.005]", "density = 7800.0",
+         'placement = "lattice"', "[rapier]", "dt = 0.001", "[run]", f"horizon = {horizon}", "sample_dt = 0.001"]
+open(path, "w").write("\n".join(lines) + "\n")
+PY
+  "$lpc" run "$dir/box$n.toml" --model rapier --format json > "$dir/out$n.json"
+  python3 - "$n" "$dir/out$n.json" <<'PY'
+import json, sys
+n, out = int(sys.argv[1]), json.load(open(sys.argv[2]))
+wall, horizon, impacts = out["wall_time_s"], out["horizon"], out["impact_count"]
+print(f"| {n:,} | {horizon:g} s | {impacts:,} | {wall:.2f} s | {wall / horizon:,.2f} s | {1e3 * wall / horizon / n:.2f} ms |")
+PY
+done
+rm -rf "$dir"
