@@ -25,6 +25,10 @@ pub struct ImpactSummary {
     pub contact_duration: Option<f64>,
 }
 
+fn is_zero(x: &f64) -> bool {
+    *x == 0.0
+}
+
 /// The energy account as in the JSON contract.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct EnergySummary {
@@ -37,6 +41,10 @@ pub struct EnergySummary {
     pub damping_loss: f64,
     /// J.
     pub impact_loss: f64,
+    /// Lost in contacts besides the impacts (friction, plastic resting contacts), J; absent
+    /// when 0.
+    #[serde(default, skip_serializing_if = "is_zero")]
+    pub contact_loss: f64,
     /// Work done by the excitation, J (0 in free vibration).
     #[serde(default)]
     pub forcing_work: f64,
@@ -144,6 +152,7 @@ impl RunSummary {
                 final_: run.energy.final_,
                 damping_loss: run.energy.damping_loss,
                 impact_loss: run.energy.impact_loss,
+                contact_loss: run.energy.contact_loss,
                 forcing_work: run.energy.forcing_work,
                 balance_error: run.energy.balance_error,
             },

@@ -33,7 +33,7 @@ pub fn text_summary(s: &RunSummary) -> String {
          rms displacement   {:.4} mm\n\
          settling time      {}\n\
          energy remaining   {}\n\
-         energy (J)         initial {:.6e}{} = final {:.6e} + damping {:.6e} + impacts {:.6e} (balance error {:.1e})\n\
+         energy (J)         initial {:.6e}{} = final {:.6e} + damping {:.6e} + impacts {:.6e}{} (balance error {:.1e})\n\
          noise proxy        {}\n",
         s.scene,
         s.model,
@@ -55,6 +55,7 @@ pub fn text_summary(s: &RunSummary) -> String {
         e.final_,
         e.damping_loss,
         e.impact_loss,
+        if e.contact_loss != 0.0 { format!(" + contacts {:.6e}", e.contact_loss) } else { String::new() },
         e.balance_error,
         noise_line(&s.noise),
     ) + &floors_table(s)

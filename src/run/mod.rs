@@ -102,7 +102,8 @@ pub struct Impact {
 }
 
 /// Where the energy went.
-/// `balance_error = (initial + forcing_work - final - damping_loss - impact_loss) / (|initial| + |forcing_work|)`.
+/// `balance_error = (initial + forcing_work - final - damping_loss - impact_loss - contact_loss)
+/// / (|initial| + |forcing_work|)`.
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
 pub struct EnergyAccount {
     /// Mechanical energy at t = 0, J.
@@ -111,8 +112,12 @@ pub struct EnergyAccount {
     pub final_: f64,
     /// Dissipated by the frame damper `cs`, J.
     pub damping_loss: f64,
-    /// Lost in impacts, J.
+    /// Lost in impacts, J: along the contacts' normals, by the impact law (the compliant
+    /// model's normal damping).
     pub impact_loss: f64,
+    /// Lost in contacts besides the impacts, J: friction, and what the contact model's plastic
+    /// solve takes from resting and pushed contacts (0 where every contact is an impact).
+    pub contact_loss: f64,
     /// Work done by the excitation, J (0 in free vibration).
     pub forcing_work: f64,
     /// Relative balance error.
@@ -133,9 +138,17 @@ impl EnergyAccount {
             final_,
             damping_loss,
             impact_loss,
+            contact_loss: 0.0,
             forcing_work,
             balance_error: (initial + forcing_work - final_ - damping_loss - impact_loss) / scale,
         }
+    }
+    /// The account with `contact_loss` booked besides the impacts' loss.
+    pub fn with_contact_loss(self, contact_loss: f64) -> Self {
+        let scale = self.initial.abs() + self.forcing_work.abs();
+        let scale = if scale != 0.0 { scale } else { 1.0 };
+        let residual = self.initial + self.forcing_work - self.final_ - self.damping_loss - self.impact_loss - contact_loss;
+        EnergyAccount { contact_loss, balance_error: residual / scale, ..self }
     }
 }
 

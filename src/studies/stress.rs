@@ -327,7 +327,8 @@ pub fn judge(model: Model, scene: &Scene, run: &Run) -> Result<(), Failure> {
     let s = &run.series;
     let finite = |v: &[f64]| v.iter().all(|x| x.is_finite());
     let series_finite = finite(s.xs()) && finite(s.vs()) && finite(s.a()) && (0..s.balls()).all(|i| finite(s.x(i)) && finite(s.v(i)));
-    let account_finite = [run.energy.final_, run.energy.damping_loss, run.energy.impact_loss].iter().all(|x| x.is_finite());
+    let account_finite =
+        [run.energy.final_, run.energy.damping_loss, run.energy.impact_loss, run.energy.contact_loss].iter().all(|x| x.is_finite());
     if !(series_finite && account_finite) {
         return fail("non-finite", "a series or the energy account holds NaN or infinity".into());
     }
@@ -350,8 +351,8 @@ pub fn judge(model: Model, scene: &Scene, run: &Run) -> Result<(), Failure> {
     // took is counted too (a bed falling under gravity loses in impacts what it had as height).
     if let Some(balance_tol) = checks.balance {
         let a = &run.energy;
-        let residual = a.initial + a.forcing_work - a.final_ - a.damping_loss - a.impact_loss;
-        let flow = e0 + work.abs() + forced_energy_scale(scene) + a.impact_loss.abs() + a.damping_loss.abs();
+        let residual = a.initial + a.forcing_work - a.final_ - a.damping_loss - a.impact_loss - a.contact_loss;
+        let flow = e0 + work.abs() + forced_energy_scale(scene) + a.impact_loss.abs() + a.damping_loss.abs() + a.contact_loss.abs();
         if residual.abs() > balance_tol * flow {
             return fail("energy-gained", format!("energy balance off by {residual:e} J (energy flows of {flow:e} J)"));
         }

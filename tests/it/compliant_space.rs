@@ -71,6 +71,7 @@ fn an_impact_has_the_scenes_restitution_at_any_speed() {
 /// A ball sliding on the floor with friction ends rolling at 5/7 of its speed: friction acts at
 /// the contact point only, so the angular momentum about it is conserved (to round-off in
 /// velocity Verlet, whose kicks change the linear and angular momenta by the same impulse).
+/// What friction took is the run's contact loss.
 #[test]
 fn a_sliding_ball_ends_rolling_at_five_sevenths_of_its_speed() {
     let (v0, mu, g) = (1.0, 0.3, 9.81);
@@ -88,6 +89,13 @@ fn a_sliding_ball_ends_rolling_at_five_sevenths_of_its_speed() {
     let k = (0.5 * rolls_after / scene.sample_dt) as usize;
     let sliding = v0 - mu * g * s.t()[k];
     assert!((s.v(0)[k] - sliding).abs() <= verlet_error() * (v0 - sliding), "{} vs {sliding}", s.v(0)[k]);
+    // Friction took 2/7 of the kinetic energy (rolling keeps 5/7 of it, spin included): the
+    // run's contact loss, to the balance's stated integration error; the normal damping of
+    // the resting contact took next to nothing.
+    let e0 = 0.5 * scene.balls[0].mass * v0 * v0;
+    let friction = run.energy.contact_loss;
+    assert!((friction - 2.0 / 7.0 * e0).abs() <= verlet_error() * e0, "friction took {friction} J of {e0} J");
+    assert!(run.energy.impact_loss.abs() <= verlet_error() * e0, "{:?}", run.energy);
     judge(Model::Compliant, &scene, &run).unwrap();
 }
 

@@ -84,6 +84,67 @@ fn a_dropped_ball_rebounds_with_the_scenes_restitution() {
     }
 }
 
+/// A ball sliding on the floor of a resting box with friction ends rolling at 5/7 of its
+/// speed, and what the contact took, friction's `2/7` of its kinetic energy and the weight's
+/// work as the ball sank into Rapier's soft floor, is booked as the run's contact loss, not its
+/// impacts'.
+///
+/// Tolerance: the loss booked in a step is the step's energy change (spin included) less
+/// gravity's work, so the sum is the energy the ball lost; what is left is the f32 rounding of
+/// the velocities, [`F32_SOLVE`] relative in each of some `2 v0 / (7 mu g h)` steps, and the
+/// final speed's own error, by which Rapier's iterative friction solve misses rolling. The
+/// account then closes to its round-off: every step's loss is in it.
+#[test]
+fn a_sliding_balls_friction_loss_is_its_contact_loss() {
+    let (v0, mu, g, h) = (1.0, 0.3, 9.81, 1e-3);
+    let m = 0.0040841;
+    let rolls_after = 2.0 * v0 / (7.0 * mu * g);
+    let scene = scene_from_toml(&format!(
+        r#"
+[frame]
+mass = 1e6
+stiffness = 1e6
+damping = 0.0
+initial_displacement = 0.0
+[container]
+length = 0.5
+width = 0.05
+height = 0.05
+[world]
+gravity = [0.0, 0.0, -{g}]
+friction = {mu}
+restitution = 0.6
+[[ball]]
+position = [0.05, 0.0, -0.02]
+mass = {m}
+radius = 0.005
+velocity = [{v0}, 0.0, 0.0]
+[rapier]
+dt = {h}
+[run]
+horizon = {horizon}
+sample_dt = 0.001
+"#,
+        horizon = 1.5 * rolls_after
+    ));
+    let run = simulate_spatial(&scene, &RunOptions::default()).unwrap();
+    let v = run.final_velocities[0];
+    let rolling = 5.0 / 7.0 * v0;
+    let speed_error = (v - rolling).abs() / v0;
+    assert!(speed_error <= 1e-3, "ends at {v} m/s, rolling is {rolling} m/s");
+    let e0 = 0.5 * m * v0 * v0;
+    let steps = rolls_after / h + 1.0;
+    let tolerance = (steps * F32_SOLVE + 2.0 * speed_error) * e0;
+    let s = &run.series;
+    let sunk = -0.02 - s.across(0, s.len() - 1)[1];
+    assert!((0.0..=RESTING_SINK_FRACTION * 0.005).contains(&sunk), "sank {sunk} m");
+    let expected = 2.0 / 7.0 * e0 + m * g * sunk;
+    let loss = run.energy.contact_loss;
+    assert!((loss - expected).abs() <= tolerance, "contact loss {loss} J against {expected} J (sank {sunk} m)");
+    assert!(run.impacts.is_empty() && run.energy.impact_loss == 0.0, "{:?}", run.impacts);
+    assert!(run.energy.balance_error.abs() <= tolerance / e0, "{:?}", run.energy);
+}
+
 /// Two equal balls on one line in a box without gravity or friction, the first at `v0`
 /// towards the second at rest, with `e = 1`.
 fn head_on(v0: f64) -> Scene {

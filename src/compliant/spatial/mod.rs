@@ -83,10 +83,12 @@ struct Open {
     /// the Hunt-Crossley damping `alpha = c / approach`.
     approach: f64,
     peak_force: f64,
-    /// Energy taken so far (normal damping and friction), J.
+    /// Energy the normal damping took so far (the impact's loss), J.
     loss: f64,
-    /// Power taken at the last step, W.
+    /// Power the normal damping took at the last step, W.
     power: f64,
+    /// Power friction took at the last step, W.
+    friction_power: f64,
     /// Overlap and its rate at the last step.
     overlap: f64,
     rate: f64,
@@ -149,7 +151,10 @@ struct Solver<'a> {
     t: f64,
     steps: u64,
     impacts: Vec<Impact>,
+    /// Energy the contacts' normal damping took, J (the impacts' loss).
     contact_loss: f64,
+    /// Energy friction took, J.
+    friction_loss: f64,
     damping_loss: f64,
     forcing_work: f64,
 }
@@ -329,6 +334,7 @@ impl<'a> Solver<'a> {
             steps: 0,
             impacts: Vec::new(),
             contact_loss: 0.0,
+            friction_loss: 0.0,
             damping_loss: 0.0,
             forcing_work: 0.0,
         };
@@ -528,6 +534,7 @@ impl<'a> Solver<'a> {
                     peak_force: 0.0,
                     loss: 0.0,
                     power: 0.0,
+                    friction_power: 0.0,
                     overlap,
                     rate,
                     seen: true,
@@ -550,7 +557,8 @@ impl<'a> Solver<'a> {
         self.stiffness_rate = self.stiffness_rate.max(1.5 * c.k * root / m_star);
         self.damping_rate = self.damping_rate.max(elastic * alpha / m_star);
         // What the normal force does beyond the elastic spring's work is lost.
-        let mut power = (elastic - f_n) * -rate;
+        let power = (elastic - f_n) * -rate;
+        let mut friction_power = 0.0;
         let along = dot(slip_all, normal);
         let slip: [f64; 3] = std::array::from_fn(|k| slip_all[k] - along * normal[k]);
         let speed = dot(slip, slip).sqrt();
@@ -560,11 +568,13 @@ impl<'a> Solver<'a> {
             let viscous = (2.0 / 7.0) * m_star / (SLIP_RELAXATION_STEPS * h.max(f64::MIN_POSITIVE)) * speed;
             let f = viscous.min(self.friction * f_n);
             f_t = std::array::from_fn(|k| -f * slip[k] / speed);
-            power += f * speed;
+            friction_power = f * speed;
         }
         c.loss += 0.5 * (c.power + power) * h;
         self.contact_loss += 0.5 * (c.power + power) * h;
+        self.friction_loss += 0.5 * (c.friction_power + friction_power) * h;
         c.power = power;
+        c.friction_power = friction_power;
         c.peak_force = c.peak_force.max(f_n);
         c.overlap = overlap;
         c.rate = rate;
@@ -576,6 +586,7 @@ impl<'a> Solver<'a> {
     fn close(&mut self, i: usize, c: Open, h: f64) {
         let tail = 0.5 * c.power * h;
         self.contact_loss += tail;
+        self.friction_loss += 0.5 * c.friction_power * h;
         // Forward along the separation to zero overlap.
         let end = if c.rate < 0.0 { (self.t - h - c.overlap / c.rate).min(self.t) } else { self.t };
         if c.approach <= self.v_floor {
@@ -692,8 +703,9 @@ impl<'a> Solver<'a> {
     /// flow: the step (`h`, the last) has not resolved some contact.
     fn watch_balance(&self, energy_in: f64, h: f64) -> Result<(), ModelError> {
         let held = self.energy();
-        let residual = energy_in + self.forcing_work - held - self.damping_loss - self.contact_loss;
-        let flow = energy_in.abs() + self.forcing_work.abs() + self.contact_loss + self.gravity_allowance();
+        let taken = self.contact_loss + self.friction_loss;
+        let residual = energy_in + self.forcing_work - held - self.damping_loss - taken;
+        let flow = energy_in.abs() + self.forcing_work.abs() + taken + self.gravity_allowance();
         if held.is_finite() && residual.is_finite() && residual.abs() <= UNSTABLE_BALANCE * flow {
             return Ok(());
         }
@@ -730,7 +742,8 @@ impl<'a> Solver<'a> {
             series,
             motion,
             impacts: self.impacts,
-            energy: EnergyAccount::forced(scene.initial_energy(), final_, self.damping_loss, self.contact_loss, self.forcing_work),
+            energy: EnergyAccount::forced(scene.initial_energy(), final_, self.damping_loss, self.contact_loss, self.forcing_work)
+                .with_contact_loss(self.friction_loss),
             events: self.steps,
             final_velocities: self.v.iter().map(|v| v[0]).collect(),
             peak_true_acceleration: None,
