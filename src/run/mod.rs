@@ -131,24 +131,21 @@ impl EnergyAccount {
     }
     /// An account of a forced run, the excitation having done `forcing_work`.
     pub fn forced(initial: f64, final_: f64, damping_loss: f64, impact_loss: f64, forcing_work: f64) -> Self {
-        let scale = initial.abs() + forcing_work.abs();
-        let scale = if scale != 0.0 { scale } else { 1.0 };
-        EnergyAccount {
-            initial,
-            final_,
-            damping_loss,
-            impact_loss,
-            contact_loss: 0.0,
-            forcing_work,
-            balance_error: (initial + forcing_work - final_ - damping_loss - impact_loss) / scale,
-        }
+        EnergyAccount { initial, final_, damping_loss, impact_loss, contact_loss: 0.0, forcing_work, balance_error: 0.0 }.balanced()
     }
     /// The account with `contact_loss` booked besides the impacts' loss.
     pub fn with_contact_loss(self, contact_loss: f64) -> Self {
+        EnergyAccount { contact_loss, ..self }.balanced()
+    }
+    /// The energy the account does not explain, J: what was put in less what is held and lost.
+    pub fn residual(&self) -> f64 {
+        self.initial + self.forcing_work - self.final_ - self.damping_loss - self.impact_loss - self.contact_loss
+    }
+    /// The account with its balance error computed from its entries.
+    fn balanced(self) -> Self {
         let scale = self.initial.abs() + self.forcing_work.abs();
         let scale = if scale != 0.0 { scale } else { 1.0 };
-        let residual = self.initial + self.forcing_work - self.final_ - self.damping_loss - self.impact_loss - contact_loss;
-        EnergyAccount { contact_loss, balance_error: residual / scale, ..self }
+        EnergyAccount { balance_error: self.residual() / scale, ..self }
     }
 }
 

@@ -351,7 +351,7 @@ pub fn judge(model: Model, scene: &Scene, run: &Run) -> Result<(), Failure> {
     // took is counted too (a bed falling under gravity loses in impacts what it had as height).
     if let Some(balance_tol) = checks.balance {
         let a = &run.energy;
-        let residual = a.initial + a.forcing_work - a.final_ - a.damping_loss - a.impact_loss - a.contact_loss;
+        let residual = a.residual();
         let flow = e0 + work.abs() + forced_energy_scale(scene) + a.impact_loss.abs() + a.damping_loss.abs() + a.contact_loss.abs();
         if residual.abs() > balance_tol * flow {
             return fail("energy-gained", format!("energy balance off by {residual:e} J (energy flows of {flow:e} J)"));

@@ -152,7 +152,7 @@ struct Solver<'a> {
     steps: u64,
     impacts: Vec<Impact>,
     /// Energy the contacts' normal damping took, J (the impacts' loss).
-    contact_loss: f64,
+    impact_loss: f64,
     /// Energy friction took, J.
     friction_loss: f64,
     damping_loss: f64,
@@ -333,7 +333,7 @@ impl<'a> Solver<'a> {
             t: 0.0,
             steps: 0,
             impacts: Vec::new(),
-            contact_loss: 0.0,
+            impact_loss: 0.0,
             friction_loss: 0.0,
             damping_loss: 0.0,
             forcing_work: 0.0,
@@ -571,7 +571,7 @@ impl<'a> Solver<'a> {
             friction_power = f * speed;
         }
         c.loss += 0.5 * (c.power + power) * h;
-        self.contact_loss += 0.5 * (c.power + power) * h;
+        self.impact_loss += 0.5 * (c.power + power) * h;
         self.friction_loss += 0.5 * (c.friction_power + friction_power) * h;
         c.power = power;
         c.friction_power = friction_power;
@@ -585,7 +585,7 @@ impl<'a> Solver<'a> {
     /// Contact `c` of ball `i` ended in the last step: its record becomes an impact.
     fn close(&mut self, i: usize, c: Open, h: f64) {
         let tail = 0.5 * c.power * h;
-        self.contact_loss += tail;
+        self.impact_loss += tail;
         self.friction_loss += 0.5 * c.friction_power * h;
         // Forward along the separation to zero overlap.
         let end = if c.rate < 0.0 { (self.t - h - c.overlap / c.rate).min(self.t) } else { self.t };
@@ -703,7 +703,7 @@ impl<'a> Solver<'a> {
     /// flow: the step (`h`, the last) has not resolved some contact.
     fn watch_balance(&self, energy_in: f64, h: f64) -> Result<(), ModelError> {
         let held = self.energy();
-        let taken = self.contact_loss + self.friction_loss;
+        let taken = self.impact_loss + self.friction_loss;
         let residual = energy_in + self.forcing_work - held - self.damping_loss - taken;
         let flow = energy_in.abs() + self.forcing_work.abs() + taken + self.gravity_allowance();
         if held.is_finite() && residual.is_finite() && residual.abs() <= UNSTABLE_BALANCE * flow {
@@ -742,7 +742,7 @@ impl<'a> Solver<'a> {
             series,
             motion,
             impacts: self.impacts,
-            energy: EnergyAccount::forced(scene.initial_energy(), final_, self.damping_loss, self.contact_loss, self.forcing_work)
+            energy: EnergyAccount::forced(scene.initial_energy(), final_, self.damping_loss, self.impact_loss, self.forcing_work)
                 .with_contact_loss(self.friction_loss),
             events: self.steps,
             final_velocities: self.v.iter().map(|v| v[0]).collect(),
