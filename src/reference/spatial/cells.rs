@@ -74,24 +74,17 @@ impl Cells {
         origin + c[axis] as f64 * self.size
     }
 
-    /// Calls `f` with every ball in the 27 cells around `c` (each once).
+    /// Calls `f` with every ball in the 27 cells around `c` (each once: there are at
+    /// least three columns, so three neighbouring ones never fold onto one another).
     pub(super) fn around(&self, c: [i64; 3], mut f: impl FnMut(u32)) {
-        let mut seen = [usize::MAX; 27];
-        let mut count = 0;
+        let ys = (c[1] - 1).max(0)..=(c[1] + 1).min(self.across[0] - 1);
+        let zs = (c[2] - 1).max(0)..=(c[2] + 1).min(self.across[1] - 1);
         for dx in -1..=1 {
-            for dy in -1..=1 {
-                for dz in -1..=1 {
-                    let n = [c[0] + dx, c[1] + dy, c[2] + dz];
-                    if !(0..self.across[0]).contains(&n[1]) || !(0..self.across[1]).contains(&n[2]) {
-                        continue;
-                    }
-                    let k = self.index(n);
-                    if seen[..count].contains(&k) {
-                        continue;
-                    }
-                    seen[count] = k;
-                    count += 1;
-                    for &b in &self.members[k] {
+            let column = (c[0] + dx).rem_euclid(self.nx) * self.across[0];
+            for y in ys.clone() {
+                let row = (column + y) * self.across[1];
+                for z in zs.clone() {
+                    for &b in &self.members[(row + z) as usize] {
                         f(b);
                     }
                 }
