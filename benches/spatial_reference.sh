@@ -3,13 +3,14 @@
 # balls without gravity, a gas at 0.5 m/s per component (seeded) in a cubic box on the
 # frame, a quarter of its volume filled; the frame's mass and stiffness in
 # proportion to the balls' mass, so that it keeps the particle box's frequency and mass ratio.
+# The events (impacts, cell crossings, searches resumed) are counted by `lpc bench`.
 #   bash benches/spatial_reference.sh [LPC] [N...]   (default: target/release/lpc, 100 1000 10000)
 set -euo pipefail
 lpc=${1:-target/release/lpc}
 shift || true
 counts=${*:-100 1000 10000}
 dir=$(mktemp -d)
-printf '| balls | horizon | impacts | computed in | impacts per second | per impact |\n|---|---|---|---|---|---|\n'
+printf '| balls | horizon | impacts | events | computed in | impacts per second | events per second |\n|---|---|---|---|---|---|---|\n'
 for n in $counts; do
   python3 - "$n" "$dir/box$n.toml" <<'PY'
 import random, sys
@@ -34,11 +35,13 @@ for i in range(n):
 open(path, "w").write("\n".join(lines) + "\n")
 PY
   "$lpc" run "$dir/box$n.toml" --format json > "$dir/out$n.json"
-  python3 - "$n" "$dir/out$n.json" <<'PY'
+  "$lpc" bench "$dir/box$n.toml" --models reference --repeat 1 --format json > "$dir/bench$n.json"
+  python3 - "$n" "$dir/out$n.json" "$dir/bench$n.json" <<'PY'
 import json, sys
-n, out = int(sys.argv[1]), json.load(open(sys.argv[2]))
+n, out, bench = int(sys.argv[1]), json.load(open(sys.argv[2])), json.load(open(sys.argv[3]))
 impacts, wall, horizon = out["impact_count"], out["wall_time_s"], out["horizon"]
-print(f"| {n:,} | {horizon:g} s | {impacts:,} | {wall:.3f} s | {impacts / wall:,.0f} | {1e6 * wall / impacts:.2f} µs |")
+events = round(bench[0]["steps_per_sim_s"] * horizon)
+print(f"| {n:,} | {horizon:g} s | {impacts:,} | {events:,} | {wall:.3f} s | {impacts / wall:,.0f} | {events / wall:,.0f} |")
 PY
 done
 rm -rf "$dir"

@@ -107,23 +107,59 @@ impl FrameGap<'_> {
     /// its extremes, twice over), which also keeps every Newton step of the search longer than
     /// an ulp of time.
     pub(super) fn may_reach(&self, from: f64, limit: f64) -> bool {
-        let seg = &self.frame.seg;
         let Some(reach) = self.frame.reach() else { return true };
-        let speed = seg.osc.w0() * reach;
-        let (x, v) = (self.x, self.v);
-        let (s, k) = (self.s, self.k);
-        let line = |t: f64| s * (x + v * (t - self.now)) + k;
-        let nearest = line(from).min(line(limit));
-        let eps = f64::EPSILON;
-        let farthest = x.abs() + v.abs() * (limit - self.now).abs();
-        let err = 2.0
-            * (self.drift
-                + seg.position_roundoff(limit)
-                + 4.0 * eps * (farthest + reach + k.abs())
-                + 2.0 * eps * limit.abs() * (v.abs() + speed).max(self.limits.fastest))
-            + 4.0 * eps * reach;
+        let nearest = self.line(from).min(self.line(limit));
         // Written so that a NaN anywhere answers "may reach" (the search then decides).
-        !(nearest - reach - err > self.limits.tol)
+        !(nearest - reach - self.bound_error(limit, reach) > self.limits.tol)
+    }
+
+    /// The gap with the frame at 0 at `t`: a line in time, since the ball flies straight.
+    #[inline(always)]
+    fn line(&self, t: f64) -> f64 {
+        self.s * (self.x + self.v * (t - self.now)) + self.k
+    }
+
+    /// What the gap's bound in [`FrameGap::may_reach`] must clear the tolerance by on a
+    /// window that ends at `limit`, for a frame that never goes farther than `reach`.
+    #[inline(always)]
+    fn bound_error(&self, limit: f64, reach: f64) -> f64 {
+        let seg = &self.frame.seg;
+        let speed = seg.osc.w0() * reach;
+        let eps = f64::EPSILON;
+        let farthest = self.x.abs() + self.v.abs() * (limit - self.now).abs();
+        2.0 * (self.drift
+            + seg.position_roundoff(limit)
+            + 4.0 * eps * (farthest + reach + self.k.abs())
+            + 2.0 * eps * limit.abs() * (self.v.abs() + speed).max(self.limits.fastest))
+            + 4.0 * eps * reach
+    }
+
+    /// The earliest time from `from` on at which the gap may come within the length
+    /// tolerance, with the frame at `xs` at `from`: `from` when it may now (or the frame's
+    /// reach is unknown), `None` when it cannot before the horizon. Two bounds of
+    /// [`FrameGap::may_reach`]'s unforced frame, the later of the two: the frame never goes
+    /// farther than its reach `R` (the gap is at least a line in time less `R`), nor faster
+    /// than `w0 R` (the gap closes no faster than the ball's speed towards the wall plus that).
+    /// Both clear the tolerance by the bound's error at the horizon, its largest, which also
+    /// counts the two ulps of time at the gap's speed that rounding the time can cost: the
+    /// time is never late, and a search need not start before it.
+    pub(super) fn earliest_reach(&self, from: f64, xs: f64) -> Option<f64> {
+        let Some(reach) = self.frame.reach() else { return Some(from) };
+        let margin = self.bound_error(self.horizon, reach) + self.limits.tol;
+        let line = self.line(from);
+        let room = line - self.s * xs - margin;
+        // Written so that a NaN answers "from now" (the search then decides).
+        if !(room > 0.0) {
+            return Some(from);
+        }
+        let closing = -self.s * self.v;
+        let wall_speed = self.frame.seg.osc.w0() * reach;
+        let mut t = if closing + wall_speed > 0.0 { from + room / (closing + wall_speed) } else { f64::INFINITY };
+        let above = line - reach - margin;
+        if above > 0.0 {
+            t = t.max(if closing > 0.0 { from + above / closing } else { f64::INFINITY });
+        }
+        (t <= self.horizon).then_some(t)
     }
 
     /// The first root of a gap that is convex on `[a, b]`: Newton from the left, whose
@@ -233,5 +269,60 @@ impl FrameGap<'_> {
             }
         }
         Some(h)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The first contact the search finds from `from`, following its "not before" answers.
+    fn first_contact(gap: &FrameGap, mut from: f64) -> f64 {
+        loop {
+            let c = gap.search(from, gap.horizon);
+            if c.exact {
+                return c.t;
+            }
+            from = c.t;
+        }
+    }
+
+    /// A search that starts where `earliest_reach` says finds the contact a search from now
+    /// finds (the wait is never late), for balls at every distance from both walls of a
+    /// swinging frame, flying towards them, away or at rest, and from any instant.
+    #[test]
+    fn a_wait_never_passes_a_contact() {
+        let mut scene = crate::scene::load(crate::scene::scenes_dir().join("lpc-lsl.toml")).unwrap().scene.unwrap();
+        scene.horizon = 2.0;
+        let frame = FrameMotion::new(&scene).unwrap();
+        let limits = Limits::new(&scene);
+        let length = 0.1;
+        let (mut waited, mut met) = (0, 0);
+        for from in [0.0, 0.013, 0.37] {
+            let (xs, _) = frame.state(from);
+            for step in 0..40 {
+                let x = xs - 0.02 + 0.14 * step as f64 / 39.0;
+                for v in [-3.0, -0.4, -0.01, 0.0, 0.02, 0.5, 2.5] {
+                    for side in [1.0, -1.0] {
+                        let k = if side > 0.0 { -0.005 } else { length - 0.005 };
+                        let gap =
+                            FrameGap { frame: &frame, limits: &limits, horizon: scene.horizon, now: from, x, v, drift: 0.0, s: side, k };
+                        if gap.at(from).0 <= limits.tol {
+                            continue; // in the wall already: not a ball the solver would hold
+                        }
+                        let contact = first_contact(&gap, from);
+                        match gap.earliest_reach(from, xs) {
+                            None => assert!(contact.is_infinite(), "x {x}, v {v}, side {side}: a contact at {contact} s"),
+                            Some(t) => {
+                                assert!(t <= contact, "x {x}, v {v}, side {side}: waits until {t} s, contact at {contact} s");
+                                waited += usize::from(t > from);
+                                met += usize::from(contact.is_finite() && t > from);
+                            }
+                        }
+                    }
+                }
+            }
+        }
+        assert!(waited > 500 && met > 100, "{waited} waits, {met} of them before a contact");
     }
 }

@@ -350,8 +350,19 @@ impl<'a> Solver<'a> {
         }
     }
 
+    /// Ball `i`'s next contact with the frame's wall on side `side`: searched from now when
+    /// the ball may be within the frame's reach of that wall, else a wait until it may be
+    /// (most balls are far from the walls, and most of those meet another body first).
+    fn predict_frame_wall(&mut self, i: usize, side: f64, xs: f64) {
+        match self.frame_gap(i, side).earliest_reach(self.t, xs) {
+            Some(t) if t > self.t => self.push(t, i, Kind::Frame(side as i8, false), None),
+            Some(_) => self.search_frame_wall(i, side),
+            None => {}
+        }
+    }
+
     /// Ball `i`'s next contact with the frame's wall on side `side`, searched from now.
-    fn predict_frame_wall(&mut self, i: usize, side: f64) {
+    fn search_frame_wall(&mut self, i: usize, side: f64) {
         let c = self.frame_gap(i, side).search(self.t, self.horizon);
         if c.t.is_finite() {
             self.push(c.t, i, Kind::Frame(side as i8, c.exact), None);
@@ -376,8 +387,9 @@ impl<'a> Solver<'a> {
                 }
             }
         }
+        let (xs, _) = self.frame.state(t);
         for side in [1.0, -1.0] {
-            self.predict_frame_wall(i, side);
+            self.predict_frame_wall(i, side, xs);
         }
         let mut crossing: Option<(f64, usize, i64)> = None;
         for axis in 0..3 {
@@ -646,7 +658,7 @@ impl<'a> Solver<'a> {
                 if !exact {
                     // No contact before now: the search goes on from here.
                     self.bring(i);
-                    self.predict_frame_wall(i, side);
+                    self.search_frame_wall(i, side);
                     return Ok(());
                 }
                 self.bring(i);
@@ -673,12 +685,12 @@ impl<'a> Solver<'a> {
                     self.check_ball(i, None)?;
                     self.predict(i);
                     if self.frame.exists() {
-                        // The walls move otherwise from now: every ball's search against them.
+                        // The walls move otherwise from now: every ball's search against them
+                        // (from the ball's flight as it stands, so no ball is moved).
                         for k in 0..self.balls.len() {
                             if k != i {
-                                self.bring(k);
                                 for s in [1.0, -1.0] {
-                                    self.predict_frame_wall(k, s);
+                                    self.predict_frame_wall(k, s, xs);
                                 }
                             }
                         }
