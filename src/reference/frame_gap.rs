@@ -7,6 +7,7 @@ use super::frame::FrameMotion;
 use super::geometry::Limits;
 use super::search::{Candidate, NO_EVENT};
 use super::MAX_ROOT_ITERATIONS;
+use crate::oscillator::Oscillator;
 
 /// The gap between a ball moving at constant velocity along x and a wall of the frame.
 pub(super) struct FrameGap<'a> {
@@ -25,6 +26,29 @@ pub(super) struct FrameGap<'a> {
     pub(super) s: f64,
     /// The gap's offset (radii and the wall's place on the frame), m.
     pub(super) k: f64,
+}
+
+/// Where and how fast a frame can be from some instant to the horizon: no farther from 0 than
+/// `reach`, no faster than `speed`, its evaluated position off by no more than `roundoff`.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(super) struct FrameReach {
+    /// m.
+    pub(super) reach: f64,
+    /// m/s.
+    pub(super) speed: f64,
+    /// m.
+    pub(super) roundoff: f64,
+}
+
+impl FrameReach {
+    /// The bound of an unforced frame of oscillator `osc` whose every segment until `horizon`
+    /// stays within `reach` ([`Oscillator::envelope`](crate::oscillator::Oscillator::envelope)):
+    /// its speed then stays within `w0 reach`, and a segment starting within both rounds off
+    /// its position by no more than one starting at both at once, evaluated at the horizon.
+    pub(super) fn new(osc: &Oscillator, reach: f64, horizon: f64) -> FrameReach {
+        let speed = osc.w0() * reach;
+        FrameReach { reach, speed, roundoff: osc.roundoff(reach, speed, horizon) }
+    }
 }
 
 impl FrameGap<'_> {
@@ -109,8 +133,9 @@ impl FrameGap<'_> {
     pub(super) fn may_reach(&self, from: f64, limit: f64) -> bool {
         let Some(reach) = self.frame.reach() else { return true };
         let nearest = self.line(from).min(self.line(limit));
+        let err = self.bound_error(limit, reach, self.frame.seg.osc.w0() * reach, self.frame.seg.position_roundoff(limit));
         // Written so that a NaN anywhere answers "may reach" (the search then decides).
-        !(nearest - reach - self.bound_error(limit, reach) > self.limits.tol)
+        !(nearest - reach - err > self.limits.tol)
     }
 
     /// The gap with the frame at 0 at `t`: a line in time, since the ball flies straight.
@@ -119,33 +144,33 @@ impl FrameGap<'_> {
         self.s * (self.x + self.v * (t - self.now)) + self.k
     }
 
-    /// What the gap's bound in [`FrameGap::may_reach`] must clear the tolerance by on a
-    /// window that ends at `limit`, for a frame that never goes farther than `reach`.
+    /// What a bound on the gap must clear the tolerance by on a window that ends at `limit`,
+    /// for a frame that goes no farther than `reach` nor faster than `speed` and whose
+    /// position rounds off by at most `roundoff` there: twice what the evaluated gap can err
+    /// by (as [`FrameGap::tolerance`] counts it, at the window's far end and with the frame at
+    /// its extremes).
     #[inline(always)]
-    fn bound_error(&self, limit: f64, reach: f64) -> f64 {
-        let seg = &self.frame.seg;
-        let speed = seg.osc.w0() * reach;
+    fn bound_error(&self, limit: f64, reach: f64, speed: f64, roundoff: f64) -> f64 {
         let eps = f64::EPSILON;
         let farthest = self.x.abs() + self.v.abs() * (limit - self.now).abs();
         2.0 * (self.drift
-            + seg.position_roundoff(limit)
+            + roundoff
             + 4.0 * eps * (farthest + reach + self.k.abs())
             + 2.0 * eps * limit.abs() * (self.v.abs() + speed).max(self.limits.fastest))
             + 4.0 * eps * reach
     }
 
     /// The earliest time from `from` on at which the gap may come within the length
-    /// tolerance, with the frame at `xs` at `from`: `from` when it may now (or the frame's
-    /// reach is unknown), `None` when it cannot before the horizon. Two bounds of
-    /// [`FrameGap::may_reach`]'s unforced frame, the later of the two: the frame never goes
-    /// farther than its reach `R` (the gap is at least a line in time less `R`), nor faster
-    /// than `w0 R` (the gap closes no faster than the ball's speed towards the wall plus that).
-    /// Both clear the tolerance by the bound's error at the horizon, its largest, which also
-    /// counts the two ulps of time at the gap's speed that rounding the time can cost: the
-    /// time is never late, and a search need not start before it.
-    pub(super) fn earliest_reach(&self, from: f64, xs: f64) -> Option<f64> {
-        let Some(reach) = self.frame.reach() else { return Some(from) };
-        let margin = self.bound_error(self.horizon, reach) + self.limits.tol;
+    /// tolerance, with the frame at `xs` at `from` and within `bound` from then to the
+    /// horizon: `from` when it may now, `None` when it cannot before the horizon. The later of
+    /// two bounds: the frame goes no farther than the bound's reach (the gap is at least the
+    /// ball's line less it), nor faster than its speed (the gap closes no faster than the
+    /// ball's speed towards the wall plus that). Both clear the tolerance by the bound's error
+    /// at the horizon, its largest, which also counts the two ulps of time at the gap's speed
+    /// that rounding the time can cost: the time is never late, and a search need not start
+    /// before it.
+    pub(super) fn earliest_reach(&self, from: f64, xs: f64, bound: &FrameReach) -> Option<f64> {
+        let margin = self.bound_error(self.horizon, bound.reach, bound.speed, bound.roundoff) + self.limits.tol;
         let line = self.line(from);
         let room = line - self.s * xs - margin;
         // Written so that a NaN answers "from now" (the search then decides).
@@ -153,9 +178,8 @@ impl FrameGap<'_> {
             return Some(from);
         }
         let closing = -self.s * self.v;
-        let wall_speed = self.frame.seg.osc.w0() * reach;
-        let mut t = if closing + wall_speed > 0.0 { from + room / (closing + wall_speed) } else { f64::INFINITY };
-        let above = line - reach - margin;
+        let mut t = if closing + bound.speed > 0.0 { from + room / (closing + bound.speed) } else { f64::INFINITY };
+        let above = line - bound.reach - margin;
         if above > 0.0 {
             t = t.max(if closing > 0.0 { from + above / closing } else { f64::INFINITY });
         }
@@ -296,6 +320,7 @@ mod tests {
         scene.horizon = 2.0;
         let frame = FrameMotion::new(&scene).unwrap();
         let limits = Limits::new(&scene);
+        let bound = FrameReach::new(&frame.seg.osc, frame.reach().unwrap(), scene.horizon);
         let length = 0.1;
         let (mut waited, mut met) = (0, 0);
         for from in [0.0, 0.013, 0.37] {
@@ -311,7 +336,7 @@ mod tests {
                             continue; // in the wall already: not a ball the solver would hold
                         }
                         let contact = first_contact(&gap, from);
-                        match gap.earliest_reach(from, xs) {
+                        match gap.earliest_reach(from, xs, &bound) {
                             None => assert!(contact.is_infinite(), "x {x}, v {v}, side {side}: a contact at {contact} s"),
                             Some(t) => {
                                 assert!(t <= contact, "x {x}, v {v}, side {side}: waits until {t} s, contact at {contact} s");

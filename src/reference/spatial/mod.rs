@@ -16,7 +16,7 @@ use std::cmp::Ordering;
 use std::collections::BinaryHeap;
 
 use super::frame::FrameMotion;
-use super::frame_gap::FrameGap;
+use super::frame_gap::{FrameGap, FrameReach};
 use super::geometry::Limits;
 use super::{CONTACT_DURATION, MAX_EVENTS};
 use crate::impact_law::{reduced_mass, separate};
@@ -80,17 +80,19 @@ enum Kind {
     Frame(i8, bool),
     /// Ball `i` leaves its cell across `axis` on side `dir`.
     Cell(u8, i8),
+    /// Ball `i` may come near the frame's wall on side `side`: its search starts then.
+    Wait(i8),
 }
 
 /// An entry of the calendar, valid while its balls' stamps (and for a wall of the frame, the
-/// frame's segment) are those it was predicted with.
+/// frame's segment; for a wait, the bound's version) are those it was predicted with.
 #[derive(Debug, Clone, Copy)]
 struct Entry {
     t: f64,
     ball: u32,
     kind: Kind,
     stamps: (u32, u32),
-    segment: u64,
+    version: u64,
 }
 
 impl PartialEq for Entry {
@@ -163,6 +165,18 @@ struct Solver<'a> {
     /// the frame's motion, invalidates them all and predicts them all anew, so this calendar is
     /// emptied then rather than left to carry a stale entry per ball.
     frame_calendar: BinaryHeap<Entry>,
+    /// Where the frame can be from now to the horizon, for the balls' waits before their
+    /// searches against its walls; `None` when unknown (a forced frame, or one without a
+    /// spring), and then every ball searches.
+    frame_reach: Option<FrameReach>,
+    /// Changes when `frame_reach` does: the waits taken with an older bound are stale.
+    reach_version: u64,
+    /// Whether each ball's contact with the frame's wall on each side (left, right) is being
+    /// searched, rather than waited for: what an impact on those walls must search again.
+    searched: Vec<[bool; 2]>,
+    /// The walls that balls started searching since the last impact on the frame's walls
+    /// (some have stopped since), so that the impact looks at these and not at every ball.
+    searching: Vec<(u32, u8)>,
     gravity: [f64; 3],
     e: f64,
     length: f64,
@@ -174,6 +188,36 @@ struct Solver<'a> {
     damping_loss: f64,
     forcing_work: f64,
     start: Vec<[f64; 3]>,
+}
+
+/// The index of the frame's wall on side `side` (`+1` the left wall) in a ball's flags.
+fn wall_index(side: f64) -> usize {
+    usize::from(side < 0.0)
+}
+
+/// Where the frame of `scene` can be from the start to the horizon, for an unforced frame with
+/// a spring and damping `>= 0` (docs/MODEL.md §14): its energy `M v^2 / 2 + K x^2 / 2` can grow
+/// only by what the balls give it, at most their kinetic energy and the height gravity can
+/// still take them down, so it never goes farther than `sqrt(2 E / K)`, `E` the sum, with a
+/// millionth to spare for round-off. A segment beyond it (the collapse rule's energy) widens
+/// it then (see [`Solver::searches_ended`]).
+fn frame_reach(scene: &Scene, frame: &FrameMotion, balls: &[Ball]) -> Option<FrameReach> {
+    if !frame.exists() {
+        return None;
+    }
+    let reach = frame.reach()?;
+    let g = scene.space.gravity;
+    let half = [0.5 * scene.space.section[0], 0.5 * scene.space.section[1]];
+    let given: f64 = balls
+        .iter()
+        .map(|b| {
+            let lowest: f64 = (1..3).map(|k| g[k].abs() * (half[k - 1] - b.radius).max(0.0)).sum();
+            b.mass * (0.5 * dot(b.v, b.v) + (lowest - dot(g, b.p)).max(0.0))
+        })
+        .sum();
+    let energy = (frame.energy(0.0, scene) + given) * (1.0 + 1e-6);
+    let bound = frame.seg.osc.envelope(0.0, (2.0 * energy / frame.mass).sqrt())?;
+    Some(FrameReach::new(&frame.seg.osc, bound.max(reach), scene.horizon))
 }
 
 fn dot(a: [f64; 3], b: [f64; 3]) -> f64 {
@@ -214,8 +258,17 @@ impl Ball {
 
 /// Runs the spatial reference on `scene` (which [`refusal`] accepts).
 pub(super) fn simulate(scene: &Scene, options: &RunOptions) -> Result<Run, ModelError> {
+    simulate_with(scene, options, true)
+}
+
+/// [`simulate`], with the balls waiting before their searches against the frame's walls where
+/// the frame's motion is bounded (`waits`), or always searching.
+fn simulate_with(scene: &Scene, options: &RunOptions, waits: bool) -> Result<Run, ModelError> {
     let meter = Meter::new(options, BUDGET_EVENTS);
     let mut s = Solver::new(scene)?;
+    if !waits {
+        s.frame_reach = None;
+    }
     let mut recorder = Recorder::new(scene, options.record);
     let outcome = s.run(&meter, &mut recorder);
     let t = s.t;
@@ -279,6 +332,7 @@ impl<'a> Solver<'a> {
             })
             .collect();
         let start = balls.iter().map(|b| b.p).collect();
+        let frame_reach = frame_reach(scene, &frame, &balls);
         Ok(Solver {
             scene,
             balls,
@@ -288,6 +342,10 @@ impl<'a> Solver<'a> {
             neighbours: Vec::new(),
             calendar: BinaryHeap::new(),
             frame_calendar: BinaryHeap::new(),
+            frame_reach,
+            reach_version: 0,
+            searched: vec![[false; 2]; scene.balls.len()],
+            searching: Vec::new(),
             gravity: scene.space.gravity,
             e: scene.restitution,
             length: container.length,
@@ -332,7 +390,8 @@ impl<'a> Solver<'a> {
     fn push(&mut self, t: f64, ball: usize, kind: Kind, other: Option<usize>) {
         if t <= self.horizon {
             let stamps = (self.balls[ball].stamp, other.map_or(0, |j| self.balls[j].stamp));
-            let entry = Entry { t, ball: ball as u32, kind, stamps, segment: self.frame.segment };
+            let version = if matches!(kind, Kind::Wait(_)) { self.reach_version } else { self.frame.segment };
+            let entry = Entry { t, ball: ball as u32, kind, stamps, version };
             if matches!(kind, Kind::Frame(..)) {
                 self.frame_calendar.push(entry);
             } else {
@@ -350,19 +409,38 @@ impl<'a> Solver<'a> {
         }
     }
 
-    /// Ball `i`'s next contact with the frame's wall on side `side`: searched from now when
-    /// the ball may be within the frame's reach of that wall, else a wait until it may be
+    /// Ball `i`'s next contact with the frame's wall on side `side`, the frame at `xs` now:
+    /// searched from now when the ball may be near that wall, else a wait until it may be
     /// (most balls are far from the walls, and most of those meet another body first).
     fn predict_frame_wall(&mut self, i: usize, side: f64, xs: f64) {
-        match self.frame_gap(i, side).earliest_reach(self.t, xs) {
-            Some(t) if t > self.t => self.push(t, i, Kind::Frame(side as i8, false), None),
-            Some(_) => self.search_frame_wall(i, side),
-            None => {}
+        let wait = match &self.frame_reach {
+            Some(bound) => self.frame_gap(i, side).earliest_reach(self.t, xs, bound),
+            None => Some(self.t),
+        };
+        match wait {
+            Some(t) if t <= self.t => self.search_frame_wall(i, side),
+            Some(t) => {
+                self.searched[i][wall_index(side)] = false;
+                self.push(t, i, Kind::Wait(side as i8), None);
+            }
+            None => self.searched[i][wall_index(side)] = false,
         }
     }
 
     /// Ball `i`'s next contact with the frame's wall on side `side`, searched from now.
     fn search_frame_wall(&mut self, i: usize, side: f64) {
+        let w = wall_index(side);
+        if !self.searched[i][w] {
+            self.searched[i][w] = true;
+            self.searching.push((i as u32, w as u8));
+            if self.searching.len() > 4 * self.balls.len() + 64 {
+                // Rebuilt from the flags, so that the list never outgrows them.
+                self.searching = (0..self.balls.len() as u32)
+                    .flat_map(|k| [(k, 0u8), (k, 1)])
+                    .filter(|&(k, w)| self.searched[k as usize][w as usize])
+                    .collect();
+            }
+        }
         let c = self.frame_gap(i, side).search(self.t, self.horizon);
         if c.t.is_finite() {
             self.push(c.t, i, Kind::Frame(side as i8, c.exact), None);
@@ -443,7 +521,8 @@ impl<'a> Solver<'a> {
         }
         match e.kind {
             Kind::Pair(j) => self.balls[j as usize].stamp == e.stamps.1,
-            Kind::Frame(..) => self.frame.segment == e.segment,
+            Kind::Frame(..) => self.frame.segment == e.version,
+            Kind::Wait(_) => self.reach_version == e.version,
             _ => true,
         }
     }
@@ -653,6 +732,10 @@ impl<'a> Solver<'a> {
                 }
                 self.predict(i);
             }
+            Kind::Wait(side) => {
+                self.bring(i);
+                self.search_frame_wall(i, side as f64);
+            }
             Kind::Frame(side, exact) => {
                 let side = side as f64;
                 if !exact {
@@ -672,10 +755,12 @@ impl<'a> Solver<'a> {
                     let (damping, work) = self.frame.segment_energy(self.t, self.scene);
                     self.damping_loss += damping;
                     self.forcing_work += work;
+                    let mut searched_before = Vec::new();
                     if self.frame.exists() {
                         self.frame.restart(self.t, xs, vf);
                         // Every entry against the frame's walls belongs to the motion just ended.
                         self.frame_calendar.clear();
+                        searched_before = self.searches_ended();
                     }
                     self.balls[i].v[0] = vb;
                     self.balls[i].last_impact = self.t;
@@ -684,15 +769,11 @@ impl<'a> Solver<'a> {
                     self.limits.fastest = self.limits.fastest.max(approach);
                     self.check_ball(i, None)?;
                     self.predict(i);
-                    if self.frame.exists() {
-                        // The walls move otherwise from now: every ball's search against them
-                        // (from the ball's flight as it stands, so no ball is moved).
-                        for k in 0..self.balls.len() {
-                            if k != i {
-                                for s in [1.0, -1.0] {
-                                    self.predict_frame_wall(k, s, xs);
-                                }
-                            }
+                    // The walls move otherwise from now: the searches against them start again
+                    // (from each ball's flight as it stands, so no ball is moved).
+                    for (k, w) in searched_before {
+                        if k != i {
+                            self.predict_frame_wall(k, if w == 0 { 1.0 } else { -1.0 }, xs);
                         }
                     }
                 } else {
@@ -701,6 +782,33 @@ impl<'a> Solver<'a> {
             }
         }
         Ok(())
+    }
+
+    /// After the frame's segment changed: the walls whose searches it ended, each once. The
+    /// waits hold while the frame keeps within the bound they were taken with, so only the
+    /// searches end; a segment beyond the bound widens it and ends every wait and search.
+    fn searches_ended(&mut self) -> Vec<(usize, usize)> {
+        let within = match (&self.frame_reach, self.frame.reach()) {
+            (Some(bound), Some(reach)) => reach <= bound.reach,
+            _ => false,
+        };
+        if !within {
+            if self.frame_reach.is_some() {
+                self.frame_reach = self.frame.reach().map(|r| FrameReach::new(&self.frame.seg.osc, r * (1.0 + 1e-6), self.horizon));
+                self.reach_version += 1;
+            }
+            self.searching.clear();
+            self.searched.iter_mut().for_each(|s| *s = [false; 2]);
+            return (0..self.balls.len()).flat_map(|k| [(k, 0), (k, 1)]).collect();
+        }
+        let mut ended = Vec::new();
+        for (k, w) in std::mem::take(&mut self.searching) {
+            let (k, w) = (k as usize, w as usize);
+            if std::mem::replace(&mut self.searched[k][w], false) {
+                ended.push((k, w));
+            }
+        }
+        ended
     }
 
     /// The contact tolerance of balls `i` and `j` approaching at `rate`: the length tolerance,
@@ -829,5 +937,27 @@ mod tests {
         let (fa, fb) = (spatial.series.xs(), line.series.xs());
         assert!(fa.iter().zip(fb).all(|(a, b)| (a - b).abs() <= 1e-12), "the frame moves alike");
         assert!(spatial.energy.balance_error.abs() <= 1e-12, "{:?}", spatial.energy);
+    }
+
+    /// Balls that wait before searching against the frame's walls, their waits kept across
+    /// the frame's segments, meet the walls where balls that search after every event and
+    /// every impact on the walls do: `planar-bed`'s first impacts, dozens of them on the end
+    /// walls, alike to round-off (the searches start at other instants, so roots differ in
+    /// their last bits, which the bed amplifies later).
+    #[test]
+    fn waiting_balls_meet_the_frames_walls_where_searching_ones_do() {
+        let mut scene = crate::scene::load(crate::scene::scenes_dir().join("planar-bed.toml")).unwrap().scene.unwrap();
+        scene.horizon = 0.1;
+        let waiting = simulate_with(&scene, &RunOptions::default(), true).unwrap();
+        let searching = simulate_with(&scene, &RunOptions::default(), false).unwrap();
+        let walls = |r: &Run| r.impacts.iter().filter(|i| matches!((i.a, i.b), (Body::LeftWall, _) | (_, Body::RightWall))).count();
+        let alike = waiting
+            .impacts
+            .iter()
+            .zip(&searching.impacts)
+            .take_while(|(a, b)| (a.a, a.b) == (b.a, b.b) && (a.t - b.t).abs() <= 1e-12)
+            .count();
+        let shared = Run { impacts: waiting.impacts[..alike].to_vec(), ..waiting.clone() };
+        assert!(alike >= 1000 && walls(&shared) >= 30, "{alike} impacts alike, {} on the end walls", walls(&shared));
     }
 }
