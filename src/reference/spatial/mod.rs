@@ -387,8 +387,10 @@ impl<'a> Solver<'a> {
         }
     }
 
-    fn push(&mut self, t: f64, ball: usize, kind: Kind, other: Option<usize>) {
-        if t <= self.horizon {
+    /// Enters an event at `t` in the calendar, unless it comes after `until` (the horizon, or
+    /// the instant its ball leaves its cell and is predicted again).
+    fn push(&mut self, t: f64, until: f64, ball: usize, kind: Kind, other: Option<usize>) {
+        if t <= until.min(self.horizon) {
             let stamps = (self.balls[ball].stamp, other.map_or(0, |j| self.balls[j].stamp));
             let version = if matches!(kind, Kind::Wait(_)) { self.reach_version } else { self.frame.segment };
             let entry = Entry { t, ball: ball as u32, kind, stamps, version };
@@ -411,24 +413,26 @@ impl<'a> Solver<'a> {
 
     /// Ball `i`'s next contact with the frame's wall on side `side`, the frame at `xs` now:
     /// searched from now when the ball may be near that wall, else a wait until it may be
-    /// (most balls are far from the walls, and most of those meet another body first).
-    fn predict_frame_wall(&mut self, i: usize, side: f64, xs: f64) {
+    /// (most balls are far from the walls, and most of those meet another body first); kept
+    /// if not after `until`.
+    fn predict_frame_wall(&mut self, i: usize, side: f64, xs: f64, until: f64) {
         let wait = match &self.frame_reach {
             Some(bound) => self.frame_gap(i, side).earliest_reach(self.t, xs, bound),
             None => Some(self.t),
         };
         match wait {
-            Some(t) if t <= self.t => self.search_frame_wall(i, side),
+            Some(t) if t <= self.t => self.search_frame_wall(i, side, until),
             Some(t) => {
                 self.searched[i][wall_index(side)] = false;
-                self.push(t, i, Kind::Wait(side as i8), None);
+                self.push(t, until, i, Kind::Wait(side as i8), None);
             }
             None => self.searched[i][wall_index(side)] = false,
         }
     }
 
-    /// Ball `i`'s next contact with the frame's wall on side `side`, searched from now.
-    fn search_frame_wall(&mut self, i: usize, side: f64) {
+    /// Ball `i`'s next contact with the frame's wall on side `side`, searched from now, kept
+    /// if not after `until`.
+    fn search_frame_wall(&mut self, i: usize, side: f64, until: f64) {
         let w = wall_index(side);
         if !self.searched[i][w] {
             self.searched[i][w] = true;
@@ -443,32 +447,17 @@ impl<'a> Solver<'a> {
         }
         let c = self.frame_gap(i, side).search(self.t, self.horizon);
         if c.t.is_finite() {
-            self.push(c.t, i, Kind::Frame(side as i8, c.exact), None);
+            self.push(c.t, until, i, Kind::Frame(side as i8, c.exact), None);
         }
     }
 
     /// Everything ball `i` (brought to now) meets next: walls, its cell's faces, other balls.
+    /// What comes after it leaves its cell is not kept: it is predicted again then.
     fn predict(&mut self, i: usize) {
         self.balls[i].stamp = self.balls[i].stamp.wrapping_add(1);
         let b = self.balls[i];
         let a = b.acceleration(self.gravity);
         let t = self.t;
-        for axis in 1..3 {
-            let half = self.cells.half[axis - 1];
-            for side in [1.0, -1.0] {
-                if b.rest == Some((axis, side)) {
-                    continue;
-                }
-                let g0 = half - side * b.p[axis] - b.radius;
-                if let Some(dt) = plane_time(g0, side, b.v[axis], a[axis]) {
-                    self.push(t + dt, i, Kind::Across(axis as u8, side as i8), None);
-                }
-            }
-        }
-        let (xs, _) = self.frame.state(t);
-        for side in [1.0, -1.0] {
-            self.predict_frame_wall(i, side, xs);
-        }
         let mut crossing: Option<(f64, usize, i64)> = None;
         for axis in 0..3 {
             for dir in [1i64, -1] {
@@ -484,22 +473,39 @@ impl<'a> Solver<'a> {
                 }
             }
         }
+        let until = crossing.map_or(self.horizon, |(dt, ..)| (t + dt).min(self.horizon));
+        for axis in 1..3 {
+            let half = self.cells.half[axis - 1];
+            for side in [1.0, -1.0] {
+                if b.rest == Some((axis, side)) {
+                    continue;
+                }
+                let g0 = half - side * b.p[axis] - b.radius;
+                if let Some(dt) = plane_time(g0, side, b.v[axis], a[axis]) {
+                    self.push(t + dt, until, i, Kind::Across(axis as u8, side as i8), None);
+                }
+            }
+        }
+        let (xs, _) = self.frame.state(t);
+        for side in [1.0, -1.0] {
+            self.predict_frame_wall(i, side, xs, until);
+        }
         if let Some((dt, axis, dir)) = crossing {
-            self.push(t + dt, i, Kind::Cell(axis as u8, dir as i8), None);
+            self.push(t + dt, until, i, Kind::Cell(axis as u8, dir as i8), None);
         }
         let mut others = std::mem::take(&mut self.neighbours);
         others.clear();
         self.cells.around(b.cell, |j| others.push(j as usize));
         for &j in &others {
             if j != i {
-                self.predict_pair(i, j, t);
+                self.predict_pair(i, j, t, until);
             }
         }
         self.neighbours = others;
     }
 
-    /// When balls `i` and `j` touch, searched from `from`.
-    fn predict_pair(&mut self, i: usize, j: usize, from: f64) {
+    /// When balls `i` and `j` touch, searched from `from`, kept if not after `until`.
+    fn predict_pair(&mut self, i: usize, j: usize, from: f64, until: f64) {
         let g = self.gravity;
         let (pi, vi) = self.balls[i].at(from, g);
         let (pj, vj) = self.balls[j].at(from, g);
@@ -510,7 +516,7 @@ impl<'a> Solver<'a> {
         let reach = self.balls[i].radius + self.balls[j].radius;
         let (lo, hi) = (i.min(j), i.max(j));
         if let Some(dt) = pair_time(dr, dv, da, reach, still(vi, vj), self.horizon - from) {
-            self.push(from + dt, lo, Kind::Pair(hi as u32), Some(hi));
+            self.push(from + dt, until, lo, Kind::Pair(hi as u32), Some(hi));
         }
     }
 
@@ -734,14 +740,14 @@ impl<'a> Solver<'a> {
             }
             Kind::Wait(side) => {
                 self.bring(i);
-                self.search_frame_wall(i, side as f64);
+                self.search_frame_wall(i, side as f64, self.horizon);
             }
             Kind::Frame(side, exact) => {
                 let side = side as f64;
                 if !exact {
                     // No contact before now: the search goes on from here.
                     self.bring(i);
-                    self.search_frame_wall(i, side);
+                    self.search_frame_wall(i, side, self.horizon);
                     return Ok(());
                 }
                 self.bring(i);
@@ -773,7 +779,7 @@ impl<'a> Solver<'a> {
                     // (from each ball's flight as it stands, so no ball is moved).
                     for (k, w) in searched_before {
                         if k != i {
-                            self.predict_frame_wall(k, if w == 0 { 1.0 } else { -1.0 }, xs);
+                            self.predict_frame_wall(k, if w == 0 { 1.0 } else { -1.0 }, xs, self.horizon);
                         }
                     }
                 } else {
