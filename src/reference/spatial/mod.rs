@@ -226,11 +226,12 @@ fn dot(a: [f64; 3], b: [f64; 3]) -> f64 {
 
 impl Ball {
     fn acceleration(&self, g: [f64; 3]) -> [f64; 3] {
-        let mut a = g;
-        if let Some((axis, _)) = self.rest {
-            a[axis] = 0.0;
+        // Written component by component rather than by storing into the wall's axis: the
+        // store, read back as a vector, stalled every prediction.
+        match self.rest {
+            Some((axis, _)) => std::array::from_fn(|k| if k == axis { 0.0 } else { g[k] }),
+            None => g,
         }
-        a
     }
 
     /// How the ball takes an impulse along `n`: the direction its velocity changes in (`n`, less
