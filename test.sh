@@ -20,8 +20,11 @@ cargo test --locked --features render
 # The Python package (python/, built by maturin with the locked dependencies) in a virtual
 # environment of its own, with what its tests use (pytest, dask[distributed], pandas,
 # pyarrow); its tests compare it with the release CLI.
-cargo build --locked --release --bin lpc
 venv=target/python-venv
 [ -x "$venv/bin/python" ] || python3 -m venv "$venv"
 MATURIN_PEP517_ARGS="--locked" "$venv/bin/python" -m pip install --quiet --disable-pip-version-check "./python[test]"
+# The release CLI, its dependencies resolved together with the binding's (which turns on a few
+# more features of the linear-algebra crates), so that it reuses the binding's release build
+# instead of building them again.
+cargo build --locked --release -p lpc-damper -p lpc-damper-python --bin lpc
 "$venv/bin/python" -m pytest -q python/tests
