@@ -1,7 +1,8 @@
 //! The reference beyond one line (docs/MODEL.md §14): smooth balls flying in closed form in the
 //! plane or in space under gravity inside the container the frame carries, their impacts by
-//! Eq. 9-10 along the contact normal, found by an event calendar (binary heaps whose stale
-//! entries are dropped when they surface) over cells as wide as a ball. Ball-ball and
+//! Eq. 9-10 along the contact normal, found by an event calendar (a list per ball under a
+//! tournament tree, and a heap for the frame's walls; stale entries are dropped when they
+//! surface) over cells as wide as a ball. Ball-ball and
 //! ball-floor times are roots of quadratics; a ball against the walls that move with the frame
 //! is found by the one-line reference's sound root isolation ([`FrameGap`]).
 //!
@@ -9,6 +10,7 @@
 //! duration of a ball's previous one is elastic (the TC model), and a ball whose bounce off a
 //! wall that gravity presses it against would return within the contact duration rests on it.
 
+mod calendar;
 mod cells;
 mod flight;
 
@@ -23,6 +25,7 @@ use crate::impact_law::{reduced_mass, separate};
 use crate::model::{Meter, Model, ModelError, OverBudget, RunOptions, STALL_EVENTS_PER_SIM_S};
 use crate::run::{EnergyAccount, Impact, Recorder, Run};
 use crate::scene::{Body, Scene};
+use calendar::Calendar;
 use cells::Cells;
 use flight::{pair_time, plane_time, still};
 
@@ -159,8 +162,8 @@ struct Solver<'a> {
     cells: Cells,
     /// Scratch: the balls of the cells around one ball (kept to spare an allocation an event).
     neighbours: Vec<usize>,
-    /// Every entry but the balls' contacts with the frame's walls.
-    calendar: BinaryHeap<Entry>,
+    /// Every entry but the balls' contacts with the frame's walls, each owned by its `ball`.
+    calendar: Calendar<Entry>,
     /// The balls' contacts with the frame's walls, apart: each impact on those walls changes
     /// the frame's motion, invalidates them all and predicts them all anew, so this calendar is
     /// emptied then rather than left to carry a stale entry per ball.
@@ -341,7 +344,7 @@ impl<'a> Solver<'a> {
             limits: Limits::new(scene),
             cells,
             neighbours: Vec::new(),
-            calendar: BinaryHeap::new(),
+            calendar: Calendar::new(scene.balls.len()),
             frame_calendar: BinaryHeap::new(),
             frame_reach,
             reach_version: 0,
@@ -398,7 +401,7 @@ impl<'a> Solver<'a> {
             if matches!(kind, Kind::Frame(..)) {
                 self.frame_calendar.push(entry);
             } else {
-                self.calendar.push(entry);
+                self.calendar.push(ball, entry);
             }
         }
     }
@@ -457,6 +460,8 @@ impl<'a> Solver<'a> {
     /// What comes after it leaves its cell is not kept: it is predicted again then.
     fn predict(&mut self, i: usize) {
         self.balls[i].stamp = self.balls[i].stamp.wrapping_add(1);
+        // Every entry the ball owns is stale from here on.
+        self.calendar.clear(i);
         let b = self.balls[i];
         let a = b.acceleration(self.gravity);
         let t = self.t;
@@ -578,8 +583,9 @@ impl<'a> Solver<'a> {
             }
             self.resolve(entry)?;
             if self.calendar.len() + self.frame_calendar.len() > 64 * self.balls.len() + 4096 {
-                let kept: Vec<Entry> = std::mem::take(&mut self.calendar).into_iter().filter(|e| self.valid(e)).collect();
-                self.calendar = kept.into();
+                let mut calendar = std::mem::replace(&mut self.calendar, Calendar::new(0));
+                calendar.retain(|e| self.valid(e));
+                self.calendar = calendar;
                 let kept: Vec<Entry> = std::mem::take(&mut self.frame_calendar).into_iter().filter(|e| self.valid(e)).collect();
                 self.frame_calendar = kept.into();
             }
