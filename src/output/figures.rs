@@ -94,7 +94,9 @@ fn write_both(
         let tmp = dir.join(format!(".{name}.tmp.{ext}"));
         let fail = |reason: String| FigureError { path: path.display().to_string(), reason };
         let drawn = if ext == "png" {
-            (png.take().expect("once"))(BitMapBackend::new(&tmp, size).into_drawing_area())
+            let mut rgb = vec![0u8; 3 * size.0 as usize * size.1 as usize];
+            let drawn = (png.take().expect("once"))(BitMapBackend::with_buffer(&mut rgb, size).into_drawing_area());
+            drawn.and_then(|()| encode_png(&tmp, size, &rgb))
         } else {
             (svg.take().expect("once"))(SVGBackend::new(&tmp, size).into_drawing_area())
         };
@@ -103,6 +105,17 @@ fn write_both(
         written.push(path);
     }
     Ok(written)
+}
+
+/// Writes 8-bit RGB pixels, row by row, as a PNG file of `size` (width, height).
+fn encode_png(path: &Path, size: (u32, u32), rgb: &[u8]) -> Result<(), String> {
+    let file = std::fs::File::create(path).map_err(|e| e.to_string())?;
+    let mut encoder = png::Encoder::new(std::io::BufWriter::new(file), size.0, size.1);
+    encoder.set_color(png::ColorType::Rgb);
+    encoder.set_depth(png::BitDepth::Eight);
+    let mut writer = encoder.write_header().map_err(|e| e.to_string())?;
+    writer.write_image_data(rgb).map_err(|e| e.to_string())?;
+    writer.finish().map_err(|e| e.to_string())
 }
 
 /// A design map: one metric over a grid of two parameters.
