@@ -254,9 +254,15 @@ impl Ball {
 
     /// Centre and velocity at `t`.
     fn at(&self, t: f64, g: [f64; 3]) -> ([f64; 3], [f64; 3]) {
+        let (p, v, _) = self.motion(t, g);
+        (p, v)
+    }
+
+    /// Position, velocity and acceleration at `t`.
+    fn motion(&self, t: f64, g: [f64; 3]) -> ([f64; 3], [f64; 3], [f64; 3]) {
         let a = self.acceleration(g);
         let dt = t - self.since;
-        (std::array::from_fn(|k| self.p[k] + self.v[k] * dt + 0.5 * a[k] * dt * dt), std::array::from_fn(|k| self.v[k] + a[k] * dt))
+        (std::array::from_fn(|k| self.p[k] + self.v[k] * dt + 0.5 * a[k] * dt * dt), std::array::from_fn(|k| self.v[k] + a[k] * dt), a)
     }
 }
 
@@ -502,20 +508,21 @@ impl<'a> Solver<'a> {
         let mut others = std::mem::take(&mut self.neighbours);
         others.clear();
         self.cells.around(b.cell, |j| others.push(j as usize));
+        // Ball `i`'s motion now, evaluated once for all its neighbours.
+        let motion = b.motion(t, self.gravity);
         for &j in &others {
             if j != i {
-                self.predict_pair(i, j, t, until);
+                self.predict_pair(i, motion, j, t, until);
             }
         }
         self.neighbours = others;
     }
 
-    /// When balls `i` and `j` touch, searched from `from`, kept if not after `until`.
-    fn predict_pair(&mut self, i: usize, j: usize, from: f64, until: f64) {
-        let g = self.gravity;
-        let (pi, vi) = self.balls[i].at(from, g);
-        let (pj, vj) = self.balls[j].at(from, g);
-        let (ai, aj) = (self.balls[i].acceleration(g), self.balls[j].acceleration(g));
+    /// When ball `i`, in `motion` (position, velocity, acceleration) at `from`, and ball `j`
+    /// touch, searched from `from`, kept if not after `until`.
+    fn predict_pair(&mut self, i: usize, motion: ([f64; 3], [f64; 3], [f64; 3]), j: usize, from: f64, until: f64) {
+        let (pi, vi, ai) = motion;
+        let (pj, vj, aj) = self.balls[j].motion(from, self.gravity);
         let dr = std::array::from_fn(|k| pj[k] - pi[k]);
         let dv = std::array::from_fn(|k| vj[k] - vi[k]);
         let da = std::array::from_fn(|k| aj[k] - ai[k]);
