@@ -469,8 +469,10 @@ impl<'a> Solver<'a> {
         // Every entry the ball owns is stale from here on.
         self.calendar.clear(i);
         let b = self.balls[i];
-        let a = b.acceleration(self.gravity);
         let t = self.t;
+        // Ball `i`'s motion now, evaluated once for its walls, its cell and all its neighbours.
+        let motion = b.motion(t, self.gravity);
+        let a = motion.2;
         let mut crossing: Option<(f64, usize, i64)> = None;
         for axis in 0..3 {
             for dir in [1i64, -1] {
@@ -508,8 +510,6 @@ impl<'a> Solver<'a> {
         let mut others = std::mem::take(&mut self.neighbours);
         others.clear();
         self.cells.around(b.cell, |j| others.push(j as usize));
-        // Ball `i`'s motion now, evaluated once for all its neighbours.
-        let motion = b.motion(t, self.gravity);
         for &j in &others {
             if j != i {
                 self.predict_pair(i, motion, j, t, until);
