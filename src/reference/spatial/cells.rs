@@ -5,7 +5,12 @@
 //! bound and folded onto a few more columns than the container spans, so the frame may carry
 //! the balls anywhere.
 
-/// The balls in each cell.
+/// No ball: the end of a cell's list.
+const NONE: u32 = u32::MAX;
+
+/// The balls in each cell, a list threaded through the balls: a cell holds its first ball and
+/// each ball the next and the previous one in its cell, so that the cells around a ball are
+/// read from two small arrays rather than from a buffer of their own each.
 pub(super) struct Cells {
     /// Width of a cell, m.
     pub(super) size: f64,
@@ -15,7 +20,12 @@ pub(super) struct Cells {
     across: [i64; 2],
     /// The container's half width and half height: cells across start at `-half`.
     pub(super) half: [f64; 2],
-    members: Vec<Vec<u32>>,
+    /// Each cell's first ball, or `NONE`.
+    first: Vec<u32>,
+    /// Each ball's next ball in its cell, or `NONE`.
+    next: Vec<u32>,
+    /// Each ball's previous ball in its cell, or `NONE` for the first.
+    previous: Vec<u32>,
 }
 
 impl Cells {
@@ -34,7 +44,15 @@ impl Cells {
         let nx = (length / size).ceil() as i64 + 3;
         let across = [((section[0] / size).ceil() as i64).max(1), ((section[1] / size).ceil() as i64).max(1)];
         let count = (nx * across[0] * across[1]) as usize;
-        Cells { size, nx, across, half: [0.5 * section[0], 0.5 * section[1]], members: vec![Vec::new(); count] }
+        Cells {
+            size,
+            nx,
+            across,
+            half: [0.5 * section[0], 0.5 * section[1]],
+            first: vec![NONE; count],
+            next: vec![NONE; balls],
+            previous: vec![NONE; balls],
+        }
     }
 
     /// The cell of a ball at `p`: its world column along x and its cells across.
@@ -49,16 +67,31 @@ impl Cells {
         ((c[0].rem_euclid(self.nx) * self.across[0] + c[1]) * self.across[1] + c[2]) as usize
     }
 
+    /// Puts `ball` first in cell `c`.
     pub(super) fn insert(&mut self, c: [i64; 3], ball: u32) {
         let k = self.index(c);
-        self.members[k].push(ball);
+        let b = ball as usize;
+        let head = self.first[k];
+        self.next[b] = head;
+        self.previous[b] = NONE;
+        if head != NONE {
+            self.previous[head as usize] = ball;
+        }
+        self.first[k] = ball;
     }
 
+    /// Takes `ball` out of cell `c`, which holds it.
     pub(super) fn remove(&mut self, c: [i64; 3], ball: u32) {
-        let k = self.index(c);
-        let list = &mut self.members[k];
-        if let Some(at) = list.iter().position(|&b| b == ball) {
-            list.swap_remove(at);
+        let b = ball as usize;
+        let (previous, next) = (self.previous[b], self.next[b]);
+        if previous == NONE {
+            let k = self.index(c);
+            self.first[k] = next;
+        } else {
+            self.next[previous as usize] = next;
+        }
+        if next != NONE {
+            self.previous[next as usize] = previous;
         }
     }
 
@@ -76,16 +109,24 @@ impl Cells {
 
     /// Calls `f` with every ball in the 27 cells around `c` (each once: there are at
     /// least three columns, so three neighbouring ones never fold onto one another).
-    pub(super) fn around(&self, c: [i64; 3], mut f: impl FnMut(u32)) {
-        let ys = (c[1] - 1).max(0)..=(c[1] + 1).min(self.across[0] - 1);
-        let zs = (c[2] - 1).max(0)..=(c[2] + 1).min(self.across[1] - 1);
-        for dx in -1..=1 {
-            let column = (c[0] + dx).rem_euclid(self.nx) * self.across[0];
-            for y in ys.clone() {
+    pub(super) fn around(&self, c: [i64; 3], f: impl FnMut(u32)) {
+        let lo = [c[0] - 1, (c[1] - 1).max(0), (c[2] - 1).max(0)];
+        let hi = [c[0] + 1, (c[1] + 1).min(self.across[0] - 1), (c[2] + 1).min(self.across[1] - 1)];
+        self.in_block(lo, hi, f);
+    }
+
+    /// Calls `f` with every ball in the cells from `lo` to `hi` (both included).
+    fn in_block(&self, lo: [i64; 3], hi: [i64; 3], mut f: impl FnMut(u32)) {
+        // Ranges without an inclusive end, which compile to plainer loops.
+        for x in lo[0]..hi[0] + 1 {
+            let column = x.rem_euclid(self.nx) * self.across[0];
+            for y in lo[1]..hi[1] + 1 {
                 let row = (column + y) * self.across[1];
-                for z in zs.clone() {
-                    for &b in &self.members[(row + z) as usize] {
+                for z in lo[2]..hi[2] + 1 {
+                    let mut b = self.first[(row + z) as usize];
+                    while b != NONE {
                         f(b);
+                        b = self.next[b as usize];
                     }
                 }
             }
