@@ -4,25 +4,42 @@
 //! then stale), so stale entries no longer wait in one large heap until they surface, and the
 //! tree a pop walks is as deep as the balls are many, not their entries.
 
+/// An entry's time as an integer in the same order: of two entries of different owners, the
+/// one with the smaller key is the earlier, and at equal keys the lower owner's.
+pub(super) trait Timed {
+    fn key(&self) -> u64;
+}
+
 /// Entries of type `T` (greater is earlier, as in a max-heap), each owned by a ball.
 pub(super) struct Calendar<T> {
     lists: Vec<Vec<T>>,
     /// Each ball's earliest entry, and its place in the ball's list.
     heads: Vec<Option<(T, u32)>>,
-    /// Node `k` holds the ball whose head is earliest below it; the leaves start at `leaves`.
+    /// Each leaf's head's key, `NO_HEAD` for a ball without entries (and past the balls): the
+    /// tree compares these, a few to a cache line, rather than the entries.
+    keys: Vec<u64>,
+    /// Node `k` holds the leaf whose head is earliest below it (at equal keys the lower one);
+    /// the leaves start at `leaves`.
     tree: Vec<u32>,
     leaves: usize,
     len: usize,
 }
 
-/// No ball (an empty subtree).
-const NONE: u32 = u32::MAX;
+/// The key of a ball without entries: later than any entry's.
+const NO_HEAD: u64 = u64::MAX;
 
-impl<T: Ord + Copy> Calendar<T> {
+impl<T: Ord + Copy + Timed> Calendar<T> {
     /// An empty calendar for `balls` balls.
     pub(super) fn new(balls: usize) -> Self {
         let leaves = balls.max(1).next_power_of_two();
-        Calendar { lists: vec![Vec::new(); balls], heads: vec![None; balls], tree: vec![NONE; 2 * leaves], leaves, len: 0 }
+        let mut tree = vec![0; 2 * leaves];
+        for k in 0..leaves {
+            tree[leaves + k] = k as u32;
+        }
+        for node in (1..leaves).rev() {
+            tree[node] = tree[2 * node];
+        }
+        Calendar { lists: vec![Vec::new(); balls], heads: vec![None; balls], keys: vec![NO_HEAD; leaves], tree, leaves, len: 0 }
     }
 
     /// Entries held, stale ones included.
@@ -43,18 +60,14 @@ impl<T: Ord + Copy> Calendar<T> {
 
     /// The earliest entry.
     pub(super) fn peek(&self) -> Option<&T> {
-        let ball = self.tree[1];
-        (ball != NONE).then(|| &self.heads[ball as usize].as_ref().expect("a ball in the tree has a head").0)
+        let ball = self.tree[1] as usize;
+        self.heads.get(ball).and_then(|h| h.as_ref()).map(|(entry, _)| entry)
     }
 
     /// Takes the earliest entry out.
     pub(super) fn pop(&mut self) -> Option<T> {
-        let ball = self.tree[1];
-        if ball == NONE {
-            return None;
-        }
-        let owner = ball as usize;
-        let (_, at) = self.heads[owner].expect("a ball in the tree has a head");
+        let owner = self.tree[1] as usize;
+        let (_, at) = *self.heads.get(owner)?.as_ref()?;
         let entry = self.lists[owner].swap_remove(at as usize);
         self.len -= 1;
         self.find_head(owner);
@@ -94,23 +107,13 @@ impl<T: Ord + Copy> Calendar<T> {
 
     /// Walks from ball `owner`'s leaf to the root, each node taking its earlier child.
     fn update(&mut self, owner: usize) {
+        self.keys[owner] = self.heads[owner].map_or(NO_HEAD, |(head, _)| head.key());
         let mut node = self.leaves + owner;
-        self.tree[node] = if self.heads[owner].is_some() { owner as u32 } else { NONE };
         while node > 1 {
             node /= 2;
             let (a, b) = (self.tree[2 * node], self.tree[2 * node + 1]);
-            let earlier = match (a, b) {
-                (NONE, _) => b,
-                (_, NONE) => a,
-                _ => {
-                    let (ha, hb) = (self.heads[a as usize].map(|h| h.0), self.heads[b as usize].map(|h| h.0));
-                    if hb > ha {
-                        b
-                    } else {
-                        a
-                    }
-                }
-            };
+            // The left child's leaves are the lower ones: it wins a tie.
+            let earlier = if self.keys[b as usize] < self.keys[a as usize] { b } else { a };
             if self.tree[node] == earlier && earlier != owner as u32 {
                 // Nothing above changes: this node kept its winner, and it is not the ball
                 // whose head moved.
@@ -126,6 +129,12 @@ mod tests {
     use super::*;
     use std::cmp::Reverse;
     use std::collections::BinaryHeap;
+
+    impl Timed for Reverse<(u64, usize, u64)> {
+        fn key(&self) -> u64 {
+            self.0 .0
+        }
+    }
 
     /// The calendar gives its entries in the order a binary heap gives them, through pushes,
     /// pops and clears of a ball's entries, on 20 000 random operations.
