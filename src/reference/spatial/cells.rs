@@ -132,4 +132,18 @@ impl Cells {
             }
         }
     }
+
+    /// Calls `f` with every ball in the nine cells next to `c` across its face along `axis`
+    /// on side `dir`: the cells a ball that has just crossed into `c` that way neighbours
+    /// now and did not before (none past the container's walls across).
+    pub(super) fn slab(&self, c: [i64; 3], axis: usize, dir: i64, f: impl FnMut(u32)) {
+        if !self.has_neighbour(c, axis, dir) {
+            return;
+        }
+        let mut lo = [c[0] - 1, (c[1] - 1).max(0), (c[2] - 1).max(0)];
+        let mut hi = [c[0] + 1, (c[1] + 1).min(self.across[0] - 1), (c[2] + 1).min(self.across[1] - 1)];
+        lo[axis] = c[axis] + dir;
+        hi[axis] = c[axis] + dir;
+        self.in_block(lo, hi, f);
+    }
 }

@@ -405,10 +405,9 @@ impl<'a> Solver<'a> {
         }
     }
 
-    /// Enters an event at `t` in the calendar, unless it comes after `until` (the horizon, or
-    /// the instant its ball leaves its cell and is predicted again).
-    fn push(&mut self, t: f64, until: f64, ball: usize, kind: Kind, other: Option<usize>) {
-        if t <= until.min(self.horizon) {
+    /// Enters an event at `t` in the calendar, unless it comes after the horizon.
+    fn push(&mut self, t: f64, ball: usize, kind: Kind, other: Option<usize>) {
+        if t <= self.horizon {
             let stamps = (self.balls[ball].stamp, other.map_or(0, |j| self.balls[j].stamp));
             let version = if matches!(kind, Kind::Wait(_)) { self.reach_version } else { self.frame.segment };
             let entry = Entry { t, ball: ball as u32, kind, stamps, version };
@@ -431,8 +430,8 @@ impl<'a> Solver<'a> {
 
     /// Ball `i`'s next contact with the frame's wall on side `side`: searched from now when
     /// the ball may be near that wall, else a wait until it may be (most balls are far from
-    /// the walls, and most of those meet another body first); kept if not after `until`.
-    fn predict_frame_wall(&mut self, i: usize, side: f64, until: f64) {
+    /// the walls, and most of those meet another body first).
+    fn predict_frame_wall(&mut self, i: usize, side: f64) {
         let wait = match &self.frame_reach {
             // The frame's state now is kept by `FrameMotion::state`: one evaluation serves
             // both walls and every ball predicted at this instant.
@@ -440,18 +439,17 @@ impl<'a> Solver<'a> {
             None => Some(self.t),
         };
         match wait {
-            Some(t) if t <= self.t => self.search_frame_wall(i, side, until),
+            Some(t) if t <= self.t => self.search_frame_wall(i, side),
             Some(t) => {
                 self.searched[i][wall_index(side)] = false;
-                self.push(t, until, i, Kind::Wait(side as i8), None);
+                self.push(t, i, Kind::Wait(side as i8), None);
             }
             None => self.searched[i][wall_index(side)] = false,
         }
     }
 
-    /// Ball `i`'s next contact with the frame's wall on side `side`, searched from now, kept
-    /// if not after `until`.
-    fn search_frame_wall(&mut self, i: usize, side: f64, until: f64) {
+    /// Ball `i`'s next contact with the frame's wall on side `side`, searched from now.
+    fn search_frame_wall(&mut self, i: usize, side: f64) {
         let w = wall_index(side);
         if !self.searched[i][w] {
             self.searched[i][w] = true;
@@ -466,13 +464,17 @@ impl<'a> Solver<'a> {
         }
         let c = self.frame_gap(i, side).search(self.t, self.horizon);
         if c.t.is_finite() {
-            self.push(c.t, until, i, Kind::Frame(side as i8, c.exact), None);
+            self.push(c.t, i, Kind::Frame(side as i8, c.exact), None);
         }
     }
 
-    /// Everything ball `i` (brought to now) meets next: walls, its cell's faces, other balls.
-    /// What comes after it leaves its cell is not kept: it is predicted again then.
-    fn predict(&mut self, i: usize) {
+    /// Everything ball `i` (brought to now) meets next: walls, its cell's faces, the balls of
+    /// the cells around it. With `check`, after an impact of the ball, first the postcondition:
+    /// it overlaps no wall and none of those balls (the cells are read once for both).
+    fn predict(&mut self, i: usize, check: bool) -> Result<(), ModelError> {
+        if check {
+            self.check_walls(i)?;
+        }
         self.balls[i].stamp = self.balls[i].stamp.wrapping_add(1);
         // Every entry the ball owns is stale from here on.
         self.calendar.clear(i);
@@ -481,6 +483,50 @@ impl<'a> Solver<'a> {
         // Ball `i`'s motion now, evaluated once for its walls, its cell and all its neighbours.
         let motion = b.motion(t, self.gravity);
         let a = motion.2;
+        for axis in 1..3 {
+            let half = self.cells.half[axis - 1];
+            for side in [1.0, -1.0] {
+                if b.rest == Some((axis, side)) {
+                    continue;
+                }
+                let g0 = half - side * b.p[axis] - b.radius;
+                if let Some(dt) = plane_time(g0, side, b.v[axis], a[axis]) {
+                    self.push(t + dt, i, Kind::Across(axis as u8, side as i8), None);
+                }
+            }
+        }
+        for side in [1.0, -1.0] {
+            self.predict_frame_wall(i, side);
+        }
+        self.predict_crossing(i, a);
+        let mut others = std::mem::take(&mut self.neighbours);
+        others.clear();
+        self.cells.around(b.cell, |j| others.push(j as usize));
+        let checked = if check { self.check_neighbours(i, &others) } else { Ok(()) };
+        if checked.is_ok() {
+            self.predict_pairs(i, motion, &others);
+        }
+        self.neighbours = others;
+        checked
+    }
+
+    /// Ball `i` (brought to now) has crossed into its cell along `axis` on side `dir`: its
+    /// flight goes on, so its entries stand; it meets in addition the balls of the slab of
+    /// nine cells it neighbours now and did not before, and it crosses again.
+    fn predict_slab(&mut self, i: usize, axis: usize, dir: i64) {
+        let b = self.balls[i];
+        let motion = b.motion(self.t, self.gravity);
+        self.predict_crossing(i, motion.2);
+        let mut others = std::mem::take(&mut self.neighbours);
+        others.clear();
+        self.cells.slab(b.cell, axis, dir, |j| others.push(j as usize));
+        self.predict_pairs(i, motion, &others);
+        self.neighbours = others;
+    }
+
+    /// When ball `i` (brought to now), accelerated by `a`, next leaves its cell.
+    fn predict_crossing(&mut self, i: usize, a: [f64; 3]) {
+        let b = self.balls[i];
         let mut crossing: Option<(f64, usize, i64)> = None;
         for axis in 0..3 {
             for dir in [1i64, -1] {
@@ -496,39 +542,23 @@ impl<'a> Solver<'a> {
                 }
             }
         }
-        let until = crossing.map_or(self.horizon, |(dt, ..)| (t + dt).min(self.horizon));
-        for axis in 1..3 {
-            let half = self.cells.half[axis - 1];
-            for side in [1.0, -1.0] {
-                if b.rest == Some((axis, side)) {
-                    continue;
-                }
-                let g0 = half - side * b.p[axis] - b.radius;
-                if let Some(dt) = plane_time(g0, side, b.v[axis], a[axis]) {
-                    self.push(t + dt, until, i, Kind::Across(axis as u8, side as i8), None);
-                }
-            }
-        }
-        for side in [1.0, -1.0] {
-            self.predict_frame_wall(i, side, until);
-        }
         if let Some((dt, axis, dir)) = crossing {
-            self.push(t + dt, until, i, Kind::Cell(axis as u8, dir as i8), None);
+            self.push(self.t + dt, i, Kind::Cell(axis as u8, dir as i8), None);
         }
-        let mut others = std::mem::take(&mut self.neighbours);
-        others.clear();
-        self.cells.around(b.cell, |j| others.push(j as usize));
-        for &j in &others {
+    }
+
+    /// Ball `i`, in `motion` now, against each of `others` but itself.
+    fn predict_pairs(&mut self, i: usize, motion: ([f64; 3], [f64; 3], [f64; 3]), others: &[usize]) {
+        for &j in others {
             if j != i {
-                self.predict_pair(i, motion, j, t, until);
+                self.predict_pair(i, motion, j, self.t);
             }
         }
-        self.neighbours = others;
     }
 
     /// When ball `i`, in `motion` (position, velocity, acceleration) at `from`, and ball `j`
-    /// touch, searched from `from`, kept if not after `until`.
-    fn predict_pair(&mut self, i: usize, motion: ([f64; 3], [f64; 3], [f64; 3]), j: usize, from: f64, until: f64) {
+    /// touch, searched from `from`.
+    fn predict_pair(&mut self, i: usize, motion: ([f64; 3], [f64; 3], [f64; 3]), j: usize, from: f64) {
         let (pi, vi, ai) = motion;
         let (pj, vj, aj) = self.balls[j].motion(from, self.gravity);
         let dr = std::array::from_fn(|k| pj[k] - pi[k]);
@@ -537,7 +567,7 @@ impl<'a> Solver<'a> {
         let reach = self.balls[i].radius + self.balls[j].radius;
         let (lo, hi) = (i.min(j), i.max(j));
         if let Some(dt) = pair_time(dr, dv, da, reach, still(vi, vj), self.horizon - from) {
-            self.push(from + dt, until, lo, Kind::Pair(hi as u32), Some(hi));
+            self.push(from + dt, lo, Kind::Pair(hi as u32), Some(hi));
         }
     }
 
@@ -556,7 +586,7 @@ impl<'a> Solver<'a> {
 
     fn run(&mut self, meter: &Meter, recorder: &mut Recorder) -> Result<Option<crate::model::Budget>, ModelError> {
         for i in 0..self.balls.len() {
-            self.predict(i);
+            self.predict(i, false)?;
         }
         let sample_count = self.scene.sample_count();
         let mut next_sample = 0;
@@ -612,7 +642,13 @@ impl<'a> Solver<'a> {
         }
         for i in 0..self.balls.len() {
             self.bring(i);
-            self.check_ball(i, None)?;
+            self.check_walls(i)?;
+            let mut near = std::mem::take(&mut self.neighbours);
+            near.clear();
+            self.cells.around(self.balls[i].cell, |o| near.push(o as usize));
+            let checked = self.check_neighbours(i, &near);
+            self.neighbours = near;
+            checked?;
         }
         Ok(None)
     }
@@ -691,7 +727,7 @@ impl<'a> Solver<'a> {
                 let new = b.cell;
                 self.cells.remove(old, i as u32);
                 self.cells.insert(new, i as u32);
-                self.predict(i);
+                self.predict_slab(i, axis as usize, dir as i64);
             }
             Kind::Pair(j) => {
                 let j = j as usize;
@@ -714,6 +750,7 @@ impl<'a> Solver<'a> {
                 let touching = gap <= self.pair_tolerance(i, j, ui - uj);
                 // Two balls each pushed square into its wall cannot move along `n`.
                 let movable = mi.is_finite() || mj.is_finite();
+                let mut struck = false;
                 if let Some(after) = separation(approach, pressing, self.restitution(i, Some(j))).filter(|_| touching && movable) {
                     let (wi, wj) = separate(mi, ui, mj, uj, after);
                     let impulse = if mj.is_finite() { mj * (wj - uj) } else { mi * (ui - wi) };
@@ -726,10 +763,10 @@ impl<'a> Solver<'a> {
                     self.record(Body::Ball(i), Body::Ball(j), (ui - uj).max(0.0), lost + rest_loss);
                     self.balls[i].last_impact = self.t;
                     self.balls[j].last_impact = self.t;
-                    self.check_ball(i, Some(j))?;
+                    struck = true;
                 }
-                self.predict(i);
-                self.predict(j);
+                self.predict(i, struck)?;
+                self.predict(j, struck)?;
             }
             Kind::Across(axis, side) => {
                 self.bring(i);
@@ -737,6 +774,7 @@ impl<'a> Solver<'a> {
                 let b = self.balls[i];
                 let approach = side * b.v[axis];
                 let pressed = side * self.gravity[axis];
+                let mut struck = false;
                 if approach > 0.0 || (approach == 0.0 && pressed > 0.0) {
                     let e = self.restitution(i, None);
                     let after = e * approach;
@@ -756,20 +794,20 @@ impl<'a> Solver<'a> {
                     };
                     self.record(Body::Ball(i), Body::SideWall, approach, lost);
                     self.balls[i].last_impact = self.t;
-                    self.check_ball(i, None)?;
+                    struck = true;
                 }
-                self.predict(i);
+                self.predict(i, struck)?;
             }
             Kind::Wait(side) => {
                 self.bring(i);
-                self.search_frame_wall(i, side as f64, self.horizon);
+                self.search_frame_wall(i, side as f64);
             }
             Kind::Frame(side, exact) => {
                 let side = side as f64;
                 if !exact {
                     // No contact before now: the search goes on from here.
                     self.bring(i);
-                    self.search_frame_wall(i, side, self.horizon);
+                    self.search_frame_wall(i, side);
                     return Ok(());
                 }
                 self.bring(i);
@@ -795,17 +833,16 @@ impl<'a> Solver<'a> {
                     let (a, bb) = if side > 0.0 { (Body::LeftWall, Body::Ball(i)) } else { (Body::Ball(i), Body::RightWall) };
                     self.record(a, bb, approach.max(0.0), lost);
                     self.limits.fastest = self.limits.fastest.max(approach);
-                    self.check_ball(i, None)?;
-                    self.predict(i);
+                    self.predict(i, true)?;
                     // The walls move otherwise from now: the searches against them start again
                     // (from each ball's flight as it stands, so no ball is moved).
                     for (k, w) in searched_before {
                         if k != i {
-                            self.predict_frame_wall(k, if w == 0 { 1.0 } else { -1.0 }, self.horizon);
+                            self.predict_frame_wall(k, if w == 0 { 1.0 } else { -1.0 });
                         }
                     }
                 } else {
-                    self.predict(i);
+                    self.predict(i, false)?;
                 }
             }
         }
@@ -849,56 +886,57 @@ impl<'a> Solver<'a> {
         self.limits.tol + a.drift + b.drift + 8.0 * eps * size + 2.0 * eps * self.t.abs() * rate.abs().max(self.limits.fastest)
     }
 
-    /// The postcondition at an impact of ball `i` (with `j`): neither overlaps a wall or a ball
-    /// near it beyond the contact tolerance (docs/MODEL.md §14).
-    fn check_ball(&mut self, i: usize, j: Option<usize>) -> Result<(), ModelError> {
+    /// The postcondition for ball `k` (brought to now) against the walls: it overlaps none
+    /// beyond the contact tolerance (docs/MODEL.md §14).
+    fn check_walls(&self, k: usize) -> Result<(), ModelError> {
         let (xs, _) = self.frame.state(self.t);
-        let mut near = std::mem::take(&mut self.neighbours);
-        for k in std::iter::once(i).chain(j) {
-            let b = self.balls[k];
-            let tol = self.pair_tolerance(k, k, 0.0) + self.frame.position_roundoff(self.t);
-            let walls = [
-                ("left-wall", b.p[0] - b.radius - xs),
-                ("right-wall", xs + self.length - b.p[0] - b.radius),
-                ("front wall", b.p[1] + self.cells.half[0] - b.radius),
-                ("back wall", self.cells.half[0] - b.p[1] - b.radius),
-                ("floor", b.p[2] + self.cells.half[1] - b.radius),
-                ("ceiling", self.cells.half[1] - b.p[2] - b.radius),
-            ];
-            for (name, gap) in walls {
-                if gap < -tol {
-                    return Err(self.broken(format!(
-                        "its contact invariant at t = {} s: ball{} overlaps the {name} by {:.3e} m (tolerance {:.3e} m)",
-                        crate::scene::human(self.t),
-                        k + 1,
-                        -gap,
-                        tol
-                    )));
-                }
-            }
-            near.clear();
-            self.cells.around(b.cell, |o| near.push(o as usize));
-            for &o in &near {
-                if o == k {
-                    continue;
-                }
-                let (po, _) = self.balls[o].at(self.t, self.gravity);
-                let d: [f64; 3] = std::array::from_fn(|c| po[c] - b.p[c]);
-                let gap = dot(d, d).sqrt() - b.radius - self.balls[o].radius;
-                let tol = self.pair_tolerance(k, o, 0.0);
-                if gap < -tol {
-                    return Err(self.broken(format!(
-                        "its contact invariant at t = {} s: ball{} / ball{} overlap by {:.3e} m (tolerance {:.3e} m)",
-                        crate::scene::human(self.t),
-                        k + 1,
-                        o + 1,
-                        -gap,
-                        tol
-                    )));
-                }
+        let b = self.balls[k];
+        let tol = self.pair_tolerance(k, k, 0.0) + self.frame.position_roundoff(self.t);
+        let walls = [
+            ("left-wall", b.p[0] - b.radius - xs),
+            ("right-wall", xs + self.length - b.p[0] - b.radius),
+            ("front wall", b.p[1] + self.cells.half[0] - b.radius),
+            ("back wall", self.cells.half[0] - b.p[1] - b.radius),
+            ("floor", b.p[2] + self.cells.half[1] - b.radius),
+            ("ceiling", self.cells.half[1] - b.p[2] - b.radius),
+        ];
+        for (name, gap) in walls {
+            if gap < -tol {
+                return Err(self.broken(format!(
+                    "its contact invariant at t = {} s: ball{} overlaps the {name} by {:.3e} m (tolerance {:.3e} m)",
+                    crate::scene::human(self.t),
+                    k + 1,
+                    -gap,
+                    tol
+                )));
             }
         }
-        self.neighbours = near;
+        Ok(())
+    }
+
+    /// The postcondition for ball `k` (brought to now) against the balls `near` (the cells
+    /// around it): it overlaps none beyond the contact tolerance.
+    fn check_neighbours(&self, k: usize, near: &[usize]) -> Result<(), ModelError> {
+        let b = self.balls[k];
+        for &o in near {
+            if o == k {
+                continue;
+            }
+            let (po, _) = self.balls[o].at(self.t, self.gravity);
+            let d: [f64; 3] = std::array::from_fn(|c| po[c] - b.p[c]);
+            let gap = dot(d, d).sqrt() - b.radius - self.balls[o].radius;
+            let tol = self.pair_tolerance(k, o, 0.0);
+            if gap < -tol {
+                return Err(self.broken(format!(
+                    "its contact invariant at t = {} s: ball{} / ball{} overlap by {:.3e} m (tolerance {:.3e} m)",
+                    crate::scene::human(self.t),
+                    k + 1,
+                    o + 1,
+                    -gap,
+                    tol
+                )));
+            }
+        }
         Ok(())
     }
 
