@@ -502,12 +502,9 @@ impl<'a> Solver<'a> {
         let mut others = std::mem::take(&mut self.neighbours);
         others.clear();
         self.cells.around(b.cell, |j| others.push(j as usize));
-        let checked = if check { self.check_neighbours(i, &others) } else { Ok(()) };
-        if checked.is_ok() {
-            self.predict_pairs(i, motion, &others);
-        }
+        let predicted = self.predict_pairs(i, motion, &others, check);
         self.neighbours = others;
-        checked
+        predicted
     }
 
     /// Ball `i` (brought to now) has crossed into its cell along `axis` on side `dir`: its
@@ -520,7 +517,7 @@ impl<'a> Solver<'a> {
         let mut others = std::mem::take(&mut self.neighbours);
         others.clear();
         self.cells.slab(b.cell, axis, dir, |j| others.push(j as usize));
-        self.predict_pairs(i, motion, &others);
+        self.predict_pairs(i, motion, &others, false).expect("a prediction without a check cannot fail");
         self.neighbours = others;
     }
 
@@ -547,28 +544,30 @@ impl<'a> Solver<'a> {
         }
     }
 
-    /// Ball `i`, in `motion` now, against each of `others` but itself.
-    fn predict_pairs(&mut self, i: usize, motion: ([f64; 3], [f64; 3], [f64; 3]), others: &[usize]) {
+    /// When ball `i`, in `motion` (position, velocity, acceleration) now, and each of `others`
+    /// but itself touch. With `check`, first the postcondition for each pair (from the same
+    /// positions): they overlap by no more than the contact tolerance.
+    fn predict_pairs(&mut self, i: usize, motion: ([f64; 3], [f64; 3], [f64; 3]), others: &[usize], check: bool) -> Result<(), ModelError> {
+        let (pi, vi, ai) = motion;
+        let from = self.t;
         for &j in others {
-            if j != i {
-                self.predict_pair(i, motion, j, self.t);
+            if j == i {
+                continue;
+            }
+            let (pj, vj, aj) = self.balls[j].motion(from, self.gravity);
+            let dr = std::array::from_fn(|k| pj[k] - pi[k]);
+            if check {
+                self.check_pair(i, j, dr)?;
+            }
+            let dv = std::array::from_fn(|k| vj[k] - vi[k]);
+            let da = std::array::from_fn(|k| aj[k] - ai[k]);
+            let reach = self.balls[i].radius + self.balls[j].radius;
+            let (lo, hi) = (i.min(j), i.max(j));
+            if let Some(dt) = pair_time(dr, dv, da, reach, still(vi, vj), self.horizon - from) {
+                self.push(from + dt, lo, Kind::Pair(hi as u32), Some(hi));
             }
         }
-    }
-
-    /// When ball `i`, in `motion` (position, velocity, acceleration) at `from`, and ball `j`
-    /// touch, searched from `from`.
-    fn predict_pair(&mut self, i: usize, motion: ([f64; 3], [f64; 3], [f64; 3]), j: usize, from: f64) {
-        let (pi, vi, ai) = motion;
-        let (pj, vj, aj) = self.balls[j].motion(from, self.gravity);
-        let dr = std::array::from_fn(|k| pj[k] - pi[k]);
-        let dv = std::array::from_fn(|k| vj[k] - vi[k]);
-        let da = std::array::from_fn(|k| aj[k] - ai[k]);
-        let reach = self.balls[i].radius + self.balls[j].radius;
-        let (lo, hi) = (i.min(j), i.max(j));
-        if let Some(dt) = pair_time(dr, dv, da, reach, still(vi, vj), self.horizon - from) {
-            self.push(from + dt, lo, Kind::Pair(hi as u32), Some(hi));
-        }
+        Ok(())
     }
 
     fn valid(&self, e: &Entry) -> bool {
@@ -915,27 +914,43 @@ impl<'a> Solver<'a> {
     }
 
     /// The postcondition for ball `k` (brought to now) against the balls `near` (the cells
-    /// around it): it overlaps none beyond the contact tolerance.
+    /// around it).
     fn check_neighbours(&self, k: usize, near: &[usize]) -> Result<(), ModelError> {
-        let b = self.balls[k];
+        let p = self.balls[k].p;
         for &o in near {
-            if o == k {
-                continue;
+            if o != k {
+                let (po, _) = self.balls[o].at(self.t, self.gravity);
+                self.check_pair(k, o, std::array::from_fn(|c| po[c] - p[c]))?;
             }
-            let (po, _) = self.balls[o].at(self.t, self.gravity);
-            let d: [f64; 3] = std::array::from_fn(|c| po[c] - b.p[c]);
-            let gap = dot(d, d).sqrt() - b.radius - self.balls[o].radius;
-            let tol = self.pair_tolerance(k, o, 0.0);
-            if gap < -tol {
-                return Err(self.broken(format!(
-                    "its contact invariant at t = {} s: ball{} / ball{} overlap by {:.3e} m (tolerance {:.3e} m)",
-                    crate::scene::human(self.t),
-                    k + 1,
-                    o + 1,
-                    -gap,
-                    tol
-                )));
-            }
+        }
+        Ok(())
+    }
+
+    /// The postcondition for balls `k` and `o`, their centres `d` apart now: they overlap by
+    /// no more than the contact tolerance (docs/MODEL.md §14).
+    #[inline]
+    fn check_pair(&self, k: usize, o: usize, d: [f64; 3]) -> Result<(), ModelError> {
+        let reach = self.balls[k].radius + self.balls[o].radius;
+        if dot(d, d) >= reach * reach {
+            // Apart, or touching: no overlap to weigh against the tolerance.
+            return Ok(());
+        }
+        self.check_overlap(k, o, dot(d, d).sqrt() - reach)
+    }
+
+    /// [`Solver::check_pair`] for a pair closer than touching, `gap` (negative) apart.
+    #[cold]
+    fn check_overlap(&self, k: usize, o: usize, gap: f64) -> Result<(), ModelError> {
+        let tol = self.pair_tolerance(k, o, 0.0);
+        if gap < -tol {
+            return Err(self.broken(format!(
+                "its contact invariant at t = {} s: ball{} / ball{} overlap by {:.3e} m (tolerance {:.3e} m)",
+                crate::scene::human(self.t),
+                k + 1,
+                o + 1,
+                -gap,
+                tol
+            )));
         }
         Ok(())
     }
