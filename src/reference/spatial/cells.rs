@@ -147,3 +147,55 @@ impl Cells {
         self.in_block(lo, hi, f);
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use std::collections::BTreeSet;
+
+    /// The slab beyond the face a ball crossed holds exactly the balls around its new cell that
+    /// were not around its old one, in every direction, at the walls across and where the
+    /// columns along x fold: a ball in every cell of a 4 x 3 x 3 container.
+    #[test]
+    fn a_slab_holds_the_balls_a_crossing_ball_newly_neighbours() {
+        let mut cells = Cells::new(0.5, 4.0, [3.0, 3.0], 200);
+        let mut ball = 0;
+        for x in -2..6 {
+            for y in 0..3 {
+                for z in 0..3 {
+                    if (0..cells.nx).contains(&x) {
+                        cells.insert([x, y, z], ball);
+                        ball += 1;
+                    }
+                }
+            }
+        }
+        // The balls a visit meets, each once.
+        fn met(visit: impl FnOnce(&mut dyn FnMut(u32))) -> BTreeSet<u32> {
+            let mut s = BTreeSet::new();
+            visit(&mut |b| assert!(s.insert(b), "ball {b} met twice"));
+            s
+        }
+        for x in -1..cells.nx + 1 {
+            for y in 0..3 {
+                for z in 0..3 {
+                    let new = [x, y, z];
+                    for axis in 0..3 {
+                        for dir in [1i64, -1] {
+                            if !cells.has_neighbour(new, axis, -dir) {
+                                continue;
+                            }
+                            let mut old = new;
+                            old[axis] -= dir;
+                            let around_new = met(|f| cells.around(new, f));
+                            let around_old = met(|f| cells.around(old, f));
+                            let slab = met(|f| cells.slab(new, axis, dir, f));
+                            let fresh: BTreeSet<u32> = around_new.difference(&around_old).copied().collect();
+                            assert_eq!(slab, fresh, "crossing into {new:?} along {axis} towards {dir}");
+                        }
+                    }
+                }
+            }
+        }
+    }
+}
