@@ -180,6 +180,9 @@ struct Solver<'a> {
     /// searches against its walls; `None` when unknown (a forced frame, or one without a
     /// spring), and then every ball searches.
     frame_reach: Option<FrameReach>,
+    /// The most energy the frame could have at the start ([`reach_energy`]): less the impacts'
+    /// and the damping's losses, the most it can have now.
+    start_energy: f64,
     /// Changes when `frame_reach` does: the waits taken with an older bound are stale.
     reach_version: u64,
     /// Whether each ball's contact with the frame's wall on each side (left, right) is being
@@ -206,17 +209,11 @@ fn wall_index(side: f64) -> usize {
     usize::from(side < 0.0)
 }
 
-/// Where the frame of `scene` can be from the start to the horizon, for an unforced frame with
-/// a spring and damping `>= 0` (docs/MODEL.md §14): its energy `M v^2 / 2 + K x^2 / 2` can grow
-/// only by what the balls give it, at most their kinetic energy and the height gravity can
-/// still take them down, so it never goes farther than `sqrt(2 E / K)`, `E` the sum, with a
-/// millionth to spare for round-off. A segment beyond it (the collapse rule's energy) widens
-/// it then (see [`Solver::searches_ended`]).
-fn frame_reach(scene: &Scene, frame: &FrameMotion, balls: &[Ball]) -> Option<FrameReach> {
-    if !frame.exists() {
-        return None;
-    }
-    let reach = frame.reach()?;
+/// The most energy the frame of `scene` can ever have (docs/MODEL.md §14), for an unforced
+/// frame with a spring and damping `>= 0`: its energy `M v^2 / 2 + K x^2 / 2` can grow only by
+/// what the balls give it, at most their kinetic energy and the height gravity can still take
+/// them down. What the impacts and the damping take from then on comes off it.
+fn reach_energy(scene: &Scene, frame: &FrameMotion, balls: &[Ball]) -> f64 {
     let g = scene.space.gravity;
     let half = [0.5 * scene.space.section[0], 0.5 * scene.space.section[1]];
     let given: f64 = balls
@@ -226,9 +223,20 @@ fn frame_reach(scene: &Scene, frame: &FrameMotion, balls: &[Ball]) -> Option<Fra
             b.mass * (0.5 * dot(b.v, b.v) + (lowest - dot(g, b.p)).max(0.0))
         })
         .sum();
-    let energy = (frame.energy(0.0, scene) + given) * (1.0 + 1e-6);
-    let bound = frame.seg.osc.envelope(0.0, (2.0 * energy / frame.mass).sqrt())?;
-    Some(FrameReach::new(&frame.seg.osc, bound.max(reach), scene.horizon))
+    frame.energy(0.0, scene) + given
+}
+
+/// How far a frame with `energy` at most goes, `sqrt(2 E / K)` with a millionth to spare for
+/// round-off, and never less than its present segment's reach; `None` when unknown (a forced
+/// frame, or one without a spring). A segment beyond it (the collapse rule's energy) widens it
+/// then (see [`Solver::searches_ended`]).
+fn energy_reach(frame: &FrameMotion, energy: f64) -> Option<f64> {
+    if !frame.exists() {
+        return None;
+    }
+    let reach = frame.reach()?;
+    let bound = frame.seg.osc.envelope(0.0, (2.0 * energy.max(0.0) * (1.0 + 1e-6) / frame.mass).sqrt())?;
+    Some(bound.max(reach * (1.0 + 1e-6)))
 }
 
 fn dot(a: [f64; 3], b: [f64; 3]) -> f64 {
@@ -350,7 +358,8 @@ impl<'a> Solver<'a> {
             })
             .collect();
         let start = balls.iter().map(|b| b.p).collect();
-        let frame_reach = frame_reach(scene, &frame, &balls);
+        let start_energy = reach_energy(scene, &frame, &balls);
+        let frame_reach = energy_reach(&frame, start_energy).map(|r| FrameReach::new(&frame.seg.osc, r, scene.horizon));
         Ok(Solver {
             scene,
             balls,
@@ -361,6 +370,7 @@ impl<'a> Solver<'a> {
             calendar: Calendar::new(scene.balls.len()),
             frame_calendar: BinaryHeap::new(),
             frame_reach,
+            start_energy,
             reach_version: 0,
             searched: vec![[false; 2]; scene.balls.len()],
             searching: Vec::new(),
@@ -825,7 +835,7 @@ impl<'a> Solver<'a> {
                         self.frame.restart(self.t, xs, vf);
                         // Every entry against the frame's walls belongs to the motion just ended.
                         self.frame_calendar.clear();
-                        searched_before = self.searches_ended();
+                        searched_before = self.searches_ended(lost);
                     }
                     self.balls[i].v[0] = vb;
                     self.balls[i].last_impact = self.t;
@@ -848,17 +858,24 @@ impl<'a> Solver<'a> {
         Ok(())
     }
 
-    /// After the frame's segment changed: the walls whose searches it ended, each once. The
-    /// waits hold while the frame keeps within the bound they were taken with, so only the
-    /// searches end; a segment beyond the bound widens it and ends every wait and search.
-    fn searches_ended(&mut self) -> Vec<(usize, usize)> {
+    /// After the frame's segment changed at an impact that lost `lost`: the walls whose searches
+    /// it ended, each once. The waits hold while the frame keeps within the bound they were taken
+    /// with, so only the searches end; a segment beyond the bound widens it, and a bound that the
+    /// energy lost since it was taken halves tightens it, each ending every wait and search.
+    fn searches_ended(&mut self, lost: f64) -> Vec<(usize, usize)> {
         let within = match (&self.frame_reach, self.frame.reach()) {
             (Some(bound), Some(reach)) => reach <= bound.reach,
             _ => false,
         };
-        if !within {
+        let left = self.start_energy - self.impact_loss - lost - self.damping_loss;
+        let tighter = match (&self.frame_reach, energy_reach(&self.frame, left)) {
+            (Some(bound), Some(reach)) if within && reach < 0.5 * bound.reach => Some(reach),
+            _ => None,
+        };
+        if !within || tighter.is_some() {
             if self.frame_reach.is_some() {
-                self.frame_reach = self.frame.reach().map(|r| FrameReach::new(&self.frame.seg.osc, r * (1.0 + 1e-6), self.horizon));
+                let reach = tighter.or_else(|| self.frame.reach().map(|r| r * (1.0 + 1e-6)));
+                self.frame_reach = reach.map(|r| FrameReach::new(&self.frame.seg.osc, r, self.horizon));
                 self.reach_version += 1;
             }
             self.searching.clear();
@@ -1041,5 +1058,39 @@ mod tests {
             .count();
         let shared = &waiting.impacts[..alike];
         assert!(alike >= 1000 && walls(shared) >= 30, "{alike} impacts alike, {} on the end walls", walls(shared));
+    }
+
+    /// Balls that wait before searching against the frame's walls, with a bound on the frame's
+    /// reach that tightens twice as a gas of twenty balls with e = 0.5 loses its energy (from
+    /// 11.6 mm to 2.5 mm, every wait and search redone each time), meet the frame's walls where
+    /// balls that search after every event do: every impact of the first 0.4 s, twenty on the
+    /// end walls, alike to round-off.
+    #[test]
+    fn a_bound_tightened_as_the_balls_lose_energy_keeps_the_walls_impacts() {
+        let mut text = String::from(
+            "name = \"gas\"\n[frame]\nmass = 1.35\nstiffness = 865.0\ndamping = 0.0\ninitial_displacement = 0.0\n\
+             [container]\nlength = 0.1\nwidth = 0.06\nheight = 0.1\n[world]\ngravity = [0.0, 0.0, 0.0]\nrestitution = 0.5\n[run]\nhorizon = 0.4\n",
+        );
+        for i in 0..20 {
+            let (x, y, z) = (0.01 + 0.02 * (i % 4) as f64, -0.02 + 0.02 * ((i / 4) % 3) as f64, -0.04 + 0.02 * (i / 12) as f64);
+            let v = [(i as f64 * 0.37).sin(), (i as f64 * 0.91).cos(), (i as f64 * 1.73).sin()];
+            text +=
+                &format!("[[ball]]\nposition = [{x}, {y}, {z}]\nmass = 0.004\nradius = 0.005\nvelocity = [{}, {}, {}]\n", v[0], v[1], v[2]);
+        }
+        let scene = crate::scene::parse(&text, "gas.toml", "gas").unwrap().scene.unwrap();
+        let options = RunOptions::default();
+        let mut solver = Solver::new(&scene).unwrap();
+        let first = solver.frame_reach.as_ref().unwrap().reach;
+        solver.run(&Meter::new(&options, BUDGET_EVENTS), &mut Recorder::new(&scene, options.record)).unwrap();
+        let last = solver.frame_reach.as_ref().unwrap().reach;
+        assert!(solver.reach_version == 2 && last < 0.25 * first, "{} bounds, from {first} m to {last} m", solver.reach_version);
+        let waiting = simulate_with(&scene, &options, true).unwrap();
+        let searching = simulate_with(&scene, &options, false).unwrap();
+        assert_eq!(waiting.impacts.len(), searching.impacts.len());
+        for (a, b) in waiting.impacts.iter().zip(&searching.impacts) {
+            assert!((a.a, a.b) == (b.a, b.b) && (a.t - b.t).abs() <= 1e-12, "{a:?} against {b:?}");
+        }
+        let walls = waiting.impacts.iter().filter(|i| matches!((i.a, i.b), (Body::LeftWall, _) | (_, Body::RightWall))).count();
+        assert!(walls >= 20, "{walls} impacts on the end walls");
     }
 }
