@@ -79,26 +79,56 @@ fn eval(c: &[f64], t: f64) -> f64 {
     c.iter().rev().fold(0.0, |acc, &k| acc * t + k)
 }
 
-/// The polynomial's derivative.
-fn derivative(c: &[f64]) -> Vec<f64> {
-    c.iter().enumerate().skip(1).map(|(k, &v)| k as f64 * v).collect()
+/// A few numbers on the stack: a quartic's coefficients, or the points that split `[0, limit]`
+/// for it (at most one more than its degree), so that a root search allocates nothing.
+#[derive(Clone, Copy)]
+struct Few {
+    values: [f64; 6],
+    len: usize,
 }
 
-/// Every point of `[0, limit]` where the polynomial `c` changes sign, in order: the
-/// derivative's sign changes split the interval into pieces where `c` is monotone, and each
-/// piece holds at most one sign change, found by bisection to an ulp.
-fn sign_changes(c: &[f64], limit: f64) -> Vec<f64> {
+impl Few {
+    fn new() -> Few {
+        Few { values: [0.0; 6], len: 0 }
+    }
+
+    fn push(&mut self, value: f64) {
+        self.values[self.len] = value;
+        self.len += 1;
+    }
+
+    fn as_slice(&self) -> &[f64] {
+        &self.values[..self.len]
+    }
+}
+
+/// The polynomial's derivative.
+fn derivative(c: &[f64]) -> Few {
+    let mut d = Few::new();
+    for (k, &v) in c.iter().enumerate().skip(1) {
+        d.push(k as f64 * v);
+    }
+    d
+}
+
+/// Every point of `[0, limit]` where the polynomial `c` (of degree four at most) changes sign,
+/// in order: the derivative's sign changes split the interval into pieces where `c` is
+/// monotone, and each piece holds at most one sign change, found by bisection to an ulp.
+fn sign_changes(c: &[f64], limit: f64) -> Few {
+    let mut roots = Few::new();
     let degree = c.iter().rposition(|&k| k != 0.0).unwrap_or(0);
     if degree == 0 {
-        return Vec::new();
+        return roots;
     }
-    let mut ends = vec![0.0];
+    let mut ends = Few::new();
+    ends.push(0.0);
     if degree > 1 {
-        ends.extend(sign_changes(&derivative(&c[..=degree]), limit));
+        for &r in sign_changes(derivative(&c[..=degree]).as_slice(), limit).as_slice() {
+            ends.push(r);
+        }
     }
     ends.push(limit);
-    let mut roots = Vec::new();
-    for w in ends.windows(2) {
+    for w in ends.as_slice().windows(2) {
         let (mut l, mut h) = (w[0], w[1]);
         let (fl, fh) = (eval(c, l), eval(c, h));
         if (fl > 0.0) == (fh > 0.0) || l >= h {
@@ -126,13 +156,17 @@ fn sign_changes(c: &[f64], limit: f64) -> Vec<f64> {
 /// that starts at or below zero), or `None`.
 fn first_fall(c: &[f64], limit: f64) -> Option<f64> {
     let d = derivative(c);
+    let d = d.as_slice();
     if c[0] <= 0.0 && (d[0] < 0.0 || (d[0] == 0.0 && d[1] < 0.0)) {
         return Some(0.0);
     }
-    let mut ends = vec![0.0];
-    ends.extend(sign_changes(&d, limit));
+    let mut ends = Few::new();
+    ends.push(0.0);
+    for &r in sign_changes(d, limit).as_slice() {
+        ends.push(r);
+    }
     ends.push(limit);
-    for w in ends.windows(2) {
+    for w in ends.as_slice().windows(2) {
         let (mut l, mut h) = (w[0], w[1]);
         let (fl, fh) = (eval(c, l), eval(c, h));
         if !(fh <= 0.0 && fl > fh) {
