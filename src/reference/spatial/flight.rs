@@ -4,6 +4,18 @@
 //! floor) where a quartic first falls through zero, isolated between the sign changes of its
 //! derivatives.
 
+/// The roots of `c + b t + a t^2` (`a != 0`), `q / a` and `c / q` with
+/// `q = -(b + sign(b) sqrt(b^2 - 4 a c)) / 2`, the form that does not cancel; `None` when they
+/// are complex or `q` is zero.
+fn quadratic_roots(a: f64, b: f64, c: f64) -> Option<(f64, f64)> {
+    let disc = b * b - 4.0 * a * c;
+    if disc < 0.0 {
+        return None;
+    }
+    let q = -0.5 * (b + b.signum() * disc.sqrt());
+    (q != 0.0).then(|| (q / a, c / q))
+}
+
 /// The first `t >= 0` at which `c + b t + a t^2 = 0` with `c > 0` before it, or `None`: the
 /// smaller non-negative root, computed in the form that does not cancel.
 pub(super) fn first_root(a: f64, b: f64, c: f64) -> Option<f64> {
@@ -18,17 +30,9 @@ pub(super) fn first_root(a: f64, b: f64, c: f64) -> Option<f64> {
     if a == 0.0 {
         return (b < 0.0).then(|| c / -b);
     }
-    let disc = b * b - 4.0 * a * c;
-    if disc < 0.0 {
-        return None;
-    }
-    let q = -0.5 * (b + b.signum() * disc.sqrt());
-    if q == 0.0 {
-        return None;
-    }
-    // Roots q / a and c / q; with c > 0 both have the sign of q / a (when a > 0) or opposite
-    // signs (a < 0, the positive one is the root reached first from above).
-    let (r1, r2) = (q / a, c / q);
+    // With c > 0 both roots have the sign of q / a (when a > 0) or opposite signs (a < 0,
+    // the positive one is the root reached first from above).
+    let (r1, r2) = quadratic_roots(a, b, c)?;
     let mut best: Option<f64> = None;
     for r in [r1, r2] {
         if r >= 0.0 && r.is_finite() {
@@ -147,16 +151,9 @@ fn sign_changes(c: &[f64], limit: f64) -> Few {
             // to a few ulps: narrowed around it likewise. Where its values in floating point
             // change sign once between floats, the result is the bisection's from the whole
             // piece; elsewhere it is another float of the same band of round-off.
-            let (a, b, k) = (c[2], c[1], c[0]);
-            let disc = b * b - 4.0 * a * k;
-            if disc >= 0.0 {
-                let q = -0.5 * (b + b.signum() * disc.sqrt());
-                for guess in [q / a, k / q] {
-                    if guess > l && guess < h {
-                        (l, h) = narrow(l, h, guess, after);
-                        break;
-                    }
-                }
+            if let Some((r1, r2)) = quadratic_roots(c[2], c[1], c[0]) {
+                let guess = if r1 > l && r1 < h { r1 } else { r2 };
+                (l, h) = narrow(l, h, guess, after);
             }
         }
         for _ in 0..200 {
