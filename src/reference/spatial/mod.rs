@@ -509,9 +509,7 @@ impl<'a> Solver<'a> {
             self.predict_frame_wall(i, side);
         }
         self.predict_crossing(i, a);
-        let mut others = std::mem::take(&mut self.neighbours);
-        others.clear();
-        self.cells.around(b.cell, |j| others.push(j as usize));
+        let others = self.gather(b.cell, None);
         let predicted = self.predict_pairs(i, motion, &others, check);
         self.neighbours = others;
         predicted
@@ -524,11 +522,21 @@ impl<'a> Solver<'a> {
         let b = self.balls[i];
         let motion = b.motion(self.t, self.gravity);
         self.predict_crossing(i, motion.2);
-        let mut others = std::mem::take(&mut self.neighbours);
-        others.clear();
-        self.cells.slab(b.cell, axis, dir, |j| others.push(j as usize));
+        let others = self.gather(b.cell, Some((axis, dir)));
         self.predict_pairs(i, motion, &others, false).expect("a prediction without a check cannot fail");
         self.neighbours = others;
+    }
+
+    /// The balls of the cells around `cell`, or with `slab` (`(axis, dir)`) of the slab beyond
+    /// its face, in the scratch list, which the caller puts back in `neighbours` when done.
+    fn gather(&mut self, cell: [i64; 3], slab: Option<(usize, i64)>) -> Vec<usize> {
+        let mut others = std::mem::take(&mut self.neighbours);
+        others.clear();
+        match slab {
+            None => self.cells.around(cell, |j| others.push(j as usize)),
+            Some((axis, dir)) => self.cells.slab(cell, axis, dir, |j| others.push(j as usize)),
+        }
+        others
     }
 
     /// When ball `i` (brought to now), accelerated by `a`, next leaves its cell.
@@ -652,9 +660,7 @@ impl<'a> Solver<'a> {
         for i in 0..self.balls.len() {
             self.bring(i);
             self.check_walls(i)?;
-            let mut near = std::mem::take(&mut self.neighbours);
-            near.clear();
-            self.cells.around(self.balls[i].cell, |o| near.push(o as usize));
+            let near = self.gather(self.balls[i].cell, None);
             let checked = self.check_neighbours(i, &near);
             self.neighbours = near;
             checked?;
