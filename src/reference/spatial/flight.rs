@@ -54,6 +54,7 @@ pub(super) fn plane_time(g0: f64, s: f64, v: f64, acc: f64) -> Option<f64> {
 /// through zero. A pair touching now meets now if it closes, else at its next fall through
 /// zero (a ball bouncing on one that rests on the floor comes back). A touching pair that closes
 /// no faster than `still` (the round-off of its velocities, [`still`]) does not close.
+#[inline]
 pub(super) fn pair_time(dr: [f64; 3], dv: [f64; 3], da: [f64; 3], reach: f64, still: f64, limit: f64) -> Option<f64> {
     let dot = |a: [f64; 3], b: [f64; 3]| a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
     let c0 = dot(dr, dr) - reach * reach;
@@ -197,6 +198,9 @@ fn narrow(mut l: f64, mut h: f64, guess: f64, after: impl Fn(f64) -> bool) -> (f
 /// The first time in `[0, limit]` at which the polynomial `c` falls to zero or below from
 /// above (or `0` when it is at or below zero and falling now, or the start of a falling piece
 /// that starts at or below zero), or `None`.
+// Kept out of line, so that `pair_time` stays small enough to inline into the pairs'
+// prediction: the quartic is the rare case, the quadratic the event loop's hottest path.
+#[inline(never)]
 fn first_fall(c: &[f64], limit: f64) -> Option<f64> {
     let d = derivative(c);
     let d = d.as_slice();
