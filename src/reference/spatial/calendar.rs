@@ -15,14 +15,21 @@ pub(super) struct Calendar<T> {
     lists: Vec<Vec<T>>,
     /// Each ball's earliest entry, and its place in the ball's list.
     heads: Vec<Option<(T, u32)>>,
-    /// Each leaf's head's key, `NO_HEAD` for a ball without entries (and past the balls): the
-    /// tree compares these, a few to a cache line, rather than the entries.
-    keys: Vec<u64>,
-    /// Node `k` holds the leaf whose head is earliest below it (at equal keys the lower one);
-    /// the leaves start at `leaves`.
-    tree: Vec<u32>,
+    /// Node `k` holds the key and the leaf of the earliest head below it (at equal keys the
+    /// lower leaf); the leaves start at `leaves`, one per ball, `NO_HEAD` for a ball without
+    /// entries (and past the balls). A walk up the tree compares the key it carries with each
+    /// sibling's, read from the node itself rather than through the leaf it names.
+    tree: Vec<Node>,
     leaves: usize,
     len: usize,
+}
+
+/// A node of the tree: the earliest head's key below it, then its leaf. Ordered as a pair, so
+/// that at equal keys the lower leaf is the earlier.
+#[derive(Clone, Copy, PartialEq, Eq, PartialOrd, Ord)]
+struct Node {
+    key: u64,
+    leaf: u32,
 }
 
 /// The key of a ball without entries: later than any entry's.
@@ -32,14 +39,14 @@ impl<T: Ord + Copy + Timed> Calendar<T> {
     /// An empty calendar for `balls` balls.
     pub(super) fn new(balls: usize) -> Self {
         let leaves = balls.max(1).next_power_of_two();
-        let mut tree = vec![0; 2 * leaves];
+        let mut tree = vec![Node { key: NO_HEAD, leaf: 0 }; 2 * leaves];
         for k in 0..leaves {
-            tree[leaves + k] = k as u32;
+            tree[leaves + k].leaf = k as u32;
         }
         for node in (1..leaves).rev() {
             tree[node] = tree[2 * node];
         }
-        Calendar { lists: vec![Vec::new(); balls], heads: vec![None; balls], keys: vec![NO_HEAD; leaves], tree, leaves, len: 0 }
+        Calendar { lists: vec![Vec::new(); balls], heads: vec![None; balls], tree, leaves, len: 0 }
     }
 
     /// Entries held, stale ones included.
@@ -60,13 +67,13 @@ impl<T: Ord + Copy + Timed> Calendar<T> {
 
     /// The earliest entry.
     pub(super) fn peek(&self) -> Option<&T> {
-        let ball = self.tree[1] as usize;
+        let ball = self.tree[1].leaf as usize;
         self.heads.get(ball).and_then(|h| h.as_ref()).map(|(entry, _)| entry)
     }
 
     /// Takes the earliest entry out.
     pub(super) fn pop(&mut self) -> Option<T> {
-        let owner = self.tree[1] as usize;
+        let owner = self.tree[1].leaf as usize;
         let (_, at) = *self.heads.get(owner)?.as_ref()?;
         let entry = self.lists[owner].swap_remove(at as usize);
         self.len -= 1;
@@ -107,19 +114,18 @@ impl<T: Ord + Copy + Timed> Calendar<T> {
 
     /// Walks from ball `owner`'s leaf to the root, each node taking its earlier child.
     fn update(&mut self, owner: usize) {
-        self.keys[owner] = self.heads[owner].map_or(NO_HEAD, |(head, _)| head.key());
+        let key = self.heads[owner].map_or(NO_HEAD, |(head, _)| head.key());
         let mut node = self.leaves + owner;
+        let mut earliest = Node { key, leaf: owner as u32 };
+        self.tree[node] = earliest;
         while node > 1 {
+            earliest = earliest.min(self.tree[node ^ 1]);
             node /= 2;
-            let (a, b) = (self.tree[2 * node], self.tree[2 * node + 1]);
-            // The left child's leaves are the lower ones: it wins a tie.
-            let earlier = if self.keys[b as usize] < self.keys[a as usize] { b } else { a };
-            if self.tree[node] == earlier && earlier != owner as u32 {
-                // Nothing above changes: this node kept its winner, and it is not the ball
-                // whose head moved.
+            if self.tree[node] == earliest {
+                // Nothing above changes: every node there was taken from this one as it is.
                 break;
             }
-            self.tree[node] = earlier;
+            self.tree[node] = earliest;
         }
     }
 }
