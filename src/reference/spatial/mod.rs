@@ -486,7 +486,9 @@ impl<'a> Solver<'a> {
             self.check_walls(i)?;
         }
         self.balls[i].stamp = self.balls[i].stamp.wrapping_add(1);
-        // Every entry the ball owns is stale from here on.
+        // Every entry the ball owns is stale from here on. Its place in the calendar's tree is
+        // found once, when all its new entries are in.
+        self.calendar.hold(i);
         self.calendar.clear(i);
         let b = self.balls[i];
         let t = self.t;
@@ -512,6 +514,7 @@ impl<'a> Solver<'a> {
         let others = self.gather(b.cell, None);
         let predicted = self.predict_pairs(i, motion, &others, check);
         self.neighbours = others;
+        self.calendar.release();
         predicted
     }
 
@@ -521,10 +524,12 @@ impl<'a> Solver<'a> {
     fn predict_slab(&mut self, i: usize, axis: usize, dir: i64) {
         let b = self.balls[i];
         let motion = b.motion(self.t, self.gravity);
+        self.calendar.hold(i);
         self.predict_crossing(i, motion.2);
         let others = self.gather(b.cell, Some((axis, dir)));
         self.predict_pairs(i, motion, &others, false).expect("a prediction without a check cannot fail");
         self.neighbours = others;
+        self.calendar.release();
     }
 
     /// The balls of the cells around `cell`, or with `slab` (`(axis, dir)`) of the slab beyond
