@@ -34,3 +34,35 @@ fn a_changed_metric_is_a_regression() {
     assert_eq!(code, Some(3), "{out}");
     assert!(out.contains("lpc-lsl") && out.contains("peak_displacement") && out.contains("FAIL"), "{out}");
 }
+
+/// `--update` keeps a spread only for the values that a few ulps of restitution move beyond
+/// the exact tolerance: none for the Fig. 16 sweep's e = 0.85, the late-time values of its
+/// e = 0.95, where the balls' impacts amplify it (as in the committed goldens), and a check
+/// against those goldens passes.
+#[test]
+fn update_keeps_a_spread_where_round_off_moves_a_value() {
+    let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR"));
+    let (scenes, golden) = (tempfile::tempdir().unwrap(), tempfile::tempdir().unwrap());
+    std::fs::copy(root.join("scenes/sweep-cor.toml"), scenes.path().join("sweep-cor.toml")).unwrap();
+    let o = lpc_command()
+        .arg("check")
+        .arg(scenes.path())
+        .arg("--golden")
+        .arg(golden.path())
+        .args(["--models", "reference", "--update"])
+        .output()
+        .unwrap();
+    assert_eq!(o.status.code(), Some(0), "{}", String::from_utf8_lossy(&o.stdout));
+    let read = |dir: &std::path::Path, e: &str| -> serde_json::Value {
+        let file = dir.join(format!("sweep-cor_restitution_{e}_.reference.json"));
+        serde_json::from_slice(&std::fs::read(file).unwrap()).unwrap()
+    };
+    let low = read(golden.path(), "0.85");
+    assert!(low.get("spread").is_none(), "{low}");
+    let names = |g: &serde_json::Value| -> Vec<String> { g["spread"].as_object().expect("a spread").keys().cloned().collect() };
+    let high = read(golden.path(), "0.95");
+    assert!(names(&high).contains(&"settling_time".to_string()) && !names(&high).contains(&"peak_displacement".to_string()), "{high}");
+    assert_eq!(names(&high), names(&read(&root.join("tests/golden"), "0.95")));
+    let (code, out) = lpc_check(scenes.path(), golden.path(), "reference");
+    assert_eq!(code, Some(0), "{out}");
+}

@@ -19,7 +19,8 @@ pub struct Args {
     /// Models, comma-separated.
     #[arg(long, value_delimiter = ',', default_value = "reference,rapier,compliant")]
     models: Vec<Model>,
-    /// Rewrite the golden files from this run.
+    /// Rewrite the golden files from this run (the reference's scenes are run eight more times
+    /// each, to measure how far round-off moves their values).
     #[arg(long)]
     update: bool,
     /// Print every compared value, not only the failures.
@@ -29,7 +30,7 @@ pub struct Args {
 
 pub fn run(a: Args) -> Result<ExitStatus> {
     let work = crate::watch::Work::new(None, "check");
-    let now = check::current(&a.dir, &a.models, &|| work.inc())?;
+    let now = check::current(&a.dir, &a.models, a.update, &|| work.inc())?;
     work.finish();
     let mut rows = Vec::new();
     for g in &now {
