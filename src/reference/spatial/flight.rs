@@ -126,10 +126,11 @@ fn sign_changes(c: &[f64], limit: f64) -> Few {
     if degree == 0 {
         return roots;
     }
+    let d = derivative(&c[..=degree]);
     let mut ends = Few::new();
     ends.push(0.0);
     if degree > 1 {
-        for &r in sign_changes(derivative(&c[..=degree]).as_slice(), limit).as_slice() {
+        for &r in sign_changes(d.as_slice(), limit).as_slice() {
             ends.push(r);
         }
     }
@@ -156,6 +157,11 @@ fn sign_changes(c: &[f64], limit: f64) -> Few {
                 let guess = if r1 > l && r1 < h { r1 } else { r2 };
                 (l, h) = narrow(l, h, guess, after);
             }
+        } else {
+            // A cubic or a quartic: Newton's steps from the piece's ends, kept in the bracket.
+            let guess;
+            (l, h, guess) = newton(c, d.as_slice(), (l, h), fl, fh, |f| (f > 0.0) == rising);
+            (l, h) = narrow(l, h, guess, after);
         }
         for _ in 0..200 {
             let m = 0.5 * (l + h);
@@ -172,6 +178,45 @@ fn sign_changes(c: &[f64], limit: f64) -> Few {
     }
     roots
 }
+
+/// Newton's steps on the bracket `(l, h)` of a sign change of the polynomial `c`, monotone on
+/// it, with `d` its derivative, `fl` and `fh` its values at the ends and `after` true of the
+/// values past the change: each step keeps the bracket by the sign of the value at its point,
+/// and a step that would leave the bracket takes the midpoint instead. They stop when a step
+/// moves by no more than a few ulps, or after `NEWTON_STEPS`; returned are the bracket and the
+/// last point, where the sign change is to round-off when the steps converged.
+fn newton(c: &[f64], d: &[f64], (mut l, mut h): (f64, f64), fl: f64, fh: f64, after: impl Fn(f64) -> bool) -> (f64, f64, f64) {
+    // The secant's point first: it is inside the bracket, and on a short piece already close.
+    let mut t = l + (h - l) * (fl / (fl - fh));
+    if !(t > l && t < h) {
+        t = 0.5 * (l + h);
+    }
+    for _ in 0..NEWTON_STEPS {
+        let f = eval(c, t);
+        if after(f) {
+            h = t;
+        } else {
+            l = t;
+        }
+        let step = f / eval(d, t);
+        let next = t - step;
+        let next = if next > l && next < h { next } else { 0.5 * (l + h) };
+        if !(next > l && next < h) {
+            // The bracket is two neighbouring floats.
+            break;
+        }
+        let converged = step.abs() <= 4.0 * f64::EPSILON * t.abs();
+        t = next;
+        if converged {
+            break;
+        }
+    }
+    (l, h, t)
+}
+
+/// Newton's steps at most, before the bisection finishes: from the secant's point a step
+/// gains a few digits at first and doubles them near the root.
+const NEWTON_STEPS: usize = 12;
 
 /// The bracket `[l, h]` of a sign change (`after` false at `l`, true at `h`) narrowed to a
 /// few floats around `guess` where the signs there allow, else as it is.
@@ -224,6 +269,9 @@ fn first_fall(c: &[f64], limit: f64) -> Option<f64> {
             // less than round-off): in contact again from the top of the rise.
             return Some(l);
         }
+        let guess;
+        (l, h, guess) = newton(c, d, (l, h), fl, fh, |f| f <= 0.0);
+        (l, h) = narrow(l, h, guess, |t| eval(c, t) <= 0.0);
         for _ in 0..200 {
             let m = 0.5 * (l + h);
             if m <= l || m >= h {
@@ -325,6 +373,62 @@ mod tests {
                 let band = 8.0 * f64::EPSILON * (c[0].abs() + c[1].abs() * t + c[2].abs() * t * t) / (c[1] + 2.0 * c[2] * t).abs();
                 assert!((found - expected).abs() <= band + 4.0 * f64::EPSILON, "{c:?}: {found} against {expected} (band {band})");
             }
+        }
+    }
+
+    /// The band of round-off around a sign change of `c` at `t`: where its value is below a
+    /// few ulps of the sum of its terms' magnitudes, against its slope there.
+    fn band(c: &[f64], t: f64) -> f64 {
+        let size: f64 = c.iter().enumerate().map(|(k, v)| v.abs() * t.powi(k as i32)).sum();
+        8.0 * f64::EPSILON * size / eval(&derivative(c).values[..c.len() - 1], t).abs() + 4.0 * f64::EPSILON
+    }
+
+    /// Started from Newton's steps, the search ends where the bisection from the whole piece
+    /// does, to the band of round-off: every sign change of 10 000 random cubics with three
+    /// roots in `[0, 1]`, and the first fall of 10 000 random quartics with four (in a tenth
+    /// of them the first two close together, as for balls that barely touch).
+    #[test]
+    fn newton_starts_the_search_where_the_bisection_ends() {
+        use rand::{Rng, SeedableRng};
+        let mut rng = rand_pcg::Pcg64::seed_from_u64(13);
+        for _ in 0..10_000 {
+            let r = [rng.random_range(0.0..0.33), rng.random_range(0.33..0.66), rng.random_range(0.66..1.0)];
+            let a = rng.random_range(-10.0..10.0);
+            // a (t - r0)(t - r1)(t - r2)
+            let c = [-a * r[0] * r[1] * r[2], a * (r[0] * r[1] + r[0] * r[2] + r[1] * r[2]), -a * (r[0] + r[1] + r[2]), a];
+            let mut ends = vec![0.0];
+            ends.extend_from_slice(sign_changes(&derivative(&c).values[..3], 1.0).as_slice());
+            ends.push(1.0);
+            let roots = sign_changes(&c, 1.0);
+            assert_eq!(roots.len, 3, "{c:?}");
+            for (k, piece) in ends.windows(2).enumerate() {
+                let rising = eval(&c, piece[1]) > 0.0;
+                let (found, expected) = (roots.values[k], bisected(&c, (piece[0], piece[1]), rising));
+                let band = band(&c, expected);
+                assert!((found - expected).abs() <= band, "{c:?}: {found} against {expected} (band {band})");
+            }
+        }
+        for _ in 0..10_000 {
+            let r0 = rng.random_range(0.0..0.25);
+            // The second root close to the first in a tenth of the draws.
+            let r1 = if rng.random_bool(0.1) { r0 + rng.random_range(1e-6..1e-3) } else { rng.random_range(0.25..0.5) };
+            let r = [r0, r1, rng.random_range(0.5..0.75), rng.random_range(0.75..1.0)];
+            // a (t - r0)(t - r1)(t - r2)(t - r3), lowest power first: positive at 0, first
+            // falling through zero at r0.
+            let mut c = vec![rng.random_range(0.1..100.0)];
+            for &root in &r {
+                let mut times = vec![0.0; c.len() + 1];
+                for (k, &v) in c.iter().enumerate() {
+                    times[k + 1] += v;
+                    times[k] -= root * v;
+                }
+                c = times;
+            }
+            let found = first_fall(&c, 1.0).expect("it falls at its first root");
+            let top = sign_changes(&derivative(&c).values[..4], 1.0).as_slice()[0];
+            let expected = bisected(&c, (0.0, top), false);
+            let band = band(&c, expected);
+            assert!((found - expected).abs() <= band, "{c:?}: {found} against {expected} (band {band})");
         }
     }
 
