@@ -15,15 +15,15 @@
 //! the contact model's tolerances, and its peak contact force and true acceleration peak (set
 //! by the fastest, earliest impacts) 2 %, like the peaks.
 //!
-//! A chaotic run amplifies round-off: a bed of balls that differs in the last bits of one impact
-//! (another libm, or the same roots found from another instant) has another impact count and
-//! other late-time metrics after a few seconds, though its early ones agree. So `--update`
+//! A chaotic run amplifies round-off: a bed of balls that differs in the last bits of one
+//! impact (another libm, or the same roots found from another instant) has another impact count
+//! and other late-time metrics after a few seconds, though its early ones agree. So `--update`
 //! measures how far each of the reference's values moves when the scene's restitution moves by
-//! round-off's size (`PROBES` runs, each `e` moved by a further 1e-15 of itself), and keeps the root mean
-//! square of those moves as the value's spread where `SPREAD_FACTOR` spreads exceed the exact
-//! tolerance. The value's tolerance is then that many spreads: late-time values of a chaotic
-//! scene are compared as members of their distribution, and every other value exactly as
-//! before.
+//! round-off's size (`PROBES` runs, each `e` moved by a further 1e-15 of itself), and keeps the
+//! root mean square of those moves as the value's spread where `SPREAD_FACTOR` spreads exceed
+//! the exact tolerance. The value's tolerance is then that many spreads: late-time values of a
+//! chaotic scene are compared as members of their distribution, and every other value exactly
+//! as before.
 
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
@@ -157,8 +157,8 @@ fn run_case(scene: &scene::Scene, model: Model) -> Result<Golden, StudyError> {
 
 /// The spread of each of `golden`'s values over `PROBES` runs of `scene` with the restitution
 /// moved by round-off's size (towards the inside of [0, 1]; a plastic scene's not at all),
-/// where it widens the value's tolerance. A value a probe does not have (a run that stops where the golden's did not) is
-/// left out of that probe.
+/// where it widens the value's tolerance. A value a probe does not have (a run that stops
+/// where the golden's did not) is left out of that probe.
 fn spread(golden: &Golden, scene: &scene::Scene, model: Model) -> Result<BTreeMap<String, f64>, StudyError> {
     let nominal = kept_values(golden);
     let mut squares = vec![(0.0, 0usize); nominal.len()];
