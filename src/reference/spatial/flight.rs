@@ -142,7 +142,8 @@ fn sign_changes(c: &[f64], limit: f64) -> Few {
             continue;
         }
         let rising = fh > 0.0;
-        let after = |t: f64| (eval(c, t) > 0.0) == rising;
+        let past = |f: f64| (f > 0.0) == rising;
+        let after = |t: f64| past(eval(c, t));
         if degree == 1 {
             // A line changes sign at -c0 / c1 to an ulp or two, and its values in floating
             // point are monotone: narrowed to the floats around it, the bisection below ends
@@ -159,33 +160,37 @@ fn sign_changes(c: &[f64], limit: f64) -> Few {
             }
         } else {
             // A cubic or a quartic: Newton's steps from the piece's ends, kept in the bracket.
-            let guess;
-            (l, h, guess) = newton(c, d.as_slice(), (l, h), fl, fh, |f| (f > 0.0) == rising);
-            (l, h) = narrow(l, h, guess, after);
+            (l, h) = newton(c, d.as_slice(), (l, h), fl, fh, past);
         }
-        for _ in 0..200 {
-            let m = 0.5 * (l + h);
-            if m <= l || m >= h {
-                break;
-            }
-            if after(m) {
-                h = m;
-            } else {
-                l = m;
-            }
-        }
-        roots.push(h);
+        roots.push(bisect(l, h, after));
     }
     roots
 }
 
+/// The bracket `[l, h]` of a sign change (`after` false at `l`, true at `h`) halved until its
+/// ends are neighbouring floats: the first float past the change.
+fn bisect(mut l: f64, mut h: f64, after: impl Fn(f64) -> bool) -> f64 {
+    for _ in 0..200 {
+        let m = 0.5 * (l + h);
+        if m <= l || m >= h {
+            break;
+        }
+        if after(m) {
+            h = m;
+        } else {
+            l = m;
+        }
+    }
+    h
+}
+
 /// Newton's steps on the bracket `(l, h)` of a sign change of the polynomial `c`, monotone on
-/// it, with `d` its derivative, `fl` and `fh` its values at the ends and `after` true of the
+/// it, with `d` its derivative, `fl` and `fh` its values at the ends and `past` true of the
 /// values past the change: each step keeps the bracket by the sign of the value at its point,
 /// and a step that would leave the bracket takes the midpoint instead. They stop when a step
-/// moves by no more than a few ulps, or after `NEWTON_STEPS`; returned are the bracket and the
-/// last point, where the sign change is to round-off when the steps converged.
-fn newton(c: &[f64], d: &[f64], (mut l, mut h): (f64, f64), fl: f64, fh: f64, after: impl Fn(f64) -> bool) -> (f64, f64, f64) {
+/// moves by no more than a few ulps, or after `NEWTON_STEPS`; the bracket is then narrowed
+/// around the last point, where the sign change is to round-off when the steps converged.
+fn newton(c: &[f64], d: &[f64], (mut l, mut h): (f64, f64), fl: f64, fh: f64, past: impl Fn(f64) -> bool) -> (f64, f64) {
     // The secant's point first: it is inside the bracket, and on a short piece already close.
     let mut t = l + (h - l) * (fl / (fl - fh));
     if !(t > l && t < h) {
@@ -193,7 +198,7 @@ fn newton(c: &[f64], d: &[f64], (mut l, mut h): (f64, f64), fl: f64, fh: f64, af
     }
     for _ in 0..NEWTON_STEPS {
         let f = eval(c, t);
-        if after(f) {
+        if past(f) {
             h = t;
         } else {
             l = t;
@@ -211,7 +216,7 @@ fn newton(c: &[f64], d: &[f64], (mut l, mut h): (f64, f64), fl: f64, fh: f64, af
             break;
         }
     }
-    (l, h, t)
+    narrow(l, h, t, |t| past(eval(c, t)))
 }
 
 /// Newton's steps at most, before the bisection finishes: from the secant's point a step
@@ -269,21 +274,9 @@ fn first_fall(c: &[f64], limit: f64) -> Option<f64> {
             // less than round-off): in contact again from the top of the rise.
             return Some(l);
         }
-        let guess;
-        (l, h, guess) = newton(c, d, (l, h), fl, fh, |f| f <= 0.0);
-        (l, h) = narrow(l, h, guess, |t| eval(c, t) <= 0.0);
-        for _ in 0..200 {
-            let m = 0.5 * (l + h);
-            if m <= l || m >= h {
-                break;
-            }
-            if eval(c, m) > 0.0 {
-                l = m;
-            } else {
-                h = m;
-            }
-        }
-        return Some(h);
+        let fallen = |f: f64| !(f > 0.0);
+        (l, h) = newton(c, d, (l, h), fl, fh, fallen);
+        return Some(bisect(l, h, |t| fallen(eval(c, t))));
     }
     None
 }
