@@ -180,9 +180,7 @@ fn spread(golden: &Golden, scene: &scene::Scene, model: Model) -> Result<BTreeMa
         .filter(|(_, (_, n))| *n > 0)
         .filter_map(|((name, kind, v0), (sum, n))| {
             let rms = (sum / n as f64).sqrt();
-            let (rel, abs) = tolerance(model, *kind);
-            let exact = abs.max(rel * v0.unwrap_or(0.0).abs());
-            (SPREAD_FACTOR * rms > exact).then(|| (name.clone(), rms))
+            (SPREAD_FACTOR * rms > exact_tolerance(model, *kind, v0.unwrap_or(0.0))).then(|| (name.clone(), rms))
         })
         .collect())
 }
@@ -215,6 +213,13 @@ const GOLDEN_METRICS: [Metric; 7] = [
     Metric::PeakContactForce,
     Metric::PeakTrueAcceleration,
 ];
+
+/// How far a value of one metric may move from `golden` without a spread: the larger of the
+/// model's absolute tolerance and its relative one of `golden`.
+fn exact_tolerance(model: Model, metric: Option<Metric>, golden: f64) -> f64 {
+    let (rel, abs) = tolerance(model, metric);
+    abs.max(rel * golden.abs())
+}
 
 /// Tolerance of one metric (`None`: a KER row) for a model: `(relative, absolute)`.
 fn tolerance(model: Model, metric: Option<Metric>) -> (f64, f64) {
@@ -259,17 +264,13 @@ pub fn compare(now: &Golden, golden: Option<&Golden>) -> Vec<Row> {
         .enumerate()
         .map(|(i, (metric, kind, value))| {
             let g = golden_values.as_ref().and_then(|gv| gv.get(i).filter(|(m, ..)| *m == metric).map(|(.., v)| *v));
-            let (rel, abs) = tolerance(now.model, kind);
             let spread = golden.and_then(|g| g.spread.get(&metric)).map_or(0.0, |s| SPREAD_FACTOR * s);
-            let abs = abs.max(spread);
+            let allowed = |gv: f64| exact_tolerance(now.model, kind, gv).max(spread);
             let (golden, ok, tol) = match (g, value) {
-                (None, _) => (None, false, abs),
-                (Some(None), None) => (None, true, abs),
-                (Some(Some(gv)), Some(v)) => {
-                    let tol = abs.max(rel * gv.abs());
-                    (Some(gv), (v - gv).abs() <= tol, tol)
-                }
-                (Some(gv), _) => (gv, false, abs),
+                (None, _) => (None, false, allowed(0.0)),
+                (Some(None), None) => (None, true, allowed(0.0)),
+                (Some(Some(gv)), Some(v)) => (Some(gv), (v - gv).abs() <= allowed(gv), allowed(gv)),
+                (Some(gv), _) => (gv, false, allowed(0.0)),
             };
             Row { case: now.case.clone(), model: now.model, metric, golden, now: value, tolerance: tol, ok }
         })
