@@ -229,6 +229,7 @@ mod tests {
             initial_positions: positions,
             horizon: 1.0,
             sample_dt: 1e-3,
+            reference: Default::default(),
             rapier: Default::default(),
             compliant: Default::default(),
             forcing: None,

@@ -305,8 +305,9 @@ impl Solver<'_> {
                 // With e = 0 a touching approaching run ends as one body: merge it at once
                 // instead of converging to that through a geometric series of impulses.
                 // A pair striking again within a contact duration is in persistent contact.
-                let repeats_within_contact = self.ledger.last_impact[p]
-                    .is_some_and(|k| self.ledger.impacts[k].t < self.t && self.t - self.ledger.impacts[k].t < CONTACT_DURATION);
+                let repeats_within_contact = self.ledger.last_impact[p].is_some_and(|k| {
+                    self.ledger.impacts[k].t < self.t && self.t - self.ledger.impacts[k].t < self.scene.reference.contact_duration
+                });
                 if self.e > 0.0
                     && u >= self.limits.v_stick
                     && !bounce_returns_fast

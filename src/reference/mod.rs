@@ -42,14 +42,6 @@ use crate::scene::{Body, Scene};
 
 /// Most events one run may process before it is declared stalled.
 pub const MAX_EVENTS: u64 = 20_000_000;
-/// Shortest time between two impacts of one pair that are resolved as separate impacts, s.
-///
-/// The impulse model treats impacts as instantaneous, which holds only while they are further
-/// apart than a real contact lasts (tens of microseconds for centimetre steel balls at these
-/// speeds). Closer repeats, such as a light elastic ball squeezed between two heavy ones
-/// (whose bounce rate grows without bound as the gap closes), are persistent contact: the
-/// touching run is merged, with the energy booked as an impact loss.
-pub const CONTACT_DURATION: f64 = 1e-6;
 /// Most events at one instant: everything at an instant is resolved by one `resolve`, so a
 /// second event at the same time already means two judgements disagree.
 const MAX_EVENTS_PER_INSTANT: u64 = 1000;

@@ -20,6 +20,9 @@ pub struct SceneFile {
     /// Run settings.
     #[serde(default)]
     pub run: RunFile,
+    /// Settings of the reference model.
+    #[serde(default)]
+    pub reference: ReferenceFile,
     /// Settings of the Rapier model.
     #[serde(default)]
     pub rapier: RapierFile,
@@ -259,6 +262,14 @@ pub struct RunFile {
     pub horizon: Option<f64>,
     /// Output sampling step, s (default 1 ms).
     pub sample_dt: Option<f64>,
+}
+
+/// `[reference]`: settings of the exact event-driven model.
+#[derive(Debug, Clone, Deserialize, Serialize, Default)]
+#[serde(deny_unknown_fields)]
+pub struct ReferenceFile {
+    /// The collapse rule's contact duration `t_c`, s (default 1e-6).
+    pub contact_duration: Option<f64>,
 }
 
 /// `[rapier]`: settings of the contact model.

@@ -25,7 +25,7 @@ pub use parameters::{Parameter, Tolerances};
 pub use placement::{move_placed_balls, MAX_BED_BALLS};
 pub use record::GroundRecord;
 pub use rules::{from_file, validate_sample_dt};
-pub use settings::{CompliantSettings, RapierSettings, DEFAULT_COMPLIANT_TOLERANCE};
+pub use settings::{CompliantSettings, RapierSettings, ReferenceSettings, DEFAULT_COMPLIANT_TOLERANCE, DEFAULT_CONTACT_DURATION};
 pub use space::Space;
 pub use structure::{FloorForce, Frame, Structure};
 
@@ -92,6 +92,8 @@ pub struct Scene {
     pub horizon: f64,
     /// Output sampling step, s.
     pub sample_dt: f64,
+    /// Reference model settings from the file.
+    pub reference: ReferenceSettings,
     /// Rapier model settings from the file.
     pub rapier: RapierSettings,
     /// Compliant model material.

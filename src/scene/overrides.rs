@@ -100,13 +100,14 @@ impl Overrides {
     }
 }
 
-/// `file` with the run, Rapier, compliant and forcing settings of `scene` (built from it, perhaps with
+/// `file` with the run, reference, Rapier, compliant and forcing settings of `scene` (built from it, perhaps with
 /// [`Overrides`]): what a study that varies the file's other parameters rebuilds from, so that
 /// the command line's settings hold for every variant.
 pub fn with_settings_of(file: &SceneFile, scene: &Scene) -> SceneFile {
     let r = scene.rapier;
     SceneFile {
         run: format::RunFile { horizon: Some(scene.horizon), sample_dt: Some(scene.sample_dt) },
+        reference: format::ReferenceFile { contact_duration: Some(scene.reference.contact_duration) },
         rapier: format::RapierFile { stepping: r.stepping, dt: r.dt, solver_iterations: r.solver_iterations, ccd: r.ccd },
         compliant: format::CompliantFile {
             youngs_modulus: Some(scene.compliant.youngs_modulus),

@@ -8,7 +8,7 @@ use super::format::{ExcitationKind, ForcingKind};
 use super::geometry::{ball_radius, Ball, BallKind, Container};
 use super::parameters::{Parameter, Tolerances};
 use super::record::{is_at2, read_points, GroundRecord, KanaiTajimi};
-use super::settings::{CompliantSettings, RapierSettings};
+use super::settings::{CompliantSettings, RapierSettings, ReferenceSettings};
 use super::space::Space;
 use super::structure::{FloorForce, Frame, Structure};
 use super::{human, ChainCase, Loaded, Scene, SceneError, CHAIN_HORIZON, DEFAULT_HORIZON, DEFAULT_SAMPLE_DT, MAX_SAMPLES};
@@ -31,7 +31,7 @@ pub fn from_file(parsed: SceneFile, file: &str, default_name: &str) -> Result<Lo
         (false, Some(_)) => None,
     };
     let chain = match &parsed.chain {
-        Some(c) => Some(build_chain(c, &parsed.run, &name, &v)?),
+        Some(c) => Some(build_chain(c, &parsed.run, reference_settings(&parsed.reference, &v)?, &name, &v)?),
         None => None,
     };
     if let (Some(sweep), Some(_)) = (&parsed.sweep, &scene) {
@@ -403,6 +403,7 @@ fn build_frame_damper(f: &SceneFile, name: &str, v: &Validator) -> Result<Scene,
         damping: v.non_negative("frame.damping", fr.damping)?,
     };
     let (horizon, sample_dt) = v.run(&f.run, DEFAULT_HORIZON)?;
+    let reference = reference_settings(&f.reference, v)?;
     let rapier = rapier_settings(&f.rapier, v)?;
     let compliant = compliant_settings(&f.compliant, v)?;
     let forcing = match &f.forcing {
@@ -419,7 +420,7 @@ fn build_frame_damper(f: &SceneFile, name: &str, v: &Validator) -> Result<Scene,
         return Err(v.err(given[1], &format!("cannot be combined with [{}]: give the balls one way", given[0])));
     }
     if f.balls.is_none() && (f.bed.is_some() || f.explicit_balls.is_some()) {
-        let settings = Settings { horizon, sample_dt, rapier, compliant, forcing };
+        let settings = Settings { horizon, sample_dt, reference, rapier, compliant, forcing };
         return placed_damper(f, name, v, frame, world, settings);
     }
     let Some(b) = &f.balls else {
@@ -441,6 +442,7 @@ fn build_frame_damper(f: &SceneFile, name: &str, v: &Validator) -> Result<Scene,
             initial_velocities: vec![],
             horizon,
             sample_dt,
+            reference,
             rapier,
             compliant,
             forcing,
@@ -510,6 +512,7 @@ fn build_frame_damper(f: &SceneFile, name: &str, v: &Validator) -> Result<Scene,
         initial_positions: positions,
         horizon,
         sample_dt,
+        reference,
         rapier,
         compliant,
         forcing,
@@ -629,6 +632,7 @@ fn chains(
 struct Settings {
     horizon: f64,
     sample_dt: f64,
+    reference: ReferenceSettings,
     rapier: RapierSettings,
     compliant: CompliantSettings,
     forcing: Option<Forcing>,
@@ -687,6 +691,7 @@ fn placed_damper(f: &SceneFile, name: &str, v: &Validator, frame: Frame, world: 
         initial_displacement: xs0,
         horizon: s.horizon,
         sample_dt: s.sample_dt,
+        reference: s.reference,
         rapier: s.rapier,
         compliant: s.compliant,
         forcing: s.forcing,
@@ -694,6 +699,25 @@ fn placed_damper(f: &SceneFile, name: &str, v: &Validator, frame: Frame, world: 
         space,
         structure: None,
     })
+}
+
+/// The most a contact duration may be, s: a contact lasting longer is no impact.
+const LONGEST_CONTACT_DURATION: f64 = 1e-2;
+
+pub(super) fn reference_settings(r: &format::ReferenceFile, v: &Validator) -> Result<ReferenceSettings, SceneError> {
+    let d = ReferenceSettings::default();
+    let contact_duration = v.positive("reference.contact_duration", r.contact_duration.unwrap_or(d.contact_duration))?;
+    if contact_duration > LONGEST_CONTACT_DURATION {
+        return Err(v.err(
+            "reference.contact_duration",
+            &format!(
+                "must lie in (0, {}] s: a contact lasting longer is no impact (got {})",
+                human(LONGEST_CONTACT_DURATION),
+                human(contact_duration)
+            ),
+        ));
+    }
+    Ok(ReferenceSettings { contact_duration })
 }
 
 pub(super) fn compliant_settings(c: &format::CompliantFile, v: &Validator) -> Result<CompliantSettings, SceneError> {
@@ -798,7 +822,13 @@ pub(super) fn arrangement_balls(
     Ok(balls)
 }
 
-pub(super) fn build_chain(c: &format::ChainFile, run: &format::RunFile, name: &str, v: &Validator) -> Result<Vec<ChainCase>, SceneError> {
+pub(super) fn build_chain(
+    c: &format::ChainFile,
+    run: &format::RunFile,
+    reference: ReferenceSettings,
+    name: &str,
+    v: &Validator,
+) -> Result<Vec<ChainCase>, SceneError> {
     let large_mass = v.positive("chain.large_mass", c.large_mass)?;
     let mass_ratio = v.positive("chain.mass_ratio", c.mass_ratio)?;
     let density = v.positive("chain.density", c.density)?;
@@ -853,6 +883,7 @@ pub(super) fn build_chain(c: &format::ChainFile, run: &format::RunFile, name: &s
                     initial_velocities: velocities,
                     horizon,
                     sample_dt,
+                    reference,
                     rapier: RapierSettings::default(),
                     compliant: CompliantSettings::default(),
                     forcing: None,

@@ -142,6 +142,9 @@ fn impossible_forcing_and_material() {
     expect_error(&resonant, &[], "forcing.frequency", "resonance");
     expect_error(&format!("{GOOD}\n[compliant]\npoisson_ratio = 0.5\n"), &[], "compliant.poisson_ratio", "(-1, 0.5)");
     expect_error(&format!("{GOOD}\n[compliant]\nyoungs_modulus = -2e11\n"), &[], "compliant.youngs_modulus", "positive");
+    for (duration, rule) in [("0.0", "positive"), ("nan", "finite"), ("-1e-6", "positive"), ("0.5", "no impact")] {
+        expect_error(&format!("{GOOD}\n[reference]\ncontact_duration = {duration}\n"), &[], "reference.contact_duration", rule);
+    }
 }
 
 #[test]

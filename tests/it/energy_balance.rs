@@ -22,7 +22,7 @@ fn every_paper_scene_balances_energy_and_keeps_balls_inside() {
         });
         let pressing = scene.space.gravity.iter().map(|g| g * g).sum::<f64>().sqrt() + frame_accel;
         let heaviest = scene.balls.iter().map(|b| b.mass).fold(0.0, f64::max);
-        let gain = 0.5 * heaviest * (0.5 * pressing * lpc_damper::reference::CONTACT_DURATION).powi(2);
+        let gain = 0.5 * heaviest * (0.5 * pressing * scene.reference.contact_duration).powi(2);
         assert!(run.impacts.iter().all(|i| i.energy_lost >= -gain), "{}", scene.name);
         // Contact tolerance is 1e-12 of the container length (< 1e-13 m).
         let min_gap = common::min_gap(&scene, &run);

@@ -80,30 +80,39 @@ fn a_ball_pressed_against_a_wall_of_the_frame_is_struck_once_a_contact_duration(
     // One ball with e = 0 on the floor by the right wall of a box on a frame released from
     // 10 mm: the wall strikes it after 5.6 ms and then presses it until the frame passes its
     // rest position (62 ms). The collapse rule gives the pressed contact the separation speed
-    // a t_c / 2, which keeps it open for a contact duration (docs/MODEL.md §14): the run goes on.
-    let mut text = box_scene(
-        "gravity = [0.0, 0.0, -9.81]\nrestitution = 0.0",
-        "[[ball]]\nposition = [0.0949, 0.0, -0.045]\nmass = 0.004\nradius = 0.005\n",
-        0.2,
-    );
-    text = text.replace("initial_displacement = 0.0", "initial_displacement = 0.01");
-    let scene = scene_from_toml(&text);
-    let run = reference(&scene).expect("a pressed ball never stalls the run");
-    let t_c = lpc_damper::reference::CONTACT_DURATION;
-    let wall: Vec<f64> = run.impacts.iter().filter(|i| i.b == lpc_damper::scene::Body::RightWall).map(|i| i.t).collect();
-    // The contact opens by a t_c^2 / 8 (1e-12 m), the order of the contact tolerance, so the
-    // search may find it closed again half way: between one and two impacts a contact duration.
-    let pressed = wall.last().unwrap() - wall[0];
-    assert!(pressed > 0.05 && pressed < 0.062, "pressed for {pressed} s");
-    let count = wall.len() as f64;
-    assert!(count >= pressed / t_c && count <= 2.0 * pressed / t_c + 1.0, "{count} impacts in {pressed} s");
-    let shortest = wall.windows(2).map(|w| w[1] - w[0]).fold(f64::INFINITY, f64::min);
-    assert!(shortest >= 0.5 * t_c * (1.0 - 1e-3), "impacts {shortest:e} s apart");
-    // What the rule puts in is booked: the balance closes to a few ulps of the energy at each of
-    // the frame's restarts, and the ball stays in its box.
-    let roundoff = 8.0 * f64::EPSILON * run.impacts.len() as f64;
-    assert!(run.energy.balance_error.abs() <= roundoff, "{:?}", run.energy);
-    assert!(crate::common::min_gap(&scene, &run) >= -1e-12);
+    // a t_c / 2, which keeps it open for a contact duration (docs/MODEL.md §14): the run goes on,
+    // at the default contact duration and at the longer one a scene may set.
+    for t_c in [lpc_damper::scene::DEFAULT_CONTACT_DURATION, 1e-4] {
+        let mut text = box_scene(
+            "gravity = [0.0, 0.0, -9.81]\nrestitution = 0.0",
+            "[[ball]]\nposition = [0.0949, 0.0, -0.045]\nmass = 0.004\nradius = 0.005\n",
+            0.2,
+        );
+        text = text.replace("initial_displacement = 0.0", "initial_displacement = 0.01");
+        text.push_str(&format!("\n[reference]\ncontact_duration = {t_c:e}\n"));
+        let scene = scene_from_toml(&text);
+        assert_eq!(scene.reference.contact_duration, t_c);
+        let run = reference(&scene).expect("a pressed ball never stalls the run");
+        let wall: Vec<f64> = run.impacts.iter().filter(|i| i.b == lpc_damper::scene::Body::RightWall).map(|i| i.t).collect();
+        let pressed = wall.last().unwrap() - wall[0];
+        assert!(pressed > 0.05 && pressed < 0.062, "t_c {t_c:e}: pressed for {pressed} s");
+        // The contact opens by a t_c^2 / 8 (1e-12 m at a microsecond, the order of the contact
+        // tolerance), so the search may find it closed again half way: strikes come between
+        // half a contact duration and one apart. The frame's pressing falls as it nears its rest
+        // position, by some w0 t_c = 2.5e-3 of itself over a contact duration mid-way (w0 = 25
+        // rad/s) and to nothing at the end, which lengthens the last strikes' intervals: the
+        // median interval is a contact duration to a hundredth.
+        let mut intervals: Vec<f64> = wall.windows(2).map(|w| w[1] - w[0]).collect();
+        intervals.sort_by(f64::total_cmp);
+        let (shortest, median) = (intervals[0], intervals[intervals.len() / 2]);
+        assert!(shortest >= 0.5 * t_c * (1.0 - 1e-3), "t_c {t_c:e}: impacts {shortest:e} s apart");
+        assert!(median <= t_c * (1.0 + 1e-2), "t_c {t_c:e}: impacts {median:e} s apart at the median");
+        // What the rule puts in is booked: the balance closes to a few ulps of the energy at each
+        // of the frame's restarts, and the ball stays in its box.
+        let roundoff = 8.0 * f64::EPSILON * run.impacts.len() as f64;
+        assert!(run.energy.balance_error.abs() <= roundoff, "t_c {t_c:e}: {:?}", run.energy);
+        assert!(crate::common::min_gap(&scene, &run) >= -1e-12);
+    }
 }
 
 #[test]

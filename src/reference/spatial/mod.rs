@@ -20,7 +20,7 @@ use std::collections::BinaryHeap;
 use super::frame::FrameMotion;
 use super::frame_gap::{FrameGap, FrameReach};
 use super::geometry::Limits;
-use super::{CONTACT_DURATION, MAX_EVENTS};
+use super::MAX_EVENTS;
 use crate::impact_law::{reduced_mass, separate};
 use crate::model::{Meter, Model, ModelError, OverBudget, RunOptions, STALL_EVENTS_PER_SIM_S};
 use crate::run::{EnergyAccount, Impact, Recorder, Run};
@@ -39,7 +39,7 @@ const BUDGET_EVENTS: u64 = 4096;
 /// three with walls, each struck at most once a contact duration while it is pressed (the
 /// collapse rule, docs/MODEL.md §14).
 pub(super) fn stall_rate(scene: &Scene) -> f64 {
-    STALL_EVENTS_PER_SIM_S + 9.0 * scene.balls.len() as f64 / CONTACT_DURATION
+    STALL_EVENTS_PER_SIM_S + 9.0 * scene.balls.len() as f64 / scene.reference.contact_duration
 }
 
 /// Why the spatial reference cannot run `scene`, or `None` when it can.
@@ -128,9 +128,9 @@ impl Ord for Entry {
 /// The collapse rule's separation speed for a contact closing at `approach` (negative when
 /// it opens) under the acceleration `pressing` (positive when it closes it), with
 /// restitution `e`: `e approach`, but never less than the speed that keeps a pressed contact
-/// open for a contact duration. `None` when the contact opens fast enough by itself.
-fn separation(approach: f64, pressing: f64, e: f64) -> Option<f64> {
-    let keep_open = if pressing > 0.0 { 0.5 * pressing * CONTACT_DURATION } else { 0.0 };
+/// open for the contact duration `t_c`. `None` when the contact opens fast enough by itself.
+fn separation(approach: f64, pressing: f64, e: f64, t_c: f64) -> Option<f64> {
+    let keep_open = if pressing > 0.0 { 0.5 * pressing * t_c } else { 0.0 };
     if approach > 0.0 {
         Some((e * approach).max(keep_open))
     } else if -approach < keep_open {
@@ -193,6 +193,8 @@ struct Solver<'a> {
     searching: Vec<(u32, u8)>,
     gravity: [f64; 3],
     e: f64,
+    /// The collapse rule's contact duration, s.
+    t_c: f64,
     length: f64,
     t: f64,
     horizon: f64,
@@ -376,6 +378,7 @@ impl<'a> Solver<'a> {
             searching: Vec::new(),
             gravity: scene.space.gravity,
             e: scene.restitution,
+            t_c: scene.reference.contact_duration,
             length: container.length,
             t: 0.0,
             horizon: scene.horizon,
@@ -697,7 +700,7 @@ impl<'a> Solver<'a> {
     /// The elastic rule of the TC model: `e`, or 1 within the contact duration of either
     /// ball's previous impact.
     fn restitution(&self, i: usize, j: Option<usize>) -> f64 {
-        let recent = |k: usize| self.t - self.balls[k].last_impact < CONTACT_DURATION;
+        let recent = |k: usize| self.t - self.balls[k].last_impact < self.t_c;
         if recent(i) || j.is_some_and(recent) {
             1.0
         } else {
@@ -771,7 +774,8 @@ impl<'a> Solver<'a> {
                 // Two balls each pushed square into its wall cannot move along `n`.
                 let movable = mi.is_finite() || mj.is_finite();
                 let mut struck = false;
-                if let Some(after) = separation(approach, pressing, self.restitution(i, Some(j))).filter(|_| touching && movable) {
+                if let Some(after) = separation(approach, pressing, self.restitution(i, Some(j)), self.t_c).filter(|_| touching && movable)
+                {
                     let (wi, wj) = separate(mi, ui, mj, uj, after);
                     let impulse = if mj.is_finite() { mj * (wj - uj) } else { mi * (ui - wi) };
                     for k in 0..3 {
@@ -800,7 +804,7 @@ impl<'a> Solver<'a> {
                     let after = e * approach;
                     let half = self.cells.half[axis - 1];
                     let ball = &mut self.balls[i];
-                    let rests = pressed > 0.0 && 2.0 * after < pressed * CONTACT_DURATION;
+                    let rests = pressed > 0.0 && 2.0 * after < pressed * self.t_c;
                     let lost = if rests {
                         // Its next bounce would come back within a contact duration: it rests,
                         // its centre on the wall's contact plane.
@@ -834,7 +838,7 @@ impl<'a> Solver<'a> {
                 let (xs, vs, accel) = self.frame.now(self.t);
                 let b = self.balls[i];
                 let approach = side * (vs - b.v[0]);
-                if let Some(after) = separation(approach, side * accel, self.restitution(i, None)) {
+                if let Some(after) = separation(approach, side * accel, self.restitution(i, None), self.t_c) {
                     // The wall on the left (`side > 0`) leaves the ball behind it, the right one ahead.
                     let (vb, vf) = separate(b.mass, b.v[0], self.frame.mass, vs, -side * after);
                     let lost = 0.5 * reduced_mass(b.mass, self.frame.mass) * (approach * approach - after * after);
