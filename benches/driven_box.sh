@@ -3,17 +3,22 @@
 # amplitudes A of its drive, at a fixed gap G = 30 mm; each model's energy taken by the impacts
 # per cycle over the last ten of twenty cycles, in units of m_bed (A w)^2, against G / A, with
 # the ideal block's (1 - cos theta)^2, theta - sin theta = G / A (for G / A <= pi). A run that
-# takes more than MAX_WALL_S of computing stops and is reported as stopped.
-#   bash benches/driven_box.sh [LPC] [MODELS] [MAX_WALL_S]
-#   (default: target/release/lpc, "compliant reference rapier", 60)
+# takes more than MAX_WALL_S of computing stops and is reported as stopped. CONTACT_DURATION,
+# if given, is the reference's `[reference] contact_duration` (docs/MODEL.md §14).
+#   bash benches/driven_box.sh [LPC] [MODELS] [MAX_WALL_S] [CONTACT_DURATION]
+#   (default: target/release/lpc, "compliant reference rapier", 60, the scene's)
 set -euo pipefail
 lpc=${1:-target/release/lpc}
 models=${2:-compliant reference rapier}
 budget=${3:-60}
+contact_duration=${4:-}
 dir=$(mktemp -d)
 amplitudes="0.06 0.03 0.015 0.00955 0.006 0.004 0.003 0.002 0.0015"
 for a in $amplitudes; do
   sed "s/^amplitude = [0-9.]*/amplitude = $a/" benches/driven-box.toml > "$dir/box-$a.toml"
+  if [ -n "$contact_duration" ]; then
+    printf '\n[reference]\ncontact_duration = %s\n' "$contact_duration" >> "$dir/box-$a.toml"
+  fi
   for m in $models; do
     "$lpc" run "$dir/box-$a.toml" --model "$m" --max-wall-time "$budget" --format json > "$dir/$m-$a.json" 2> /dev/null || true
   done
