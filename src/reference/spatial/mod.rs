@@ -649,7 +649,11 @@ impl<'a> Solver<'a> {
                 return Ok(Some(budget));
             }
             if self.events > MAX_EVENTS {
-                return Err(self.stalled(format!("more than {MAX_EVENTS} events")));
+                return Err(self.stalled(format!(
+                    "more than {MAX_EVENTS} events, {:.3e} per simulated second; a pile or a bed pressed against a wall has each pressed contact struck about once a contact duration (docs/MODEL.md §14, here {} s): a longer `[reference] contact_duration` makes it cheaper",
+                    self.events as f64 / self.t,
+                    crate::scene::human(self.t_c)
+                )));
             }
             self.resolve(entry)?;
             if self.calendar.len() + self.frame_calendar.len() > 64 * self.balls.len() + 4096 {
