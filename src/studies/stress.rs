@@ -71,7 +71,8 @@ pub struct Draws {
 /// 2 to 200 balls of one or two sizes (radii 2 to 8 mm) filling 20 to 70 % of the cells of a
 /// lattice in a box sized to hold them (up to twice as long), on the lattice or (at most 40 %
 /// of the cells) at random; gravity along -z three times in four; friction 0 to 0.5 (none a
-/// quarter of the time); the drawn restitution, frame and forcing.
+/// quarter of the time); the reference's contact duration the default half the time, else 1 us
+/// to 0.25 ms (log-uniform); the drawn restitution, frame and forcing.
 pub fn with_bed(mut file: SceneFile, seed: u64) -> SceneFile {
     let mut rng = Pcg64::seed_from_u64(seed ^ 0xbed0_0000_0000_0000);
     let Some(balls) = file.balls.take() else { return file };
@@ -93,6 +94,10 @@ pub fn with_bed(mut file: SceneFile, seed: u64) -> SceneFile {
     file.world = Some(WorldFile { gravity: Some(gravity), friction: Some(friction), restitution: Some(balls.restitution) });
     file.bed =
         Some(BedFile { count: Some(count), fill_fraction: None, radii, proportions: None, density: 7800.0, placement, seed: Some(seed) });
+    // Drawn last, so that every draw before it is what it was before the contact duration was.
+    if rng.random_bool(0.5) {
+        file.reference.contact_duration = Some((rng.random_range(1e-6f64.ln()..2.5e-4f64.ln())).exp());
+    }
     // A bed has no reference radius: the displacement drawn in Rr is put in metres.
     if let Some(frame) = file.frame.as_mut() {
         frame.initial_displacement = Length::Metres(frame.initial_displacement.metres(crate::scene::ball_radius(0.11, 8000.0)));
