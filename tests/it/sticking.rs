@@ -101,3 +101,41 @@ fn stiff_and_soft_frames() {
         check(&scene, 1_000_000);
     }
 }
+
+#[test]
+fn a_longer_contact_duration_merges_a_squeeze_sooner() {
+    // A light ball (660 times lighter) between a heavy one and the wall bounces ever faster as
+    // the heavy one closes in; a pair that strikes again within the contact duration `t_c` is
+    // merged (docs/MODEL.md §4). Up to the first repeat within the longer duration the two runs
+    // are the same impacts; there the longer one merges and the default goes on bouncing.
+    let text = r#"
+        [frame]
+        mass = 1.35
+        stiffness = 3366.652256466029
+        damping = 0.0
+        initial_displacement = "-0.4986277621334814 Rr"
+        [balls]
+        arrangement = "LS"
+        large_mass = 0.11
+        mass_ratio = 661.7318540906778
+        density = 8000.0
+        restitution = 0.9
+        gap = "0.25 Rr"
+        clearance = "0 Rr"
+        [run]
+        horizon = 0.061902355482029985
+        sample_dt = 0.0001
+    "#;
+    let short = scene_from_toml(text);
+    let mut long = short.clone();
+    long.reference.contact_duration = 1e-4;
+    let (by_default, by_long) = (check(&short, 10_000), check(&long, 10_000));
+    let first_repeat = (1..by_default.impacts.len())
+        .find(|&k| {
+            let i = &by_default.impacts[k];
+            by_default.impacts[..k].iter().rev().find(|p| (p.a, p.b) == (i.a, i.b)).is_some_and(|p| i.t - p.t < 1e-4)
+        })
+        .expect("the squeeze repeats within 0.1 ms");
+    assert!(by_long.impacts.len() < by_default.impacts.len());
+    assert_eq!(by_long.impacts[..first_repeat], by_default.impacts[..first_repeat]);
+}
