@@ -116,6 +116,10 @@ def test_a_bad_field_raises_scene_error_with_the_cli_message(lpc_bin, scenes, tm
     with pytest.raises(lpc.SceneError, match="balls.restitution"):
         lpc.Scene.from_dict(d)
     d = lpc.load_scene(scenes / "lpc-lsl.toml").to_dict()
+    d["reference"] = {"contact_duration": 0.5}
+    with pytest.raises(lpc.SceneError, match="reference.contact_duration"):
+        lpc.Scene.from_dict(d)
+    d = lpc.load_scene(scenes / "lpc-lsl.toml").to_dict()
     d["frame"]["colour"] = "red"
     with pytest.raises(lpc.SceneError, match="colour"):
         lpc.Scene.from_dict(d)
