@@ -104,29 +104,12 @@ fn stiff_and_soft_frames() {
 
 #[test]
 fn a_longer_contact_duration_merges_a_squeeze_sooner() {
-    // A light ball (660 times lighter) between a heavy one and the wall bounces ever faster as
-    // the heavy one closes in; a pair that strikes again within the contact duration `t_c` is
-    // merged (docs/MODEL.md §4). Up to the first repeat within the longer duration the two runs
-    // are the same impacts; there the longer one merges and the default goes on bouncing.
-    let text = r#"
-        [frame]
-        mass = 1.35
-        stiffness = 3366.652256466029
-        damping = 0.0
-        initial_displacement = "-0.4986277621334814 Rr"
-        [balls]
-        arrangement = "LS"
-        large_mass = 0.11
-        mass_ratio = 661.7318540906778
-        density = 8000.0
-        restitution = 0.9
-        gap = "0.25 Rr"
-        clearance = "0 Rr"
-        [run]
-        horizon = 0.061902355482029985
-        sample_dt = 0.0001
-    "#;
-    let short = scene_from_toml(text);
+    // A light ball (660 times lighter) between a heavy one and the wall (the regression scene of
+    // issue 6) bounces ever faster as the heavy one closes in; a pair that strikes again within
+    // the contact duration `t_c` is merged (docs/MODEL.md §4). Up to the first repeat within the
+    // longer duration the two runs are the same impacts; there the longer one merges and the
+    // default goes on bouncing.
+    let short = scene_from_toml(crate::regressions::squeezed_ball_stops::SCENE);
     let mut long = short.clone();
     long.reference.contact_duration = 1e-4;
     let (by_default, by_long) = (check(&short, 10_000), check(&long, 10_000));

@@ -21,7 +21,7 @@ mod record_point_inside_step;
 mod resting_ball_without_energy;
 mod series_beyond_memory;
 mod spatial_series_read_back;
-mod squeezed_ball_stops;
+pub(crate) mod squeezed_ball_stops;
 mod stale_impulse_bounce;
 mod stiff_frame_rapier_step;
 mod summary_without_bare_floors;

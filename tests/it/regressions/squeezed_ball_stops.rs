@@ -12,7 +12,8 @@ use lpc_damper::model::ModelError;
 use lpc_damper::model::RunOptions;
 use lpc_damper::Model;
 
-const SCENE: &str = r#"
+/// A light ball squeezed between a heavy one and the wall (mass ratio 660, e = 0.9).
+pub const SCENE: &str = r#"
 name = "stress-174"
 [frame]
 mass = 1.35
