@@ -269,7 +269,10 @@ pub fn compare(now: &Golden, golden: Option<&Golden>) -> Vec<Row> {
             let (golden, ok, tol) = match (g, value) {
                 (None, _) => (None, false, allowed(0.0)),
                 (Some(None), None) => (None, true, allowed(0.0)),
-                (Some(Some(gv)), Some(v)) => (Some(gv), (v - gv).abs() <= allowed(gv), allowed(gv)),
+                (Some(Some(gv)), Some(v)) => {
+                    let tol = allowed(gv);
+                    (Some(gv), (v - gv).abs() <= tol, tol)
+                }
                 (Some(gv), _) => (gv, false, allowed(0.0)),
             };
             Row { case: now.case.clone(), model: now.model, metric, golden, now: value, tolerance: tol, ok }
