@@ -100,9 +100,9 @@ impl Overrides {
     }
 }
 
-/// `file` with the run, reference, Rapier, compliant and forcing settings of `scene` (built from it, perhaps with
-/// [`Overrides`]): what a study that varies the file's other parameters rebuilds from, so that
-/// the command line's settings hold for every variant.
+/// `file` with the run, reference, Rapier, compliant and forcing settings of `scene` (built
+/// from it, perhaps with [`Overrides`]): what a study that varies the file's other parameters
+/// rebuilds from, so that the command line's settings hold for every variant.
 pub fn with_settings_of(file: &SceneFile, scene: &Scene) -> SceneFile {
     let r = scene.rapier;
     SceneFile {
