@@ -156,7 +156,8 @@ pub struct SpatialReport {
     pub steps: u64,
     /// Impacts found as new contacts.
     pub new_contact_impacts: u64,
-    /// Impacts of touching pairs the new ones set approaching.
+    /// Impacts of touching pairs the new ones set approaching, and of those that touch and
+    /// approach at the start.
     pub knock_on_impacts: u64,
 }
 
@@ -180,6 +181,19 @@ impl BallState {
             self.x[k] = [p.x as f64, p.y as f64, p.z as f64];
             self.v[k] = [v.x as f64, v.y as f64, v.z as f64];
             self.w[k] = [w.x as f64, w.y as f64, w.z as f64];
+        }
+    }
+
+    /// Gives Rapier the velocities of the balls marked in `which`, keeping what it will read
+    /// back (the `f32` velocity).
+    fn write_velocities(&mut self, bodies: &mut RigidBodySet, handles: &[RigidBodyHandle], which: &[bool]) {
+        for (k, &h) in handles.iter().enumerate() {
+            if which[k] {
+                let v = self.v[k];
+                bodies[h].set_linvel(Vector::new(v[0] as f32, v[1] as f32, v[2] as f32), true);
+                let r = bodies[h].linvel();
+                self.v[k] = [r.x as f64, r.y as f64, r.z as f64];
+            }
         }
     }
 }
@@ -241,6 +255,28 @@ pub fn simulate_spatial_with(scene: &Scene, solver: SolverSettings, options: &Ru
         e
     };
     let initial_energy = scene.initial_energy();
+    // Pairs that touch at the start and approach strike before the first step, the fastest
+    // first with their knock-ons (§3 along normals), as a step's impacts do at its end: left
+    // to Rapier's plastic solve, a ball touching a row would move the whole row as one block.
+    {
+        contacts::find(&geometry, &now.x, &radius, xs, touching, &mut order, &mut found);
+        kicked.iter_mut().for_each(|k| *k = true);
+        let mut struck = vec![false; n];
+        let mut balls = Balls { v: &mut now.v, mass: &mass };
+        let mut frame = FrameBody { vs, mass: f.mass };
+        cascade.run(&found, touching, &mut kicked, resting_speed, (&mut balls, &mut frame), |c, approach, balls, frame| {
+            let lost = contacts::strike(c, approach, e, balls, frame);
+            impact_loss += lost;
+            impacts.push(impact_record(0.0, c, approach, lost));
+            report.knock_on_impacts += 1;
+            struck[c.ball] = true;
+            if let Other::Ball(j) = c.other {
+                struck[j] = true;
+            }
+        });
+        vs = frame.vs;
+        now.write_velocities(&mut world.physics.bodies, &world.balls, &struck);
+    }
     let mut t = 0.0;
     let mut steps: u64 = 0;
     let finish = |t: f64,
@@ -415,15 +451,7 @@ pub fn simulate_spatial_with(scene: &Scene, solver: SolverSettings, options: &Ru
                 });
             }
         }
-        for (i, &h_ball) in world.balls.iter().enumerate() {
-            if kicked[i] {
-                let v = now.v[i];
-                world.physics.bodies[h_ball].set_linvel(Vector::new(v[0] as f32, v[1] as f32, v[2] as f32), true);
-                // What Rapier will read back: the f32 velocity.
-                let r = world.physics.bodies[h_ball].linvel();
-                now.v[i] = [r.x as f64, r.y as f64, r.z as f64];
-            }
-        }
+        now.write_velocities(&mut world.physics.bodies, &world.balls, &kicked);
         impact_loss += step_impact_loss;
         // What Rapier's step took beyond the impact law's losses (see
         // `SpatialReport::contact_loss`): the balls' and the frame's energy change, less
