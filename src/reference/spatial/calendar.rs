@@ -5,7 +5,8 @@
 //! tree a pop walks is as deep as the balls are many, not their entries.
 
 /// An entry's time as an integer in the same order: of two entries of different owners, the
-/// one with the smaller key is the earlier, and at equal keys the lower owner's.
+/// one with the smaller key is the earlier, and at equal keys the lower owner's; of two of the
+/// same owner, the one with the smaller key, and at equal keys neither.
 pub(super) trait Timed {
     fn key(&self) -> u64;
 }
@@ -40,7 +41,7 @@ const NO_HEAD: u64 = u64::MAX;
 /// No ball held.
 const NOT_HELD: usize = usize::MAX;
 
-impl<T: Ord + Copy + Timed> Calendar<T> {
+impl<T: Copy + Timed> Calendar<T> {
     /// An empty calendar for `balls` balls.
     pub(super) fn new(balls: usize) -> Self {
         let leaves = balls.max(1).next_power_of_two();
@@ -64,7 +65,7 @@ impl<T: Ord + Copy + Timed> Calendar<T> {
         let list = &mut self.lists[owner];
         list.push(entry);
         self.len += 1;
-        if self.heads[owner].is_none_or(|(head, _)| entry > head) {
+        if self.heads[owner].is_none_or(|(head, _)| entry.key() < head.key()) {
             self.heads[owner] = Some((entry, (list.len() - 1) as u32));
             if owner != self.held {
                 self.update(owner);
@@ -124,13 +125,14 @@ impl<T: Ord + Copy + Timed> Calendar<T> {
 
     /// Finds ball `owner`'s earliest entry again (the first of equals in its list).
     fn find_head(&mut self, owner: usize) {
-        let mut head: Option<(T, u32)> = None;
-        for (k, &e) in self.lists[owner].iter().enumerate() {
-            if head.is_none_or(|(h, _)| e > h) {
-                head = Some((e, k as u32));
-            }
+        let list = &self.lists[owner];
+        let (mut key, mut at) = (NO_HEAD, u32::MAX);
+        for (k, e) in list.iter().enumerate() {
+            // Chosen without a branch: whether an entry is earlier is as good as random.
+            let earlier = e.key() < key;
+            (key, at) = std::hint::select_unpredictable(earlier, (e.key(), k as u32), (key, at));
         }
-        self.heads[owner] = head;
+        self.heads[owner] = list.get(at as usize).map(|&e| (e, at));
         self.update(owner);
     }
 
@@ -141,7 +143,11 @@ impl<T: Ord + Copy + Timed> Calendar<T> {
         let mut earliest = Node { key, leaf: owner as u32 };
         self.tree[node] = earliest;
         while node > 1 {
-            earliest = earliest.min(self.tree[node ^ 1]);
+            let sibling = self.tree[node ^ 1];
+            // The earlier of the two, chosen without a branch: which one it is, is as good as
+            // random.
+            let sibling_earlier = (sibling.key, sibling.leaf) < (earliest.key, earliest.leaf);
+            earliest = std::hint::select_unpredictable(sibling_earlier, sibling, earliest);
             node /= 2;
             if self.tree[node] == earliest {
                 // Nothing above changes: every node there was taken from this one as it is.
@@ -177,8 +183,9 @@ mod tests {
         for _ in 0..20_000 {
             match rng.random_range(0..11) {
                 0..6 => {
-                    // A total order: ties in time go by owner, then by a random tag.
-                    let e = Reverse((rng.random_range(0..1_000_000u64), rng.random_range(0..balls), rng.random::<u64>()));
+                    // Ties in time go by owner; entries of one owner at one time are equal,
+                    // as the solver's are.
+                    let e = Reverse((rng.random_range(0..1_000_000u64), rng.random_range(0..balls), 0));
                     calendar.push(e.0 .1, e);
                     heap.push(e);
                 }
@@ -192,7 +199,7 @@ mod tests {
                     heap.retain(|e: &Reverse<(u64, usize, u64)>| e.0 .1 != owner);
                     for _ in 0..rng.random_range(0..8) {
                         let by = if rng.random_bool(0.5) { owner } else { rng.random_range(0..balls) };
-                        let e = Reverse((rng.random_range(0..1_000_000u64), by, rng.random::<u64>()));
+                        let e = Reverse((rng.random_range(0..1_000_000u64), by, 0));
                         calendar.push(by, e);
                         heap.push(e);
                     }
