@@ -10,7 +10,9 @@ const NONE: u32 = u32::MAX;
 
 /// The balls in each cell, a list threaded through the balls: a cell holds its first ball and
 /// each ball the next and the previous one in its cell, so that the cells around a ball are
-/// read from two small arrays rather than from a buffer of their own each.
+/// read from two small arrays rather than from a buffer of their own each. Across the motion
+/// a border of cells that stay empty lies beyond the walls, so that the 27 cells around any
+/// ball are there to be read, without a bound checked on each.
 pub(super) struct Cells {
     /// Width of a cell, m.
     pub(super) size: f64,
@@ -43,7 +45,7 @@ impl Cells {
         }
         let nx = (length / size).ceil() as i64 + 3;
         let across = [((section[0] / size).ceil() as i64).max(1), ((section[1] / size).ceil() as i64).max(1)];
-        let count = (nx * across[0] * across[1]) as usize;
+        let count = (nx * (across[0] + 2) * (across[1] + 2)) as usize;
         Cells {
             size,
             nx,
@@ -63,8 +65,9 @@ impl Cells {
         [x, y, z]
     }
 
+    /// Where cell `c` (or a cell of the border, one beyond the walls across) is kept.
     fn index(&self, c: [i64; 3]) -> usize {
-        ((c[0].rem_euclid(self.nx) * self.across[0] + c[1]) * self.across[1] + c[2]) as usize
+        ((c[0].rem_euclid(self.nx) * (self.across[0] + 2) + c[1] + 1) * (self.across[1] + 2) + c[2] + 1) as usize
     }
 
     /// Puts `ball` first in cell `c`.
@@ -110,25 +113,24 @@ impl Cells {
     /// Calls `f` with every ball in the 27 cells around `c` (each once: there are at
     /// least three columns, so three neighbouring ones never fold onto one another).
     pub(super) fn around(&self, c: [i64; 3], f: impl FnMut(u32)) {
-        let lo = [c[0] - 1, (c[1] - 1).max(0), (c[2] - 1).max(0)];
-        let hi = [c[0] + 1, (c[1] + 1).min(self.across[0] - 1), (c[2] + 1).min(self.across[1] - 1)];
-        self.in_block(lo, hi, f);
+        self.in_block([c[0] - 1, c[1] - 1, c[2] - 1], [3, 3, 3], f);
     }
 
-    /// Calls `f` with every ball in the cells from `lo` to `hi` (both included).
-    fn in_block(&self, lo: [i64; 3], hi: [i64; 3], mut f: impl FnMut(u32)) {
+    /// Calls `f` with every ball in the block of `extent` cells from `lo` (cells of the border
+    /// included, which are empty).
+    #[inline]
+    fn in_block(&self, lo: [i64; 3], extent: [i64; 3], mut f: impl FnMut(u32)) {
         // The cells' first balls are gathered first, the empty cells skipped without a branch
         // on each (whether a cell is empty is as good as random, and a branch on it is
         // mispredicted about every third cell); then each list is walked, mostly one ball long.
         let mut heads = [NONE; 27];
         let mut count = 0;
-        // Ranges without an inclusive end, which compile to plainer loops.
-        for x in lo[0]..hi[0] + 1 {
-            let column = x.rem_euclid(self.nx) * self.across[0];
-            for y in lo[1]..hi[1] + 1 {
-                let row = (column + y) * self.across[1];
-                for z in lo[2]..hi[2] + 1 {
-                    let b = self.first[(row + z) as usize];
+        for dx in 0..extent[0] {
+            let start = self.index([lo[0] + dx, lo[1], lo[2]]);
+            for dy in 0..extent[1] {
+                let row = start + (dy * (self.across[1] + 2)) as usize;
+                for dz in 0..extent[2] {
+                    let b = self.first[row + dz as usize];
                     heads[count] = b;
                     count += usize::from(b != NONE);
                 }
@@ -153,11 +155,11 @@ impl Cells {
         if !self.has_neighbour(c, axis, dir) {
             return;
         }
-        let mut lo = [c[0] - 1, (c[1] - 1).max(0), (c[2] - 1).max(0)];
-        let mut hi = [c[0] + 1, (c[1] + 1).min(self.across[0] - 1), (c[2] + 1).min(self.across[1] - 1)];
+        let mut lo = [c[0] - 1, c[1] - 1, c[2] - 1];
+        let mut extent = [3, 3, 3];
         lo[axis] = c[axis] + dir;
-        hi[axis] = c[axis] + dir;
-        self.in_block(lo, hi, f);
+        extent[axis] = 1;
+        self.in_block(lo, extent, f);
     }
 }
 
