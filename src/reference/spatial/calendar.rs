@@ -14,8 +14,8 @@ pub(super) trait Timed {
 /// Entries of type `T` (greater is earlier, as in a max-heap), each owned by a ball.
 pub(super) struct Calendar<T> {
     lists: Vec<Vec<T>>,
-    /// Each ball's earliest entry, and its place in the ball's list.
-    heads: Vec<Option<(T, u32)>>,
+    /// Each ball's earliest entry: its key and its place in the ball's list, or [`NO_ENTRY`].
+    heads: Vec<(u64, u32)>,
     /// Node `k` holds the key and the leaf of the earliest head below it (at equal keys the
     /// lower leaf); the leaves start at `leaves`, one per ball, `NO_HEAD` for a ball without
     /// entries (and past the balls). A walk up the tree compares the key it carries with each
@@ -38,6 +38,9 @@ struct Node {
 /// The key of a ball without entries: later than any entry's.
 const NO_HEAD: u64 = u64::MAX;
 
+/// The head of a ball without entries.
+const NO_ENTRY: (u64, u32) = (NO_HEAD, u32::MAX);
+
 /// No ball held.
 const NOT_HELD: usize = usize::MAX;
 
@@ -52,7 +55,7 @@ impl<T: Copy + Timed> Calendar<T> {
         for node in (1..leaves).rev() {
             tree[node] = tree[2 * node];
         }
-        Calendar { lists: vec![Vec::new(); balls], heads: vec![None; balls], tree, leaves, len: 0, held: NOT_HELD }
+        Calendar { lists: vec![Vec::new(); balls], heads: vec![NO_ENTRY; balls], tree, leaves, len: 0, held: NOT_HELD }
     }
 
     /// Entries held, stale ones included.
@@ -65,11 +68,13 @@ impl<T: Copy + Timed> Calendar<T> {
         let list = &mut self.lists[owner];
         list.push(entry);
         self.len += 1;
-        if self.heads[owner].is_none_or(|(head, _)| entry.key() < head.key()) {
-            self.heads[owner] = Some((entry, (list.len() - 1) as u32));
-            if owner != self.held {
-                self.update(owner);
-            }
+        // Chosen without a branch: whether the new entry is the ball's earliest is as good as
+        // random. The tree is walked either way; when the head stands, the walk stops at once.
+        let head = self.heads[owner];
+        let key = entry.key();
+        self.heads[owner] = std::hint::select_unpredictable(key < head.0, (key, (list.len() - 1) as u32), head);
+        if owner != self.held {
+            self.update(owner);
         }
     }
 
@@ -90,14 +95,18 @@ impl<T: Copy + Timed> Calendar<T> {
     /// The earliest entry.
     pub(super) fn peek(&self) -> Option<&T> {
         let ball = self.tree[1].leaf as usize;
-        self.heads.get(ball).and_then(|h| h.as_ref()).map(|(entry, _)| entry)
+        let &(_, at) = self.heads.get(ball)?;
+        self.lists[ball].get(at as usize)
     }
 
     /// Takes the earliest entry out.
     pub(super) fn pop(&mut self) -> Option<T> {
         debug_assert_eq!(self.held, NOT_HELD, "nothing is taken out while a ball is held");
         let owner = self.tree[1].leaf as usize;
-        let (_, at) = *self.heads.get(owner)?.as_ref()?;
+        let &(key, at) = self.heads.get(owner)?;
+        if key == NO_HEAD {
+            return None;
+        }
         let entry = self.lists[owner].swap_remove(at as usize);
         self.len -= 1;
         self.find_head(owner);
@@ -108,7 +117,8 @@ impl<T: Copy + Timed> Calendar<T> {
     pub(super) fn clear(&mut self, owner: usize) {
         self.len -= self.lists[owner].len();
         self.lists[owner].clear();
-        if self.heads[owner].take().is_some() && owner != self.held {
+        let had = std::mem::replace(&mut self.heads[owner], NO_ENTRY) != NO_ENTRY;
+        if had && owner != self.held {
             self.update(owner);
         }
     }
@@ -132,13 +142,13 @@ impl<T: Copy + Timed> Calendar<T> {
             let earlier = e.key() < key;
             (key, at) = std::hint::select_unpredictable(earlier, (e.key(), k as u32), (key, at));
         }
-        self.heads[owner] = list.get(at as usize).map(|&e| (e, at));
+        self.heads[owner] = (key, at);
         self.update(owner);
     }
 
     /// Walks from ball `owner`'s leaf to the root, each node taking its earlier child.
     fn update(&mut self, owner: usize) {
-        let key = self.heads[owner].map_or(NO_HEAD, |(head, _)| head.key());
+        let key = self.heads[owner].0;
         let mut node = self.leaves + owner;
         let mut earliest = Node { key, leaf: owner as u32 };
         self.tree[node] = earliest;
