@@ -550,24 +550,37 @@ impl<'a> Solver<'a> {
     /// When ball `i` (brought to now), accelerated by `a`, next leaves its cell.
     fn predict_crossing(&mut self, i: usize, a: [f64; 3]) {
         let b = self.balls[i];
-        let mut crossing: Option<(f64, usize, i64)> = None;
+        // The earliest crossing, at a tie the first axis's; never when the time is infinite.
+        let mut crossing: (f64, usize, i64) = (f64::INFINITY, 0, 1);
         for axis in 0..3 {
+            let lower = self.cells.face(b.cell, axis);
+            let v = b.v[axis];
+            if a[axis] == 0.0 {
+                // Without acceleration along the axis, only the face ahead is crossed, at the
+                // gap over the speed (`plane_time`'s root to the bit), chosen without a branch
+                // on the velocity's sign, which is as good as random.
+                let ahead = v > 0.0;
+                let dir = if ahead { 1 } else { -1 };
+                let g0 = std::hint::select_unpredictable(ahead, lower + self.cells.size - b.p[axis], b.p[axis] - lower);
+                let dt = g0.max(0.0) / v.abs();
+                let earlier = (v != 0.0) & self.cells.has_neighbour(b.cell, axis, dir) & (dt < crossing.0);
+                crossing = std::hint::select_unpredictable(earlier, (dt, axis, dir), crossing);
+                continue;
+            }
             for dir in [1i64, -1] {
                 if !self.cells.has_neighbour(b.cell, axis, dir) {
                     continue;
                 }
-                let lower = self.cells.face(b.cell, axis);
                 let (g0, side) = if dir > 0 { (lower + self.cells.size - b.p[axis], 1.0) } else { (b.p[axis] - lower, -1.0) };
-                if let Some(dt) = plane_time(g0.max(0.0), side, b.v[axis], a[axis]) {
-                    if crossing.is_none_or(|c| dt < c.0) {
-                        crossing = Some((dt, axis, dir));
+                if let Some(dt) = plane_time(g0.max(0.0), side, v, a[axis]) {
+                    if dt < crossing.0 {
+                        crossing = (dt, axis, dir);
                     }
                 }
             }
         }
-        if let Some((dt, axis, dir)) = crossing {
-            self.push(self.t + dt, i, Kind::Cell(axis as u8, dir as i8), None);
-        }
+        let (dt, axis, dir) = crossing;
+        self.push(self.t + dt, i, Kind::Cell(axis as u8, dir as i8), None);
     }
 
     /// When ball `i`, in `motion` (position, velocity, acceleration) now, and each of `others`
