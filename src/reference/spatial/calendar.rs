@@ -11,7 +11,7 @@ pub(super) trait Timed {
     fn key(&self) -> u64;
 }
 
-/// Entries of type `T` (greater is earlier, as in a max-heap), each owned by a ball.
+/// Entries of type `T`, ordered by their keys ([`Timed`]), each owned by a ball.
 pub(super) struct Calendar<T> {
     lists: Vec<Vec<T>>,
     /// Each ball's earliest entry: its key and its place in the ball's list, or [`NO_ENTRY`].
@@ -174,7 +174,7 @@ mod tests {
     use std::cmp::Reverse;
     use std::collections::BinaryHeap;
 
-    impl Timed for Reverse<(u64, usize, u64)> {
+    impl Timed for Reverse<(u64, usize)> {
         fn key(&self) -> u64 {
             self.0 .0
         }
@@ -195,7 +195,7 @@ mod tests {
                 0..6 => {
                     // Ties in time go by owner; entries of one owner at one time are equal,
                     // as the solver's are.
-                    let e = Reverse((rng.random_range(0..1_000_000u64), rng.random_range(0..balls), 0));
+                    let e = Reverse((rng.random_range(0..1_000_000u64), rng.random_range(0..balls)));
                     calendar.push(e.0 .1, e);
                     heap.push(e);
                 }
@@ -206,10 +206,10 @@ mod tests {
                     let owner = rng.random_range(0..balls);
                     calendar.hold(owner);
                     calendar.clear(owner);
-                    heap.retain(|e: &Reverse<(u64, usize, u64)>| e.0 .1 != owner);
+                    heap.retain(|e: &Reverse<(u64, usize)>| e.0 .1 != owner);
                     for _ in 0..rng.random_range(0..8) {
                         let by = if rng.random_bool(0.5) { owner } else { rng.random_range(0..balls) };
-                        let e = Reverse((rng.random_range(0..1_000_000u64), by, 0));
+                        let e = Reverse((rng.random_range(0..1_000_000u64), by));
                         calendar.push(by, e);
                         heap.push(e);
                     }
@@ -218,7 +218,7 @@ mod tests {
                 _ => {
                     let owner = rng.random_range(0..balls);
                     calendar.clear(owner);
-                    heap.retain(|e: &Reverse<(u64, usize, u64)>| e.0 .1 != owner);
+                    heap.retain(|e: &Reverse<(u64, usize)>| e.0 .1 != owner);
                 }
             }
             assert_eq!(calendar.len(), heap.len());
