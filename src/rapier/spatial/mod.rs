@@ -117,11 +117,18 @@ pub fn energy_gain_allowance(scene: &Scene, energy_in: f64) -> f64 {
     SPATIAL_ENERGY_GAIN * energy_in.abs() + lift
 }
 
+/// The deepest a ball of `scene` may sink into a wall on the spatial path, m: Rapier's resting
+/// sink, [`RESTING_SINK_FRACTION`] of the largest radius, and a micrometre beyond it. Deeper,
+/// Rapier's soft contacts are not holding the load on the ball, and the run stops.
+pub fn wall_sink_limit(scene: &Scene) -> f64 {
+    let largest = scene.balls.iter().map(|b| b.radius).fold(0.0, f64::max);
+    RESTING_SINK_FRACTION * largest + 1e-6
+}
+
 /// The tolerances a spatial run is checked with: its energy allowance, Rapier's resting sink
 /// as the overlap a ball may have with a wall, and the one-line path's momentum bound.
 pub fn checks(scene: &Scene, run: &Run) -> Checks {
     let put_in = (run.energy.initial.abs() + run.energy.forcing_work.abs()).max(f64::MIN_POSITIVE);
-    let largest = scene.balls.iter().map(|b| b.radius).fold(0.0, f64::max);
     let energy_gain = energy_gain_allowance(scene, put_in) / put_in;
     Checks {
         energy_gain,
@@ -132,7 +139,7 @@ pub fn checks(scene: &Scene, run: &Run) -> Checks {
         impact_gain: energy_gain,
         exact_impacts: false,
         momentum: 1e-5,
-        wall_overlap: RESTING_SINK_FRACTION * largest + 1e-6,
+        wall_overlap: wall_sink_limit(scene),
         ball_overlap: None,
         stall_rate: Some(STALL_EVENTS_PER_SIM_S),
     }
@@ -238,6 +245,10 @@ pub fn simulate_spatial_with(scene: &Scene, solver: SolverSettings, options: &Ru
     let prediction = world.physics.integration_parameters.normalized_prediction_distance;
     let lu = world.physics.integration_parameters.length_unit;
     let g_norm = contacts_dot(g, g).sqrt();
+    // A ball sunk deeper into a wall stops the run rather than leave the container. (Balls
+    // may sink deeper into each other: Rapier's solve holds a pile by the overlaps of its
+    // balls, which nothing outside the run sees.)
+    let sink_limit = wall_sink_limit(scene);
     let mut order = Vec::new();
     // How fast pairs may close, m/s: twice the fastest expected speed.
     let reach = 2.0 * speed;
@@ -367,6 +378,14 @@ pub fn simulate_spatial_with(scene: &Scene, solver: SolverSettings, options: &Ru
         contacts::find(&geometry, &now.x, &radius, x1, touching + reach * h, &mut order, &mut found);
         // Contacts whose approach Rapier stopped, the fastest first.
         let mut new: Vec<Closing> = Vec::new();
+        let sunk =
+            found
+                .iter()
+                .filter(|c| -c.gap > sink_limit)
+                .filter_map(|c| if let Other::Wall(wall) = c.other { Some((c, wall)) } else { None });
+        if let Some((c, wall)) = sunk.min_by(|a, b| a.0.gap.total_cmp(&b.0.gap)) {
+            return Err(sunk_too_deep(scene, t1, (c.ball, -c.gap, wall), sink_limit, (v1 - vs) / h));
+        }
         for (k, c) in found.iter().enumerate() {
             report.deepest_overlap = report.deepest_overlap.max(-c.gap);
             let (gap0, w0, w_end, g_n) = match c.other {
@@ -513,6 +532,36 @@ pub fn simulate_spatial_with(scene: &Scene, solver: SolverSettings, options: &Ru
     run.horizon = scene.horizon;
     run.wall_time_s = meter.elapsed();
     Ok((run, report))
+}
+
+/// The stop of a run in which Rapier's solve left a ball sunk into a wall (`sunk`: the ball,
+/// by how much, m, and the wall) deeper than `sink_limit` at `t`, the frame accelerating at
+/// `frame_acceleration` over the step.
+fn sunk_too_deep(scene: &Scene, t: f64, sunk: (usize, f64, Wall), sink_limit: f64, frame_acceleration: f64) -> ModelError {
+    let (ball, depth, wall) = sunk;
+    let into = match wall {
+        Wall::Left => "the left wall".into(),
+        Wall::Right => "the right wall".into(),
+        Wall::Front => "the front wall".into(),
+        Wall::Back => "the back wall".into(),
+        Wall::Floor => "the floor".into(),
+        Wall::Ceiling => "the ceiling".into(),
+        Wall::Divider(k) => format!("divider {}", k + 1),
+    };
+    ModelError::Unstable {
+        scene: scene.name.clone(),
+        model: Model::Rapier,
+        t,
+        reason: format!(
+            "at t = {t:.6e} s ball{} has sunk {:.3e} m into {into}, more than the {:.3e} m Rapier's soft contacts may sink ({} % of the largest radius): its solve cannot hold the load on the ball (the walls accelerate at {:.3e} m/s^2, gravity is {:.3e} m/s^2); the compliant model (and, without friction, the reference) holds any load",
+            ball + 1,
+            depth,
+            sink_limit,
+            RESTING_SINK_FRACTION * 100.0,
+            frame_acceleration.abs(),
+            contacts_dot(scene.space.gravity, scene.space.gravity).sqrt(),
+        ),
+    }
 }
 
 /// A contact Rapier stopped in the step: its closing speed and what it was computed from.

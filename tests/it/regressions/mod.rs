@@ -19,6 +19,7 @@ mod plugin_driven_by_app_update;
 mod record_beyond_double_range;
 mod record_point_inside_step;
 mod resting_ball_without_energy;
+mod row_pressed_into_wall;
 mod series_beyond_memory;
 mod spatial_series_read_back;
 pub(crate) mod squeezed_ball_stops;
