@@ -113,16 +113,39 @@ impl Cells {
     /// Calls `f` with every ball in the 27 cells around `c` (each once: there are at
     /// least three columns, so three neighbouring ones never fold onto one another).
     pub(super) fn around(&self, c: [i64; 3], f: impl FnMut(u32)) {
-        self.in_block([c[0] - 1, c[1] - 1, c[2] - 1], [3, 3, 3], f);
+        self.in_block(Cells::around_block(c), f);
     }
 
-    /// Calls `f` with every ball in the block of `extent` cells from `lo` (cells of the border
-    /// included, which are empty).
+    /// The block of the 27 cells around `c`.
+    pub(super) fn around_block(c: [i64; 3]) -> Block {
+        Block { lo: [c[0] - 1, c[1] - 1, c[2] - 1], extent: [3, 3, 3] }
+    }
+
+    /// Calls `f` with every ball in `block` (cells of the border included, which are empty).
     #[inline]
-    fn in_block(&self, lo: [i64; 3], extent: [i64; 3], mut f: impl FnMut(u32)) {
-        // The cells' first balls are gathered first, the empty cells skipped without a branch
-        // on each (whether a cell is empty is as good as random, and a branch on it is
-        // mispredicted about every third cell); then each list is walked, mostly one ball long.
+    fn in_block(&self, block: Block, mut f: impl FnMut(u32)) {
+        let (heads, count) = self.heads(block);
+        for &head in &heads[..count] {
+            let mut b = head;
+            loop {
+                f(b);
+                match self.next(b) {
+                    Some(next) => b = next,
+                    None => break,
+                }
+            }
+        }
+    }
+
+    /// The first balls of the cells of `block` that hold any, in the block's order, and how
+    /// many: each cell's list goes on through [`Cells::next`]. Inlined, so that the 27 cells
+    /// around a ball are read in loops of known length.
+    #[inline(always)]
+    pub(super) fn heads(&self, block: Block) -> ([u32; 27], usize) {
+        let Block { lo, extent } = block;
+        // The empty cells are skipped without a branch on each (whether a cell is empty is as
+        // good as random, and a branch on it is mispredicted about every third cell); the
+        // lists are then walked, mostly one ball long.
         let mut heads = [NONE; 27];
         let mut count = 0;
         for dx in 0..extent[0] {
@@ -136,31 +159,43 @@ impl Cells {
                 }
             }
         }
-        for &head in &heads[..count] {
-            let mut b = head;
-            loop {
-                f(b);
-                b = self.next[b as usize];
-                if b == NONE {
-                    break;
-                }
-            }
+        (heads, count)
+    }
+
+    /// The ball after `b` in its cell.
+    #[inline]
+    pub(super) fn next(&self, b: u32) -> Option<u32> {
+        let next = self.next[b as usize];
+        (next != NONE).then_some(next)
+    }
+
+    /// Calls `f` with every ball of [`Cells::slab_block`].
+    #[cfg(test)]
+    fn slab(&self, c: [i64; 3], axis: usize, dir: i64, f: impl FnMut(u32)) {
+        if let Some(block) = self.slab_block(c, axis, dir) {
+            self.in_block(block, f);
         }
     }
 
-    /// Calls `f` with every ball in the nine cells next to `c` across its face along `axis`
-    /// on side `dir`: the cells a ball that has just crossed into `c` that way neighbours
-    /// now and did not before (none past the container's walls across).
-    pub(super) fn slab(&self, c: [i64; 3], axis: usize, dir: i64, f: impl FnMut(u32)) {
+    /// The block of the nine cells next to `c` across its face along `axis` on side `dir`:
+    /// the cells a ball that has just crossed into `c` that way neighbours now and did not
+    /// before; `None` past the container's walls across.
+    pub(super) fn slab_block(&self, c: [i64; 3], axis: usize, dir: i64) -> Option<Block> {
         if !self.has_neighbour(c, axis, dir) {
-            return;
+            return None;
         }
-        let mut lo = [c[0] - 1, c[1] - 1, c[2] - 1];
-        let mut extent = [3, 3, 3];
-        lo[axis] = c[axis] + dir;
-        extent[axis] = 1;
-        self.in_block(lo, extent, f);
+        let mut block = Cells::around_block(c);
+        block.lo[axis] = c[axis] + dir;
+        block.extent[axis] = 1;
+        Some(block)
     }
+}
+
+/// A block of cells: `extent` cells along each axis from `lo`, at most three.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(super) struct Block {
+    lo: [i64; 3],
+    extent: [i64; 3],
 }
 
 #[cfg(test)]

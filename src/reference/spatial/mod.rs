@@ -514,9 +514,7 @@ impl<'a> Solver<'a> {
             self.predict_frame_wall(i, side);
         }
         self.predict_crossing(i, a);
-        let others = self.gather(b.cell, None);
-        let predicted = self.predict_pairs(i, motion, &others, check);
-        self.neighbours = others;
+        let predicted = self.predict_pairs(i, motion, self.cells.heads(Cells::around_block(b.cell)), check);
         self.calendar.release();
         predicted
     }
@@ -529,21 +527,18 @@ impl<'a> Solver<'a> {
         let motion = b.motion(self.t, self.gravity);
         self.calendar.hold(i);
         self.predict_crossing(i, motion.2);
-        let others = self.gather(b.cell, Some((axis, dir)));
-        self.predict_pairs(i, motion, &others, false).expect("a prediction without a check cannot fail");
-        self.neighbours = others;
+        if let Some(slab) = self.cells.slab_block(b.cell, axis, dir) {
+            self.predict_pairs(i, motion, self.cells.heads(slab), false).expect("a prediction without a check cannot fail");
+        }
         self.calendar.release();
     }
 
-    /// The balls of the cells around `cell`, or with `slab` (`(axis, dir)`) of the slab beyond
-    /// its face, in the scratch list, which the caller puts back in `neighbours` when done.
-    fn gather(&mut self, cell: [i64; 3], slab: Option<(usize, i64)>) -> Vec<usize> {
+    /// The balls of the cells around `cell`, in the scratch list, which the caller puts back
+    /// in `neighbours` when done.
+    fn gather(&mut self, cell: [i64; 3]) -> Vec<usize> {
         let mut others = std::mem::take(&mut self.neighbours);
         others.clear();
-        match slab {
-            None => self.cells.around(cell, |j| others.push(j as usize)),
-            Some((axis, dir)) => self.cells.slab(cell, axis, dir, |j| others.push(j as usize)),
-        }
+        self.cells.around(cell, |j| others.push(j as usize));
         others
     }
 
@@ -583,27 +578,42 @@ impl<'a> Solver<'a> {
         self.push(self.t + dt, i, Kind::Cell(axis as u8, dir as i8), None);
     }
 
-    /// When ball `i`, in `motion` (position, velocity, acceleration) now, and each of `others`
-    /// but itself touch. With `check`, first the postcondition for each pair (from the same
-    /// positions): they overlap by no more than the contact tolerance.
-    fn predict_pairs(&mut self, i: usize, motion: ([f64; 3], [f64; 3], [f64; 3]), others: &[usize], check: bool) -> Result<(), ModelError> {
+    /// When ball `i`, in `motion` (position, velocity, acceleration) now, and each other ball
+    /// of the cells whose first balls are `heads` ([`Cells::heads`]) touch. With `check`, first
+    /// the postcondition for each pair (from the same positions): they overlap by no more than
+    /// the contact tolerance.
+    fn predict_pairs(
+        &mut self,
+        i: usize,
+        motion: ([f64; 3], [f64; 3], [f64; 3]),
+        heads: ([u32; 27], usize),
+        check: bool,
+    ) -> Result<(), ModelError> {
         let (pi, vi, ai) = motion;
         let from = self.t;
-        for &j in others {
-            if j == i {
-                continue;
-            }
-            let (pj, vj, aj) = self.balls[j].motion(from, self.gravity);
-            let dr = std::array::from_fn(|k| pj[k] - pi[k]);
-            if check {
-                self.check_pair(i, j, dr)?;
-            }
-            let dv = std::array::from_fn(|k| vj[k] - vi[k]);
-            let da = std::array::from_fn(|k| aj[k] - ai[k]);
-            let reach = self.balls[i].radius + self.balls[j].radius;
-            let (lo, hi) = (i.min(j), i.max(j));
-            if let Some(dt) = pair_time(dr, dv, da, reach, still(vi, vj), self.horizon - from) {
-                self.push(from + dt, lo, Kind::Pair(hi as u32), Some(hi));
+        // The cells' lists are walked here rather than gathered into a list first: a ball's
+        // pairs are most of what an event costs.
+        let (heads, count) = heads;
+        for &head in &heads[..count] {
+            let mut next = Some(head);
+            while let Some(j) = next {
+                next = self.cells.next(j);
+                let j = j as usize;
+                if j == i {
+                    continue;
+                }
+                let (pj, vj, aj) = self.balls[j].motion(from, self.gravity);
+                let dr = std::array::from_fn(|k| pj[k] - pi[k]);
+                if check {
+                    self.check_pair(i, j, dr)?;
+                }
+                let dv = std::array::from_fn(|k| vj[k] - vi[k]);
+                let da = std::array::from_fn(|k| aj[k] - ai[k]);
+                let reach = self.balls[i].radius + self.balls[j].radius;
+                let (lo, hi) = (i.min(j), i.max(j));
+                if let Some(dt) = pair_time(dr, dv, da, reach, still(vi, vj), self.horizon - from) {
+                    self.push(from + dt, lo, Kind::Pair(hi as u32), Some(hi));
+                }
             }
         }
         Ok(())
@@ -685,7 +695,7 @@ impl<'a> Solver<'a> {
         for i in 0..self.balls.len() {
             self.bring(i);
             self.check_walls(i)?;
-            let near = self.gather(self.balls[i].cell, None);
+            let near = self.gather(self.balls[i].cell);
             let checked = self.check_neighbours(i, &near);
             self.neighbours = near;
             checked?;
