@@ -553,7 +553,7 @@ fn sunk_too_deep(scene: &Scene, t: f64, sunk: (usize, f64, Wall), sink_limit: f6
         model: Model::Rapier,
         t,
         reason: format!(
-            "at t = {t:.6e} s ball{} has sunk {:.3e} m into {into}, more than the {:.3e} m Rapier's soft contacts may sink ({} % of the largest radius): its solve cannot hold the load on the ball (the walls accelerate at {:.3e} m/s^2, gravity is {:.3e} m/s^2); the compliant model (and, without friction, the reference) holds any load",
+            "at t = {t:.6e} s ball{} has sunk {:.3e} m into {into}, more than the {:.3e} m Rapier's soft contacts may sink ({} % of the largest radius): its solve cannot hold the load on the ball (the walls accelerate at {:.3e} m/s^2, gravity is {:.3e} m/s^2); the compliant model and, without friction, the reference run such scenes",
             ball + 1,
             depth,
             sink_limit,
