@@ -378,11 +378,10 @@ pub fn simulate_spatial_with(scene: &Scene, solver: SolverSettings, options: &Ru
         contacts::find(&geometry, &now.x, &radius, x1, touching + reach * h, &mut order, &mut found);
         // Contacts whose approach Rapier stopped, the fastest first.
         let mut new: Vec<Closing> = Vec::new();
-        let sunk =
-            found
-                .iter()
-                .filter(|c| -c.gap > sink_limit)
-                .filter_map(|c| if let Other::Wall(wall) = c.other { Some((c, wall)) } else { None });
+        let sunk = found.iter().filter_map(|c| match c.other {
+            Other::Wall(wall) if -c.gap > sink_limit => Some((c, wall)),
+            _ => None,
+        });
         if let Some((c, wall)) = sunk.min_by(|a, b| a.0.gap.total_cmp(&b.0.gap)) {
             return Err(sunk_too_deep(scene, t1, (c.ball, -c.gap, wall), sink_limit, (v1 - vs) / h));
         }

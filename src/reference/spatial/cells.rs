@@ -192,7 +192,7 @@ impl Cells {
 }
 
 /// A block of cells: `extent` cells along each axis from `lo`, at most three.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[derive(Clone, Copy)]
 pub(super) struct Block {
     lo: [i64; 3],
     extent: [i64; 3],

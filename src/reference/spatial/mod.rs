@@ -168,8 +168,6 @@ struct Solver<'a> {
     frame: FrameMotion,
     limits: Limits,
     cells: Cells,
-    /// Scratch: the balls of the cells around one ball (kept to spare an allocation an event).
-    neighbours: Vec<usize>,
     /// Every entry but the balls' contacts with the frame's walls, each owned by its `ball`.
     calendar: Calendar<Entry>,
     /// The balls' contacts with the frame's walls, apart: each impact on those walls changes
@@ -368,7 +366,6 @@ impl<'a> Solver<'a> {
             frame,
             limits: Limits::new(scene),
             cells,
-            neighbours: Vec::new(),
             calendar: Calendar::new(scene.balls.len()),
             frame_calendar: BinaryHeap::new(),
             frame_reach,
@@ -533,15 +530,6 @@ impl<'a> Solver<'a> {
         self.calendar.release();
     }
 
-    /// The balls of the cells around `cell`, in the scratch list, which the caller puts back
-    /// in `neighbours` when done.
-    fn gather(&mut self, cell: [i64; 3]) -> Vec<usize> {
-        let mut others = std::mem::take(&mut self.neighbours);
-        others.clear();
-        self.cells.around(cell, |j| others.push(j as usize));
-        others
-    }
-
     /// When ball `i` (brought to now), accelerated by `a`, next leaves its cell.
     fn predict_crossing(&mut self, i: usize, a: [f64; 3]) {
         let b = self.balls[i];
@@ -695,10 +683,7 @@ impl<'a> Solver<'a> {
         for i in 0..self.balls.len() {
             self.bring(i);
             self.check_walls(i)?;
-            let near = self.gather(self.balls[i].cell);
-            let checked = self.check_neighbours(i, &near);
-            self.neighbours = near;
-            checked?;
+            self.check_neighbours(i)?;
         }
         Ok(None)
     }
@@ -972,17 +957,19 @@ impl<'a> Solver<'a> {
         Ok(())
     }
 
-    /// The postcondition for ball `k` (brought to now) against the balls `near` (the cells
-    /// around it).
-    fn check_neighbours(&self, k: usize, near: &[usize]) -> Result<(), ModelError> {
+    /// The postcondition for ball `k` (brought to now) against the balls of the cells around
+    /// it; the first violation found.
+    fn check_neighbours(&self, k: usize) -> Result<(), ModelError> {
         let p = self.balls[k].p;
-        for &o in near {
-            if o != k {
+        let mut checked = Ok(());
+        self.cells.around(self.balls[k].cell, |o| {
+            let o = o as usize;
+            if checked.is_ok() && o != k {
                 let (po, _) = self.balls[o].at(self.t, self.gravity);
-                self.check_pair(k, o, std::array::from_fn(|c| po[c] - p[c]))?;
+                checked = self.check_pair(k, o, std::array::from_fn(|c| po[c] - p[c]));
             }
-        }
-        Ok(())
+        });
+        checked
     }
 
     /// The postcondition for balls `k` and `o`, their centres `d` apart now: they overlap by
