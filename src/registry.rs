@@ -21,7 +21,7 @@ impl Model {
     /// not fit in memory.
     pub fn simulate(self, scene: &Scene, options: &RunOptions) -> Result<Run, ModelError> {
         if let Err((budget, rule)) = options.limits.check() {
-            return Err(ModelError::Refused(format!("{}: {rule}", budget.flag())));
+            return Err(ModelError::Refused(format!("{}: {rule}", budget.flag().unwrap_or_default())));
         }
         let model = simulator(self);
         model

@@ -462,7 +462,7 @@ impl Run {
 /// `max_wall_time`, as the CLI's `--max-steps` and `--max-wall-time`).
 fn limits(max_steps: Option<u64>, max_wall_time: Option<f64>) -> PyResult<Limits> {
     let limits = Limits { max_steps, max_wall_s: max_wall_time };
-    limits.check().map_err(|(budget, rule)| SceneError::new_err(format!("{}: {rule}", budget.keyword())))?;
+    limits.check().map_err(|(budget, rule)| SceneError::new_err(format!("{}: {rule}", budget.keyword().unwrap_or_default())))?;
     Ok(limits)
 }
 

@@ -90,9 +90,13 @@ pub struct OverBudget {
 impl OverBudget {
     /// `more than 3000 steps (--max-steps)`.
     pub fn budget_text(&self) -> String {
+        let flag = self.budget.flag().map(|f| format!(" ({f})")).unwrap_or_default();
         match self.budget {
-            Budget::Steps => format!("more than {} {} ({})", human(self.limit), self.model.step_unit(), self.budget.flag()),
-            Budget::WallTime => format!("more than {} s of computing ({})", human(self.limit), self.budget.flag()),
+            Budget::Steps => format!("more than {} {}{flag}", human(self.limit), self.model.step_unit()),
+            Budget::WallTime => format!("more than {} s of computing{flag}", human(self.limit)),
+            Budget::Memory => {
+                format!("more than {} {}, the most whose impacts a run keeps in memory", human(self.limit), self.model.step_unit())
+            }
         }
     }
 }

@@ -44,7 +44,7 @@ impl Limits {
 
     /// The rules the budgets keep (`--max-steps`, `--max-wall-time` and their Python keywords):
     /// at least one step, a positive and finite number of seconds. The rule broken, for the
-    /// caller to name its field.
+    /// caller to name its field (a budget the user sets, so one with a flag and a keyword).
     pub fn check(&self) -> Result<(), (Budget, String)> {
         if self.max_steps == Some(0) {
             return Err((Budget::Steps, "must be at least 1".into()));
@@ -56,28 +56,34 @@ impl Limits {
     }
 }
 
-/// A run's budget: steps (events, for the reference) or seconds of computing.
+/// A run's budget: steps (events, for the reference) or seconds of computing, which the user
+/// sets, or the events a run may keep, which no one sets.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Budget {
     /// Steps or events.
     Steps,
     /// Seconds of computing.
     WallTime,
+    /// The events whose impacts a run keeps in memory for its outputs: a fixed bound, so that
+    /// a run's answer never depends on the machine.
+    Memory,
 }
 
 impl Budget {
-    /// The command-line flag that sets it.
-    pub fn flag(self) -> &'static str {
+    /// The command-line flag that sets it, `None` for the fixed bound.
+    pub fn flag(self) -> Option<&'static str> {
         match self {
-            Budget::Steps => "--max-steps",
-            Budget::WallTime => "--max-wall-time",
+            Budget::Steps => Some("--max-steps"),
+            Budget::WallTime => Some("--max-wall-time"),
+            Budget::Memory => None,
         }
     }
-    /// The Python keyword that sets it.
-    pub fn keyword(self) -> &'static str {
+    /// The Python keyword that sets it, `None` for the fixed bound.
+    pub fn keyword(self) -> Option<&'static str> {
         match self {
-            Budget::Steps => "max_steps",
-            Budget::WallTime => "max_wall_time",
+            Budget::Steps => Some("max_steps"),
+            Budget::WallTime => Some("max_wall_time"),
+            Budget::Memory => None,
         }
     }
 }
@@ -115,6 +121,7 @@ pub struct Meter<'a> {
     every: u64,
     max_steps: Option<u64>,
     max_wall_s: Option<f64>,
+    max_kept: Option<u64>,
     progress: Option<&'a Progress>,
 }
 
@@ -126,19 +133,26 @@ impl<'a> Meter<'a> {
             every: every.max(1),
             max_steps: options.limits.max_steps,
             max_wall_s: options.limits.max_wall_s,
+            max_kept: None,
             progress: options.progress,
         }
+    }
+    /// The meter, stopping the run past `events` steps whose impacts it keeps in memory
+    /// ([`Budget::Memory`]).
+    pub fn keeping(self, events: u64) -> Self {
+        Meter { max_kept: Some(events), ..self }
     }
     /// Seconds of computing since the run started.
     pub fn elapsed(&self) -> f64 {
         self.start.elapsed().as_secs_f64()
     }
     /// The run has taken `steps` steps and reached `t`: on every `every`-th step (and past the
-    /// step budget) reports it and returns the budget that has run out, if any.
+    /// step budgets) reports it and returns the budget that has run out, if any.
     #[inline]
     pub fn look(&self, t: f64, steps: u64) -> Option<Budget> {
         let over_steps = self.max_steps.is_some_and(|m| steps > m);
-        if !over_steps && !steps.is_multiple_of(self.every) {
+        let over_kept = self.max_kept.is_some_and(|m| steps > m);
+        if !(over_steps | over_kept) && !steps.is_multiple_of(self.every) {
             return None;
         }
         if let Some(p) = self.progress {
@@ -146,6 +160,9 @@ impl<'a> Meter<'a> {
         }
         if over_steps {
             return Some(Budget::Steps);
+        }
+        if over_kept {
+            return Some(Budget::Memory);
         }
         self.max_wall_s.filter(|&w| self.elapsed() > w).map(|_| Budget::WallTime)
     }
@@ -160,6 +177,26 @@ impl<'a> Meter<'a> {
         match budget {
             Budget::Steps => self.max_steps.unwrap_or(u64::MAX) as f64,
             Budget::WallTime => self.max_wall_s.unwrap_or(f64::INFINITY),
+            Budget::Memory => self.max_kept.unwrap_or(u64::MAX) as f64,
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Past both, the user's step budget is the one named; past the bound on the events kept
+    /// alone, that bound, at its own limit.
+    #[test]
+    fn the_users_step_budget_comes_before_the_bound_on_events_kept() {
+        let options = RunOptions::limited(Limits { max_steps: Some(10), ..Limits::NONE });
+        let meter = Meter::new(&options, 1000).keeping(10);
+        assert_eq!(meter.look(0.0, 10), None);
+        assert_eq!(meter.look(0.0, 11), Some(Budget::Steps));
+        let meter = Meter::new(&options, 1000).keeping(5);
+        assert_eq!(meter.look(0.0, 5), None);
+        assert_eq!(meter.look(0.0, 6), Some(Budget::Memory));
+        assert_eq!(meter.limit(Budget::Memory), 5.0);
     }
 }

@@ -64,7 +64,7 @@ impl BudgetArgs {
     /// The budgets, checked by their rules (an error naming the flag and `scene`).
     pub fn limits(self, scene: &Path) -> Result<Limits> {
         let limits = Limits { max_steps: self.max_steps, max_wall_s: self.max_wall_time };
-        limits.check().map_err(|(budget, rule)| invalid(scene, budget.flag(), rule))?;
+        limits.check().map_err(|(budget, rule)| invalid(scene, budget.flag().unwrap_or_default(), rule))?;
         Ok(limits)
     }
 }

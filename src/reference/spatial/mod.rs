@@ -22,7 +22,7 @@ use super::frame_gap::{FrameGap, FrameReach};
 use super::geometry::Limits;
 use super::MAX_EVENTS;
 use crate::impact_law::{reduced_mass, separate};
-use crate::model::{Meter, Model, ModelError, OverBudget, RunOptions, STALL_EVENTS_PER_SIM_S};
+use crate::model::{Budget, Meter, Model, ModelError, OverBudget, RunOptions, STALL_EVENTS_PER_SIM_S};
 use crate::run::{EnergyAccount, Impact, Recorder, Run};
 use crate::scene::{Body, Scene};
 use calendar::Calendar;
@@ -284,13 +284,14 @@ impl Ball {
 
 /// Runs the spatial reference on `scene` (which [`refusal`] accepts).
 pub(super) fn simulate(scene: &Scene, options: &RunOptions) -> Result<Run, ModelError> {
-    simulate_with(scene, options, true)
+    simulate_with(scene, options, true, MAX_EVENTS)
 }
 
 /// [`simulate`], with the balls waiting before their searches against the frame's walls where
-/// the frame's motion is bounded (`waits`), or always searching.
-fn simulate_with(scene: &Scene, options: &RunOptions, waits: bool) -> Result<Run, ModelError> {
-    let meter = Meter::new(options, BUDGET_EVENTS);
+/// the frame's motion is bounded (`waits`), or always searching, and stopping past
+/// `max_events` events.
+fn simulate_with(scene: &Scene, options: &RunOptions, waits: bool, max_events: u64) -> Result<Run, ModelError> {
+    let meter = Meter::new(options, BUDGET_EVENTS).keeping(max_events);
     let mut s = Solver::new(scene)?;
     if !waits {
         s.frame_reach = None;
@@ -308,7 +309,21 @@ fn simulate_with(scene: &Scene, options: &RunOptions, waits: bool) -> Result<Run
         Some(budget) => {
             let wall_s = meter.elapsed();
             let steps = s.events;
-            let cost = format!("{} impacts so far; {} balls", s.impacts.len(), s.balls.len());
+            let rate = steps as f64 / t;
+            let mut cost = format!("{} impacts so far; {} balls", s.impacts.len(), s.balls.len());
+            if budget == Budget::Memory {
+                // Past the rate the collapse rule can make, the events are a flood that no
+                // part of it resolves; below it, a pile's steady price.
+                if rate > stall_rate(scene) {
+                    return Err(s.stalled(format!(
+                        "more than {max_events} events, {rate:.3e} per simulated second, more than the collapse rule makes (docs/MODEL.md §14)"
+                    )));
+                }
+                cost = format!(
+                    "{cost}; {rate:.3e} events per simulated second: a pile or a bed pressed against a wall has each pressed contact struck about once a contact duration (docs/MODEL.md §14, here {} s), and a longer `[reference] contact_duration` makes it cheaper",
+                    crate::scene::human(s.t_c)
+                );
+            }
             let mut partial = s.finish(recorder, t);
             partial.wall_time_s = wall_s;
             Err(ModelError::OverBudget(Box::new(OverBudget {
@@ -651,20 +666,13 @@ impl<'a> Solver<'a> {
                     _ => format!("ball{} stays in contact with a wall", entry.ball + 1),
                 };
                 return Err(self.stalled(format!(
-                    "more than {MAX_EVENTS_PER_INSTANT} events at one instant: {what}; the reference beyond one line has no state for persistent contact yet"
+                    "more than {MAX_EVENTS_PER_INSTANT} events at one instant: {what}; no part of the collapse rule (docs/MODEL.md §14) resolves it"
                 )));
             }
             self.t = entry.t;
             self.events += 1;
             if let Some(budget) = meter.look(self.t, self.events) {
                 return Ok(Some(budget));
-            }
-            if self.events > MAX_EVENTS {
-                return Err(self.stalled(format!(
-                    "more than {MAX_EVENTS} events, {:.3e} per simulated second; a pile or a bed pressed against a wall has each pressed contact struck about once a contact duration (docs/MODEL.md §14, here {} s): a longer `[reference] contact_duration` makes it cheaper",
-                    self.events as f64 / self.t,
-                    crate::scene::human(self.t_c)
-                )));
             }
             self.resolve(entry)?;
             if self.calendar.len() + self.frame_calendar.len() > 64 * self.balls.len() + 4096 {
@@ -1075,8 +1083,8 @@ mod tests {
     fn waiting_balls_meet_the_frames_walls_where_searching_ones_do() {
         let mut scene = crate::scene::load(crate::scene::scenes_dir().join("planar-bed.toml")).unwrap().scene.unwrap();
         scene.horizon = 0.1;
-        let waiting = simulate_with(&scene, &RunOptions::default(), true).unwrap();
-        let searching = simulate_with(&scene, &RunOptions::default(), false).unwrap();
+        let waiting = simulate_with(&scene, &RunOptions::default(), true, MAX_EVENTS).unwrap();
+        let searching = simulate_with(&scene, &RunOptions::default(), false, MAX_EVENTS).unwrap();
         let walls =
             |impacts: &[Impact]| impacts.iter().filter(|i| matches!((i.a, i.b), (Body::LeftWall, _) | (_, Body::RightWall))).count();
         let alike = waiting
@@ -1113,13 +1121,33 @@ mod tests {
         solver.run(&Meter::new(&options, BUDGET_EVENTS), &mut Recorder::new(&scene, options.record)).unwrap();
         let last = solver.frame_reach.as_ref().unwrap().reach;
         assert!(solver.reach_version == 2 && last < 0.25 * first, "{} bounds, from {first} m to {last} m", solver.reach_version);
-        let waiting = simulate_with(&scene, &options, true).unwrap();
-        let searching = simulate_with(&scene, &options, false).unwrap();
+        let waiting = simulate_with(&scene, &options, true, MAX_EVENTS).unwrap();
+        let searching = simulate_with(&scene, &options, false, MAX_EVENTS).unwrap();
         assert_eq!(waiting.impacts.len(), searching.impacts.len());
         for (a, b) in waiting.impacts.iter().zip(&searching.impacts) {
             assert!((a.a, a.b) == (b.a, b.b) && (a.t - b.t).abs() <= 1e-12, "{a:?} against {b:?}");
         }
         let walls = waiting.impacts.iter().filter(|i| matches!((i.a, i.b), (Body::LeftWall, _) | (_, Body::RightWall))).count();
         assert!(walls >= 20, "{walls} impacts on the end walls");
+    }
+    /// A run past the events it may keep stops with the run so far, which is the unbounded
+    /// run's up to there, and says what the events cost and how to make them fewer: a bed's
+    /// events come at the rate the collapse rule allows, so this is a bound, not a stall.
+    #[test]
+    fn a_run_past_the_events_it_keeps_stops_with_the_run_so_far() {
+        let mut scene = crate::scene::load(crate::scene::scenes_dir().join("planar-bed.toml")).unwrap().scene.unwrap();
+        scene.horizon = 0.5;
+        let whole = simulate(&scene, &RunOptions::default()).unwrap();
+        let bound = whole.events / 2;
+        let err = simulate_with(&scene, &RunOptions::default(), true, bound).unwrap_err();
+        let message = err.to_string();
+        let ModelError::OverBudget(stop) = err else { panic!("{message}") };
+        assert_eq!((stop.budget, stop.limit, stop.steps), (Budget::Memory, bound as f64, bound + 1));
+        assert!(message.contains("keeps in memory") && message.contains("`[reference] contact_duration`"), "{message}");
+        let partial = &stop.partial;
+        assert!(stop.t > 0.0 && stop.t < scene.horizon && partial.horizon == stop.t, "stopped at {}", stop.t);
+        assert!(!partial.impacts.is_empty() && partial.impacts.len() < whole.impacts.len());
+        assert_eq!(partial.impacts[..], whole.impacts[..partial.impacts.len()]);
+        assert!(partial.energy.balance_error.abs() <= 1e-12, "{:?}", partial.energy);
     }
 }
