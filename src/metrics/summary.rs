@@ -5,6 +5,7 @@ use serde::{Deserialize, Serialize};
 
 use super::{metrics, noise, Metric, Metrics, Noise};
 use crate::run::Run;
+use crate::scene::Body;
 
 /// One impact as in the JSON contract.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -12,7 +13,7 @@ pub struct ImpactSummary {
     /// s.
     pub t: f64,
     /// `[A, B]`, e.g. `["left-wall", "ball1"]`.
-    pub bodies: [String; 2],
+    pub bodies: [Body; 2],
     /// m/s.
     pub approach_speed: f64,
     /// J.
@@ -139,7 +140,7 @@ impl RunSummary {
                 .iter()
                 .map(|i| ImpactSummary {
                     t: i.t,
-                    bodies: [i.a.name(), i.b.name()],
+                    bodies: [i.a, i.b],
                     approach_speed: i.approach_speed,
                     energy_lost: i.energy_lost,
                     peak_force: i.peak_force,

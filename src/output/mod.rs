@@ -8,7 +8,7 @@ mod run_dir;
 
 use crate::metrics::{Noise, RunSummary};
 
-pub use run_dir::{impacts_csv, series_csv, table_csv, write_run_dir, write_run_dir_with};
+pub use run_dir::{impacts_csv, series_csv, table_csv, write_impacts_csv, write_run_dir, write_run_dir_with};
 
 fn noise_line(n: &Noise) -> String {
     let Some(e) = n.energy_lost else { return "no impacts".into() };

@@ -4,7 +4,7 @@
 use std::io::Write;
 use std::path::Path;
 
-use crate::files::{write_atomic, write_atomic_with};
+use crate::files::write_atomic_with;
 use crate::metrics::RunSummary;
 use crate::run::Run;
 
@@ -67,9 +67,16 @@ pub fn write_series_csv(run: &Run, out: &mut dyn Write) -> std::io::Result<()> {
 /// `impacts.csv`: `t, body_a, body_b, approach_speed, energy_lost, peak_force,
 /// contact_duration` (the last two empty for impulse models).
 pub fn impacts_csv(run: &Run) -> Vec<u8> {
-    let mut w = csv::Writer::from_writer(Vec::new());
-    w.write_record(["t", "body_a", "body_b", "approach_speed", "energy_lost", "peak_force", "contact_duration"])
-        .expect("writing to memory");
+    let mut bytes = Vec::new();
+    write_impacts_csv(run, &mut bytes).expect("writing to memory");
+    bytes
+}
+
+/// [`impacts_csv`] into `out`, row by row: a long run keeps millions of impacts, and their
+/// text is several times their memory.
+pub fn write_impacts_csv(run: &Run, out: &mut dyn Write) -> std::io::Result<()> {
+    let mut w = csv::Writer::from_writer(out);
+    w.write_record(["t", "body_a", "body_b", "approach_speed", "energy_lost", "peak_force", "contact_duration"])?;
     let optional = |x: Option<f64>| x.map_or(String::new(), |x| x.to_string());
     for i in &run.impacts {
         w.write_record([
@@ -80,10 +87,9 @@ pub fn impacts_csv(run: &Run) -> Vec<u8> {
             i.energy_lost.to_string(),
             optional(i.peak_force),
             optional(i.contact_duration),
-        ])
-        .expect("writing to memory");
+        ])?;
     }
-    w.into_inner().expect("writing to memory")
+    w.flush()
 }
 
 /// A CSV table of numbers under `header`; an undefined value (`None`) is an empty cell.
@@ -106,7 +112,6 @@ pub fn write_run_dir(run: &Run, dir: &Path) -> std::io::Result<()> {
 pub fn write_run_dir_with(run: &Run, summary: &RunSummary, dir: &Path) -> std::io::Result<()> {
     std::fs::create_dir_all(dir)?;
     write_atomic_with(&dir.join("series.csv"), |w| write_series_csv(run, w))?;
-    write_atomic(&dir.join("impacts.csv"), &impacts_csv(run))?;
-    let json = serde_json::to_vec_pretty(summary).expect("summary serialises");
-    write_atomic(&dir.join("summary.json"), &json)
+    write_atomic_with(&dir.join("impacts.csv"), |w| write_impacts_csv(run, w))?;
+    write_atomic_with(&dir.join("summary.json"), |w| serde_json::to_writer_pretty(w, summary).map_err(std::io::Error::other))
 }

@@ -67,7 +67,7 @@ const STICK_SPEED: f64 = 1e-9;
 /// Bounce-return time below which a ball sticks to the frame, relative to the time scale.
 const STICK_TIME: f64 = 1e-7;
 
-/// Impacts a run makes room for at its start (80 bytes each).
+/// Impacts a run makes room for at its start (96 bytes each).
 const IMPACTS_RESERVED: usize = 256;
 
 /// Events between two looks at the budgets and two reports of progress.

@@ -6,7 +6,7 @@ use crate::scene::Scene;
 
 /// Bytes the series of a run of `scene` take in memory (and, as text, several times that in
 /// `series.csv`): each sample holds `t`, `xs`, `vs`, `a` and every ball's `x` and `v` (and its
-/// `y` and `z` in a scene beyond one line), eight bytes each. Impacts add about 80 bytes each,
+/// `y` and `z` in a scene beyond one line), eight bytes each. Impacts add 96 bytes each,
 /// which no scene's series comes near.
 pub fn series_bytes(scene: &Scene) -> f64 {
     scene.sample_count() as f64 * sample_bytes(scene) as f64

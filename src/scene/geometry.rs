@@ -41,8 +41,9 @@ pub fn ball_radius(mass: f64, density: f64) -> f64 {
     (3.0 * mass / (4.0 * PI * density)).cbrt()
 }
 
-/// A body that takes part in an impact.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
+/// A body that takes part in an impact; in JSON, its name ([`Body::name`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord, serde::Serialize, serde::Deserialize)]
+#[serde(into = "String", try_from = "String")]
 pub enum Body {
     /// The container's left wall (the frame).
     LeftWall,
@@ -63,6 +64,34 @@ impl Body {
             Body::RightWall => "right-wall".into(),
             Body::SideWall => "side-wall".into(),
             Body::Ball(i) => format!("ball{}", i + 1),
+        }
+    }
+}
+
+impl From<Body> for String {
+    fn from(body: Body) -> String {
+        body.name()
+    }
+}
+
+impl TryFrom<String> for Body {
+    type Error = String;
+
+    /// The body that [`Body::name`] names `name`.
+    fn try_from(name: String) -> Result<Body, String> {
+        match name.as_str() {
+            "left-wall" => Ok(Body::LeftWall),
+            "right-wall" => Ok(Body::RightWall),
+            "side-wall" => Ok(Body::SideWall),
+            _ => name
+                .strip_prefix("ball")
+                .filter(|k| k.bytes().all(|b| b.is_ascii_digit()))
+                .and_then(|k| k.parse::<usize>().ok())
+                .filter(|&k| k >= 1)
+                .map(|k| Body::Ball(k - 1))
+                .ok_or_else(|| {
+                    format!("no body is named `{name}`: a body is `left-wall`, `right-wall`, `side-wall` or `ball1`, `ball2`, ...")
+                }),
         }
     }
 }
@@ -182,6 +211,19 @@ impl Pairs {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// A body is written by its name and read back from it; a name no body has is refused.
+    #[test]
+    fn bodies_are_read_back_from_their_names() {
+        for body in [Body::LeftWall, Body::RightWall, Body::SideWall, Body::Ball(0), Body::Ball(11)] {
+            let json = serde_json::to_string(&body).unwrap();
+            assert_eq!(json, format!("\"{}\"", body.name()));
+            assert_eq!(serde_json::from_str::<Body>(&json).unwrap(), body);
+        }
+        for name in ["ball0", "ball", "ball+1", "ball1x", "wall", "Ball1"] {
+            assert!(Body::try_from(name.to_string()).unwrap_err().contains(name), "{name}");
+        }
+    }
 
     #[test]
     fn one_chain_pairs_are_the_line_pairs() {

@@ -1,6 +1,7 @@
 //! Arguments and helpers that several commands share: output formats, the Rapier model's
 //! flags, loading a scene with command-line overrides, ranges and sizes, JSON and progress.
 
+use std::io::Write;
 use std::path::Path;
 
 use clap::ValueEnum;
@@ -214,6 +215,11 @@ pub fn parse_range(text: &str, path: &Path, field: &str) -> std::result::Result<
 
 /// `value` as pretty JSON on standard output.
 pub fn print_json<T: serde::Serialize>(value: &T) -> Result<()> {
-    println!("{}", serde_json::to_string_pretty(value)?);
+    // Streamed: a long run's summary holds every impact, and its text is several times their
+    // memory.
+    let mut out = std::io::BufWriter::new(std::io::stdout().lock());
+    serde_json::to_writer_pretty(&mut out, value)?;
+    writeln!(out)?;
+    out.flush()?;
     Ok(())
 }
