@@ -255,7 +255,11 @@ impl FrameGap<'_> {
         let mut lo = a;
         if ga <= self.limits.tol {
             // Touching but separating: the return is after the maximum of g (where g' = 0,
-            // g' decreasing on a concave piece).
+            // g' decreasing on a concave piece), so none on this piece while g still rises at
+            // its end (a window that ends within a pressed contact's hop, at the horizon).
+            if self.at(b).1 > 0.0 {
+                return None;
+            }
             let (mut l, mut h) = (a, b);
             for _ in 0..MAX_ROOT_ITERATIONS {
                 let m = 0.5 * (l + h);

@@ -16,6 +16,7 @@ mod issue_14_touching_chain;
 mod loaded_contact_sinks;
 mod overdamped_bed_balance;
 mod plugin_driven_by_app_update;
+mod pressed_at_the_horizon;
 mod record_beyond_double_range;
 mod record_point_inside_step;
 mod resting_ball_without_energy;
