@@ -320,7 +320,7 @@ fn simulate_with(scene: &Scene, options: &RunOptions, waits: bool, max_events: u
                     )));
                 }
                 cost = format!(
-                    "{cost}; {rate:.3e} events per simulated second: a pile or a bed pressed against a wall has each pressed contact struck about once a contact duration (docs/MODEL.md §14, here {} s), and a longer `[reference] contact_duration` makes it cheaper",
+                    "{cost}; {rate:.3e} events per simulated second: a pile or a bed pressed against a wall has each pressed contact struck about once a contact duration (docs/MODEL.md §14, here {} s); a longer `[reference] contact_duration` makes it cheaper, and departs further from the ideal model where the pile is dense (docs/MODEL.md §14, choosing t_c)",
                     crate::scene::human(s.t_c)
                 );
             }
