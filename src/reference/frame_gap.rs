@@ -248,7 +248,7 @@ impl FrameGap<'_> {
             // midpoint then disagrees); otherwise the ball is about to leave the wall.
             return (-self.s * self.frame.accel_ahead(a) < 0.0).then_some(a);
         }
-        let (gb, _) = self.at(b);
+        let (gb, gpb) = self.at(b);
         if gb > self.limits.tol {
             return None; // a concave function's minimum lies at an end of the piece
         }
@@ -257,7 +257,7 @@ impl FrameGap<'_> {
             // Touching but separating: the return is after the maximum of g (where g' = 0,
             // g' decreasing on a concave piece), so none on this piece while g still rises at
             // its end (a window that ends within a pressed contact's hop, at the horizon).
-            if self.at(b).1 > 0.0 {
+            if gpb > 0.0 {
                 return None;
             }
             let (mut l, mut h) = (a, b);
