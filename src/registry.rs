@@ -18,7 +18,8 @@ fn simulator(model: Model) -> &'static dyn Simulator {
 impl Model {
     /// Runs the model on `scene` under `options`. Refused before any work when a budget breaks
     /// its rule, when the model cannot represent the scene, or when the series it keeps would
-    /// not fit in memory.
+    /// not fit in memory. The run (or the run so far) keeps of its impacts what the options
+    /// ask; a model whose impacts could outgrow memory counts them as it goes.
     pub fn simulate(self, scene: &Scene, options: &RunOptions) -> Result<Run, ModelError> {
         if let Err((budget, rule)) = options.limits.check() {
             return Err(ModelError::Refused(format!("{}: {rule}", budget.flag().unwrap_or_default())));
@@ -30,7 +31,16 @@ impl Model {
         if options.record == Record::Series {
             check_memory(scene).map_err(ModelError::Refused)?;
         }
-        model.simulate(scene, options)
+        let keep = options.impacts;
+        let mut run = model.simulate(scene, options).map_err(|e| match e {
+            ModelError::OverBudget(mut stop) => {
+                stop.partial.keep_impacts(keep);
+                ModelError::OverBudget(stop)
+            }
+            e => e,
+        })?;
+        run.keep_impacts(keep);
+        Ok(run)
     }
 
     /// Whether the model can represent `scene`: the reason when it cannot.

@@ -54,6 +54,7 @@ class Run:
     y: npt.NDArray[np.float64] | None
     z: npt.NDArray[np.float64] | None
     impacts: Columns
+    impact_count: int
     metrics: dict[str, float | None]
     energy: dict[str, float]
     noise: dict[str, Any]
@@ -73,6 +74,7 @@ def run(
     tolerance: float | None = None,
     max_steps: int | None = None,
     max_wall_time: float | None = None,
+    impacts: Literal["every", "count"] = "every",
 ) -> Run: ...
 def ensemble(
     scene: Scene,

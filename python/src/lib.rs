@@ -255,6 +255,10 @@ struct Run {
     /// Computing time of the model, s.
     #[pyo3(get)]
     wall_time_s: f64,
+    /// How many impacts the run made: `len(impacts["t"])`, or more when it counted them
+    /// without keeping them (`impacts = "count"`).
+    #[pyo3(get)]
+    impact_count: usize,
     /// The run, whose series move out as they are read.
     run: std::sync::Mutex<lpc_damper::run::Run>,
     /// Everything read so far, by name.
@@ -452,6 +456,7 @@ impl Run {
             model: run.model.name().into(),
             horizon: run.horizon,
             wall_time_s: run.wall_time_s,
+            impact_count: run.impact_count(),
             run: std::sync::Mutex::new(run),
             made: Default::default(),
         }
@@ -468,9 +473,10 @@ fn limits(max_steps: Option<u64>, max_wall_time: Option<f64>) -> PyResult<Limits
 
 /// Runs one model on a damper scene. Every model takes budgets, as the CLI's `--max-steps`
 /// and `--max-wall-time`: a run that exceeds one raises `ModelError` whose `partial` attribute
-/// is the run so far.
+/// is the run so far. `impacts = "count"` (the CLI's `--impacts count`) counts the impacts
+/// without keeping them, for runs whose impacts outgrow memory.
 #[pyfunction]
-#[pyo3(signature = (scene, model = "reference", *, horizon = None, sample_dt = None, stepping = None, dt = None, solver_iterations = None, ccd = false, tolerance = None, max_steps = None, max_wall_time = None))]
+#[pyo3(signature = (scene, model = "reference", *, horizon = None, sample_dt = None, stepping = None, dt = None, solver_iterations = None, ccd = false, tolerance = None, max_steps = None, max_wall_time = None, impacts = "every"))]
 #[allow(clippy::too_many_arguments)]
 fn run(
     py: Python<'_>,
@@ -485,10 +491,12 @@ fn run(
     tolerance: Option<f64>,
     max_steps: Option<u64>,
     max_wall_time: Option<f64>,
+    impacts: &str,
 ) -> PyResult<Run> {
     let model = parse_model(model)?;
     let s = scene.damper(&Settings { horizon, sample_dt, stepping, dt, solver_iterations, ccd, tolerance })?;
-    let options = RunOptions::limited(limits(max_steps, max_wall_time)?);
+    let impacts = impacts.parse().map_err(|e| SceneError::new_err(format!("impacts: {e}")))?;
+    let options = RunOptions { impacts, ..RunOptions::limited(limits(max_steps, max_wall_time)?) };
     match py.detach(|| model.simulate(&s, &options)) {
         Ok(run) => Ok(Run::of(run)),
         Err(RustModelError::OverBudget(stop)) => {

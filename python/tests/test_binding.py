@@ -264,6 +264,19 @@ def test_a_budget_stops_every_model_and_keeps_the_run_so_far(scenes):
         lpc.run(scene, model="compliant", max_wall_time=-1.0)
 
 
+def test_a_run_that_counts_its_impacts_keeps_the_same_account(scenes):
+    """`impacts="count"` drops the list, not the physics: the same count, the same energy
+    account and metrics as the run that keeps every impact; a bad choice is refused."""
+    scene = lpc.load_scene(scenes / "planar-bed.toml")
+    every = lpc.run(scene, horizon=0.05)
+    counted = lpc.run(scene, horizon=0.05, impacts="count")
+    assert counted.impact_count == every.impact_count == len(every.impacts["t"]) > 100
+    assert len(counted.impacts["t"]) == 0
+    assert counted.energy == every.energy and counted.metrics == every.metrics
+    with pytest.raises(lpc.SceneError, match="impacts: must be `every` or `count`"):
+        lpc.run(scene, impacts="some")
+
+
 def test_studies_give_each_run_the_budget(scenes):
     """Every function that runs a model takes the budgets: a chain whose runs exceed one
     raises, a frequency response reports each frequency's stop, bad budgets are refused."""

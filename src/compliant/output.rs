@@ -115,6 +115,7 @@ impl Driver<'_, '_> {
             series,
             motion,
             impacts: self.impacts,
+            counted_impacts: crate::run::CountedImpacts::default(),
             energy,
             events: self.accepted,
             final_velocities,

@@ -180,7 +180,7 @@ pub struct Noise {
 /// Impacts per simulated second of `run` (0 for a run of no time).
 pub fn impact_rate(run: &Run) -> f64 {
     if run.horizon > 0.0 {
-        run.impacts.len() as f64 / run.horizon
+        run.impact_count() as f64 / run.horizon
     } else {
         0.0
     }
@@ -211,7 +211,7 @@ pub fn metrics(run: &Run) -> Metrics {
         energy_remaining: (run.energy.initial != 0.0).then(|| run.energy.final_ / run.energy.initial),
         dissipation_time_90: m.dissipation_times[0],
         dissipation_time_99: m.dissipation_times[1],
-        peak_contact_force: run.impacts.iter().filter_map(|i| i.peak_force).reduce(f64::max),
+        peak_contact_force: run.peak_contact_force(),
         peak_true_acceleration: run.peak_true_acceleration,
         peak_drift: m.peak_drift,
         peak_roof_displacement: m.peak_roof_displacement,

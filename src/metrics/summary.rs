@@ -64,8 +64,13 @@ pub struct RunSummary {
     pub horizon: f64,
     /// Number of impacts.
     pub impact_count: usize,
-    /// Every impact.
+    /// Every impact (none when the run counted them without keeping them).
     pub impacts: Vec<ImpactSummary>,
+    /// Present and true when the run counted its impacts without keeping them
+    /// ([`crate::run::ImpactRecord::Count`]): `impacts` is then empty, and the noise proxy has
+    /// its rate but none of its spreads.
+    #[serde(default, skip_serializing_if = "std::ops::Not::not")]
+    pub impacts_not_kept: bool,
     /// Headline metrics.
     pub metrics: Metrics,
     /// Energy account.
@@ -134,7 +139,7 @@ impl RunSummary {
             scene: run.scene.clone(),
             model: run.model,
             horizon: run.horizon,
-            impact_count: run.impacts.len(),
+            impact_count: run.impact_count(),
             impacts: run
                 .impacts
                 .iter()
@@ -147,6 +152,7 @@ impl RunSummary {
                     contact_duration: i.contact_duration,
                 })
                 .collect(),
+            impacts_not_kept: run.counted_impacts.count > 0,
             metrics: metrics(run),
             energy: EnergySummary {
                 initial: run.energy.initial,
@@ -185,7 +191,7 @@ impl Headline {
     pub fn of_run(run: &Run) -> Self {
         Headline {
             metrics: metrics(run),
-            impact_count: run.impacts.len(),
+            impact_count: run.impact_count(),
             impact_loss: run.energy.impact_loss,
             impact_rate: crate::metrics::impact_rate(run),
         }

@@ -4,13 +4,15 @@
 use std::sync::atomic::{AtomicU64, Ordering};
 use std::time::Instant;
 
-use crate::run::Record;
+use crate::run::{ImpactRecord, Record};
 
 /// How one run is to be made.
 #[derive(Debug, Clone, Copy, Default)]
 pub struct RunOptions<'a> {
     /// What the run keeps besides its metrics.
     pub record: Record,
+    /// What the run keeps of its impacts.
+    pub impacts: ImpactRecord,
     /// What the run may cost before it stops with the run so far.
     pub limits: Limits,
     /// Where the run reports the simulated time reached and the steps taken as it goes.
@@ -18,9 +20,9 @@ pub struct RunOptions<'a> {
 }
 
 impl RunOptions<'_> {
-    /// A run that keeps only its metrics (an ensemble member's).
+    /// A run that keeps only its metrics and counts its impacts (an ensemble member's).
     pub fn metrics_only() -> Self {
-        RunOptions { record: Record::MetricsOnly, ..RunOptions::default() }
+        RunOptions { record: Record::MetricsOnly, impacts: ImpactRecord::Count, ..RunOptions::default() }
     }
     /// A run that keeps its series, within `limits`.
     pub fn limited(limits: Limits) -> Self {

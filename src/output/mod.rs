@@ -11,7 +11,14 @@ use crate::metrics::{Noise, RunSummary};
 pub use run_dir::{impacts_csv, series_csv, table_csv, write_impacts_csv, write_run_dir, write_run_dir_with};
 
 fn noise_line(n: &Noise) -> String {
-    let Some(e) = n.energy_lost else { return "no impacts".into() };
+    let Some(e) = n.energy_lost else {
+        // A run that counted its impacts without keeping them has their rate but no spreads.
+        return if n.impact_rate > 0.0 {
+            format!("{:.1} impacts/s (counted, not kept: no spreads)", n.impact_rate)
+        } else {
+            "no impacts".into()
+        };
+    };
     let mut line =
         format!("{:.1} impacts/s; energy lost per impact mean {:.3e} J, p95 {:.3e} J, max {:.3e} J", n.impact_rate, e.mean, e.p95, e.max);
     if let Some(f) = n.peak_force {
@@ -27,7 +34,7 @@ pub fn text_summary(s: &RunSummary) -> String {
     let e = &s.energy;
     format!(
         "scene {} | model {} | horizon {} s | computed in {:.3} ms\n\
-         impacts            {}\n\
+         impacts            {}{}\n\
          peak displacement  {:.4} mm (t >= T)\n\
          peak acceleration  {:.4} m/s^2 (t >= T){}\n\
          rms displacement   {:.4} mm\n\
@@ -40,6 +47,7 @@ pub fn text_summary(s: &RunSummary) -> String {
         s.horizon,
         s.wall_time_s * 1e3,
         s.impact_count,
+        if s.impacts_not_kept { " (counted, not kept)" } else { "" },
         m.peak_displacement * 1e3,
         m.peak_acceleration,
         match (m.peak_true_acceleration, m.peak_contact_force) {

@@ -102,7 +102,8 @@ pub fn table_csv(header: &[String], rows: impl IntoIterator<Item = Vec<Option<f6
     w.into_inner().expect("writing to memory")
 }
 
-/// Writes `series.csv`, `impacts.csv` and `summary.json` of `run` into `dir`.
+/// Writes `series.csv`, `impacts.csv` and `summary.json` of `run` into `dir`; without
+/// `impacts.csv` (an older one removed) when the run counted its impacts without keeping them.
 pub fn write_run_dir(run: &Run, dir: &Path) -> std::io::Result<()> {
     write_run_dir_with(run, &RunSummary::of(run), dir)
 }
@@ -112,6 +113,12 @@ pub fn write_run_dir(run: &Run, dir: &Path) -> std::io::Result<()> {
 pub fn write_run_dir_with(run: &Run, summary: &RunSummary, dir: &Path) -> std::io::Result<()> {
     std::fs::create_dir_all(dir)?;
     write_atomic_with(&dir.join("series.csv"), |w| write_series_csv(run, w))?;
-    write_atomic_with(&dir.join("impacts.csv"), |w| write_impacts_csv(run, w))?;
+    let impacts = dir.join("impacts.csv");
+    if run.counted_impacts.count == 0 {
+        write_atomic_with(&impacts, |w| write_impacts_csv(run, w))?;
+    } else if impacts.exists() {
+        // An older run's list would be read as this run's.
+        std::fs::remove_file(&impacts)?;
+    }
     write_atomic_with(&dir.join("summary.json"), |w| serde_json::to_writer_pretty(w, summary).map_err(std::io::Error::other))
 }

@@ -194,6 +194,7 @@ pub fn collect(world: &mut World, scene: &Scene, t: f64, steps: u64) -> Run {
         series,
         motion,
         impacts: rec.impacts,
+        counted_impacts: crate::run::CountedImpacts::default(),
         energy,
         events: steps,
         final_velocities: rec.v,

@@ -42,8 +42,10 @@ use crate::scene::{Body, Scene};
 
 /// Most events one run may process: each may be an impact, which the run keeps for its
 /// outputs (96 bytes, 1.9 GB at the bound). On one line, where the resting state keeps a
-/// run's events few, a run past it is declared stalled; beyond one line, where the collapse
-/// rule makes a pile's events at a steady rate, it stops with the run so far.
+/// run's events few, a run past it is declared stalled. Beyond one line, where the collapse
+/// rule makes a pile's events at a steady rate, a run that keeps its impacts stops there with
+/// the run so far (or as stalled, if it made them faster than the rule makes a pile's), and
+/// one that counts them goes on.
 pub const MAX_EVENTS: u64 = 20_000_000;
 /// Most events at one instant: everything at an instant is resolved by one `resolve`, so a
 /// second event at the same time already means two judgements disagree.

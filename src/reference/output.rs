@@ -276,6 +276,7 @@ impl Solver<'_> {
             series,
             motion,
             impacts: self.ledger.impacts,
+            counted_impacts: crate::run::CountedImpacts::default(),
             energy,
             events: self.events,
             final_velocities,

@@ -101,6 +101,48 @@ pub struct Impact {
     pub contact_duration: Option<f64>,
 }
 
+/// What a run keeps of its impacts. Their energy is in its account either way.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum ImpactRecord {
+    /// Every impact, in time order (`impacts.csv`, the noise proxy's spreads, pictures).
+    #[default]
+    Every,
+    /// Their count and largest contact force only: a long run of a pile makes hundreds of
+    /// millions of impacts, more than memory holds.
+    Count,
+}
+
+impl ImpactRecord {
+    /// Every choice, as the command line and the Python binding name them.
+    pub const ALL: [(ImpactRecord, &'static str); 2] = [(ImpactRecord::Every, "every"), (ImpactRecord::Count, "count")];
+}
+
+impl std::str::FromStr for ImpactRecord {
+    type Err = String;
+    fn from_str(s: &str) -> Result<Self, String> {
+        Self::ALL.iter().find(|(_, name)| *name == s).map(|(r, _)| *r).ok_or_else(|| format!("must be `every` or `count` (got `{s}`)"))
+    }
+}
+
+/// The impacts a run counted without keeping them ([`ImpactRecord::Count`]).
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct CountedImpacts {
+    /// How many.
+    pub count: usize,
+    /// The largest contact force among them, N (compliant contact only).
+    pub peak_force: Option<f64>,
+}
+
+impl CountedImpacts {
+    /// Counts `impact`.
+    pub fn add(&mut self, impact: &Impact) {
+        self.count += 1;
+        if let Some(f) = impact.peak_force {
+            self.peak_force = Some(self.peak_force.map_or(f, |p| p.max(f)));
+        }
+    }
+}
+
 /// Where the energy went.
 /// `balance_error = (initial + forcing_work - final - damping_loss - impact_loss - contact_loss)
 /// / (|initial| + |forcing_work|)`.
@@ -169,8 +211,11 @@ pub struct Run {
     /// The metrics of the motion (tallied at the samples, or exact where a model knows its
     /// motion in closed form).
     pub motion: MotionMetrics,
-    /// Every impact, in time order.
+    /// Every impact, in time order (none when the run only counted them,
+    /// [`ImpactRecord::Count`]).
     pub impacts: Vec<Impact>,
+    /// The impacts counted but not kept.
+    pub counted_impacts: CountedImpacts,
     /// Energy account.
     pub energy: EnergyAccount,
     /// Events processed (impacts, sticks, releases); for stall detection.
@@ -206,11 +251,32 @@ impl Run {
             series: Series::default(),
             motion: MotionMetrics::default(),
             impacts: vec![],
+            counted_impacts: CountedImpacts::default(),
             energy: EnergyAccount::default(),
             events: 0,
             final_velocities: vec![],
             peak_true_acceleration: None,
             wall_time_s: 0.0,
+        }
+    }
+
+    /// How many impacts the run made, kept or only counted.
+    pub fn impact_count(&self) -> usize {
+        self.impacts.len() + self.counted_impacts.count
+    }
+
+    /// The largest contact force of any impact, N (compliant contact only).
+    pub fn peak_contact_force(&self) -> Option<f64> {
+        self.impacts.iter().filter_map(|i| i.peak_force).chain(self.counted_impacts.peak_force).reduce(f64::max)
+    }
+
+    /// Keeps of the run's impacts what `record` asks: under [`ImpactRecord::Count`] the list
+    /// goes into the count.
+    pub fn keep_impacts(&mut self, record: ImpactRecord) {
+        if record == ImpactRecord::Count {
+            for i in std::mem::take(&mut self.impacts) {
+                self.counted_impacts.add(&i);
+            }
         }
     }
 }

@@ -142,7 +142,7 @@ fn run_case(scene: &scene::Scene, model: Model) -> Result<Golden, StudyError> {
         Ok(run) => Golden {
             case,
             model,
-            impact_count: run.impacts.len(),
+            impact_count: run.impact_count(),
             metrics: Some(metrics(&run)),
             ker: vec![],
             stopped_at: None,

@@ -58,7 +58,7 @@ pub fn errors(run: &Run, reference: &Run) -> Errors {
         max_xs_early: early,
         settling_time_diff: ma.settling_time.zip(mr.settling_time).map(|(a, r)| a - r),
         impact_loss_diff: (run.energy.impact_loss - reference.energy.impact_loss) / initial,
-        impact_count_diff: run.impacts.len() as i64 - reference.impacts.len() as i64,
+        impact_count_diff: run.impact_count() as i64 - reference.impact_count() as i64,
     }
 }
 

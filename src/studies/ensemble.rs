@@ -13,7 +13,7 @@ use serde::{Deserialize, Serialize};
 
 use crate::metrics::{Headline, Metric};
 use crate::model::{Limits, Model, ModelError, RunOptions};
-use crate::run::{refuse_beyond_memory, Record};
+use crate::run::{refuse_beyond_memory, ImpactRecord, Record};
 use crate::scene::{self, Distribution, Length, Parameter, Scene, SceneError, SceneFile, Tolerances};
 
 /// Draws one member may take before its tolerances are declared too wide for it.
@@ -435,8 +435,9 @@ pub struct EnsembleRuns {
     pub xs: Vec<Vec<f64>>,
 }
 
-/// Runs every member with `model`, each within `limits`. Members build no series unless `keep_xs`, which keeps each
-/// member's frame displacement (the ensemble's band) and drops the rest.
+/// Runs every member with `model`, each within `limits`. Members count their impacts rather
+/// than keep them, and build no series unless `keep_xs`, which keeps each member's frame
+/// displacement (the ensemble's band) and drops the rest.
 pub fn run_members(
     ensemble: &Ensemble,
     model: Model,
@@ -444,7 +445,12 @@ pub fn run_members(
     keep_xs: bool,
     progress: &(dyn Fn() + Sync),
 ) -> Result<EnsembleRuns, ModelError> {
-    let record = if keep_xs { Record::Series } else { Record::MetricsOnly };
+    let options = RunOptions {
+        record: if keep_xs { Record::Series } else { Record::MetricsOnly },
+        impacts: ImpactRecord::Count,
+        limits,
+        progress: None,
+    };
     if keep_xs {
         if let Some(first) = ensemble.members.first() {
             check_band_memory(&first.scene, ensemble.members.len())?;
@@ -453,7 +459,7 @@ pub fn run_members(
     let runs = map_members(
         &ensemble.members,
         |m| {
-            let run = model.simulate(&m.scene, &RunOptions { record, limits, ..RunOptions::default() })?;
+            let run = model.simulate(&m.scene, &options)?;
             let metrics = Headline::of_run(&run).values();
             let series = keep_xs.then_some(run.series);
             Ok::<_, ModelError>((metrics, series))

@@ -3,6 +3,7 @@
 //! progress, a budget that bounds it).
 
 use lpc_damper::model::{Budget, Limits, Model, ModelError, Progress, RunOptions};
+use lpc_damper::run::ImpactRecord;
 use lpc_damper::scene::{load_scene, scenes_dir};
 
 /// A finished run has reported its end: the horizon reached, and as many steps as it took
@@ -73,4 +74,54 @@ fn every_command_takes_the_budgets() {
         assert!(p["amplitude"].is_null(), "{p}");
         assert!(p["error"].as_str().unwrap().contains("--max-steps"), "{p}");
     }
+}
+
+/// A run that counts its impacts instead of keeping them (what a long run of a pile needs)
+/// is the run that keeps them, less the list: every model gives the same count, energy
+/// account and peak contact force either way, and so does its run so far at a budget.
+#[test]
+fn every_model_counts_its_impacts_when_asked() {
+    let scene = load_scene(scenes_dir().join("lpc-lsl.toml")).unwrap();
+    let counting = RunOptions { impacts: ImpactRecord::Count, ..RunOptions::default() };
+    for (model, budget) in [(Model::Reference, 40), (Model::Rapier, 300), (Model::Compliant, 3000)] {
+        let every = model.simulate(&scene, &RunOptions::default()).unwrap();
+        let counted = model.simulate(&scene, &counting).unwrap();
+        assert!(counted.impacts.is_empty() && every.impacts.len() > 10, "{model}: {} impacts", every.impacts.len());
+        assert_eq!(counted.impact_count(), every.impacts.len(), "{model}");
+        assert_eq!((counted.energy, counted.peak_contact_force()), (every.energy, every.peak_contact_force()), "{model}");
+        let limits = Limits { max_steps: Some(budget), ..Limits::NONE };
+        let stopped = |options: RunOptions| match model.simulate(&scene, &RunOptions { limits, ..options }) {
+            Err(ModelError::OverBudget(stop)) => stop.partial,
+            other => panic!("{model}: {:?}", other.map(|r| r.horizon)),
+        };
+        let (every, counted) = (stopped(RunOptions::default()), stopped(counting));
+        assert!(counted.impacts.is_empty() && !every.impacts.is_empty(), "{model}");
+        assert_eq!((counted.impact_count(), counted.energy), (every.impacts.len(), every.energy), "{model}");
+    }
+}
+
+/// `lpc run --impacts count --out` writes the series and a summary that says the list was not
+/// kept, with the count of the run that keeps it; it writes no `impacts.csv`, and removes an
+/// older one, which would be read as this run's.
+#[test]
+fn a_run_that_counts_its_impacts_writes_no_list() {
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::write(dir.path().join("impacts.csv"), "t,body_a,body_b\n").unwrap();
+    let out = dir.path().to_str().unwrap();
+    let args = ["run", "scenes/planar-bed.toml", "--horizon", "0.05", "--format", "json"];
+    let every = crate::common::lpc(args);
+    assert_eq!(every.status.code(), Some(0), "{}", String::from_utf8_lossy(&every.stderr));
+    let every: serde_json::Value = serde_json::from_slice(&every.stdout).unwrap();
+    let counted = crate::common::lpc(args.iter().chain(&["--impacts", "count", "--out", out]));
+    assert_eq!(counted.status.code(), Some(0), "{}", String::from_utf8_lossy(&counted.stderr));
+    let summary: serde_json::Value = serde_json::from_slice(&std::fs::read(dir.path().join("summary.json")).unwrap()).unwrap();
+    assert_eq!(summary["impacts_not_kept"], true);
+    assert!(every.get("impacts_not_kept").is_none());
+    assert_eq!(summary["impact_count"], every["impact_count"]);
+    assert!(every["impact_count"].as_u64().unwrap() > 100 && summary["impacts"].as_array().unwrap().is_empty());
+    assert_eq!(summary["energy"], every["energy"]);
+    assert!(dir.path().join("series.csv").exists() && !dir.path().join("impacts.csv").exists());
+    let bad = crate::common::lpc(["run", "scenes/planar-bed.toml", "--impacts", "some"]);
+    assert_eq!(bad.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&bad.stderr).contains("--impacts"), "{}", String::from_utf8_lossy(&bad.stderr));
 }

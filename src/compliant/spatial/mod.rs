@@ -742,6 +742,7 @@ impl<'a> Solver<'a> {
             series,
             motion,
             impacts: self.impacts,
+            counted_impacts: crate::run::CountedImpacts::default(),
             energy: EnergyAccount::forced(scene.initial_energy(), final_, self.damping_loss, self.impact_loss, self.forcing_work)
                 .with_contact_loss(self.friction_loss),
             events: self.steps,

@@ -313,6 +313,7 @@ pub fn simulate_spatial_with(scene: &Scene, solver: SolverSettings, options: &Ru
             series,
             motion,
             impacts,
+            counted_impacts: crate::run::CountedImpacts::default(),
             energy: EnergyAccount::forced(initial_energy, final_, damping_loss, impact_loss, forcing_work).with_contact_loss(contact_loss),
             events: steps,
             final_velocities: state.v.iter().map(|v| v[0]).collect(),

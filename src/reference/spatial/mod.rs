@@ -23,7 +23,7 @@ use super::geometry::Limits;
 use super::MAX_EVENTS;
 use crate::impact_law::{reduced_mass, separate};
 use crate::model::{Budget, Meter, Model, ModelError, OverBudget, RunOptions, STALL_EVENTS_PER_SIM_S};
-use crate::run::{EnergyAccount, Impact, Recorder, Run};
+use crate::run::{CountedImpacts, EnergyAccount, Impact, ImpactRecord, Recorder, Run};
 use crate::scene::{Body, Scene};
 use calendar::Calendar;
 use cells::Cells;
@@ -197,7 +197,10 @@ struct Solver<'a> {
     t: f64,
     horizon: f64,
     events: u64,
+    /// Whether the run keeps every impact ([`ImpactRecord::Every`]) or counts them.
+    keeps_impacts: bool,
     impacts: Vec<Impact>,
+    counted_impacts: CountedImpacts,
     impact_loss: f64,
     damping_loss: f64,
     forcing_work: f64,
@@ -289,10 +292,13 @@ pub(super) fn simulate(scene: &Scene, options: &RunOptions) -> Result<Run, Model
 
 /// [`simulate`], with the balls waiting before their searches against the frame's walls where
 /// the frame's motion is bounded (`waits`), or always searching, and stopping past
-/// `max_events` events.
+/// `max_events` events when it keeps every impact.
 fn simulate_with(scene: &Scene, options: &RunOptions, waits: bool, max_events: u64) -> Result<Run, ModelError> {
-    let meter = Meter::new(options, BUDGET_EVENTS).keeping(max_events);
-    let mut s = Solver::new(scene)?;
+    // Only a run that keeps every impact is bounded by memory; one that counts them only by its
+    // budgets (and stops as stalled if its events pile up at one instant).
+    let meter = Meter::new(options, BUDGET_EVENTS);
+    let meter = if options.impacts == ImpactRecord::Every { meter.keeping(max_events) } else { meter };
+    let mut s = Solver::new(scene, options.impacts)?;
     if !waits {
         s.frame_reach = None;
     }
@@ -310,17 +316,17 @@ fn simulate_with(scene: &Scene, options: &RunOptions, waits: bool, max_events: u
             let wall_s = meter.elapsed();
             let steps = s.events;
             let rate = steps as f64 / t;
-            let mut cost = format!("{} impacts so far; {} balls", s.impacts.len(), s.balls.len());
+            let mut cost = format!("{} impacts so far; {} balls", s.impacts.len() + s.counted_impacts.count, s.balls.len());
             if budget == Budget::Memory {
-                // Past the rate the collapse rule can make, the events are a flood that no
-                // part of it resolves; below it, a pile's steady price.
+                // Past the rate the collapse rule makes on a pile, the events are a flood that
+                // no part of it resolves; below it, a pile's steady price.
                 if rate > stall_rate(scene) {
                     return Err(s.stalled(format!(
                         "more than {max_events} events, {rate:.3e} per simulated second, more than the collapse rule makes (docs/MODEL.md §14)"
                     )));
                 }
                 cost = format!(
-                    "{cost}; {rate:.3e} events per simulated second: a pile or a bed pressed against a wall has each pressed contact struck about once a contact duration (docs/MODEL.md §14, here {} s); a longer `[reference] contact_duration` makes it cheaper, and departs further from the ideal model where the pile is dense (docs/MODEL.md §14, choosing t_c)",
+                    "{cost}; {rate:.3e} events per simulated second: a pile or a bed pressed against a wall has each pressed contact struck about once a contact duration (docs/MODEL.md §14, here {} s); a run that counts its impacts instead of keeping them (`--impacts count`) is not bounded by memory, and a longer `[reference] contact_duration` makes it cheaper but departs further from the ideal model where the pile is dense (docs/MODEL.md §14, choosing t_c)",
                     crate::scene::human(s.t_c)
                 );
             }
@@ -343,7 +349,7 @@ fn simulate_with(scene: &Scene, options: &RunOptions, waits: bool, max_events: u
 }
 
 impl<'a> Solver<'a> {
-    fn new(scene: &'a Scene) -> Result<Self, ModelError> {
+    fn new(scene: &'a Scene, impacts: ImpactRecord) -> Result<Self, ModelError> {
         let container = scene.container.expect("refusal checks the container");
         let largest = scene.balls.iter().map(|b| b.radius).fold(0.0, f64::max);
         let mut cells = Cells::new(largest, container.length, scene.space.section, scene.balls.len());
@@ -395,7 +401,9 @@ impl<'a> Solver<'a> {
             t: 0.0,
             horizon: scene.horizon,
             events: 0,
+            keeps_impacts: impacts == ImpactRecord::Every,
             impacts: Vec::new(),
+            counted_impacts: CountedImpacts::default(),
             impact_loss: 0.0,
             damping_loss: 0.0,
             forcing_work: 0.0,
@@ -730,16 +738,13 @@ impl<'a> Solver<'a> {
 
     fn record(&mut self, a: Body, b: Body, approach: f64, lost: f64) {
         self.impact_loss += lost;
-        self.impacts.push(Impact {
-            t: self.t,
-            a,
-            b,
-            approach_speed: approach,
-            energy_lost: lost,
-            impulses: 1,
-            peak_force: None,
-            contact_duration: None,
-        });
+        let impact =
+            Impact { t: self.t, a, b, approach_speed: approach, energy_lost: lost, impulses: 1, peak_force: None, contact_duration: None };
+        if self.keeps_impacts {
+            self.impacts.push(impact);
+        } else {
+            self.counted_impacts.add(&impact);
+        }
     }
 
     /// A ball resting on a wall keeps none of its velocity into it (the wall takes it, a
@@ -1031,6 +1036,7 @@ impl<'a> Solver<'a> {
             series,
             motion,
             impacts: self.impacts,
+            counted_impacts: self.counted_impacts,
             energy: EnergyAccount::forced(
                 scene.initial_energy(),
                 final_,
@@ -1116,7 +1122,7 @@ mod tests {
         }
         let scene = crate::scene::parse(&text, "gas.toml", "gas").unwrap().scene.unwrap();
         let options = RunOptions::default();
-        let mut solver = Solver::new(&scene).unwrap();
+        let mut solver = Solver::new(&scene, ImpactRecord::Every).unwrap();
         let first = solver.frame_reach.as_ref().unwrap().reach;
         solver.run(&Meter::new(&options, BUDGET_EVENTS), &mut Recorder::new(&scene, options.record)).unwrap();
         let last = solver.frame_reach.as_ref().unwrap().reach;
@@ -1149,5 +1155,21 @@ mod tests {
         assert!(!partial.impacts.is_empty() && partial.impacts.len() < whole.impacts.len());
         assert_eq!(partial.impacts[..], whole.impacts[..partial.impacts.len()]);
         assert!(partial.energy.balance_error.abs() <= 1e-12, "{:?}", partial.energy);
+        assert!(message.contains("`--impacts count`"), "{message}");
+    }
+
+    /// A run that counts its impacts instead of keeping them is not bounded by memory: past
+    /// the bound it goes on to the horizon, and it is the run that keeps them, less the list.
+    #[test]
+    fn a_run_that_counts_its_impacts_goes_past_the_bound_on_events_kept() {
+        let mut scene = crate::scene::load(crate::scene::scenes_dir().join("planar-bed.toml")).unwrap().scene.unwrap();
+        scene.horizon = 0.5;
+        let whole = simulate(&scene, &RunOptions::default()).unwrap();
+        let counting = RunOptions { impacts: ImpactRecord::Count, ..RunOptions::default() };
+        let counted = simulate_with(&scene, &counting, true, whole.events / 2).unwrap();
+        assert!(counted.impacts.is_empty());
+        assert_eq!((counted.counted_impacts.count, counted.impact_count()), (whole.impacts.len(), whole.impact_count()));
+        assert_eq!((counted.horizon, counted.events, counted.energy), (whole.horizon, whole.events, whole.energy));
+        assert_eq!((counted.series.xs(), counted.final_velocities.as_slice()), (whole.series.xs(), whole.final_velocities.as_slice()));
     }
 }

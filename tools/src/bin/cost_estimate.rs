@@ -5,7 +5,6 @@
 //!
 //! `cargo run --release -p lpc-tools --bin cost_estimate -- examples/scenes/packed-column.toml 31338 80056 ...`
 use lpc_damper::model::{cost, Limits, Model, Progress, RunOptions};
-use lpc_damper::run::Record;
 
 fn main() {
     println!("| scene | balls | first said at | said steps | said s | revisions | last said s | steps | s | said / took |");
@@ -23,9 +22,9 @@ fn main() {
         let mut said = Vec::new();
         let start = std::time::Instant::now();
         let options = RunOptions {
-            record: Record::MetricsOnly,
             limits: Limits { max_wall_s: Some(60.0), ..Limits::NONE },
             progress: Some(&progress),
+            ..RunOptions::metrics_only()
         };
         let run = std::thread::scope(|s| {
             let watcher = s.spawn(|| {

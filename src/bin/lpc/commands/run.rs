@@ -7,6 +7,7 @@ use std::path::{Path, PathBuf};
 use anyhow::Context;
 
 use lpc_damper::model::RunOptions;
+use lpc_damper::run::ImpactRecord;
 
 use lpc_damper::files::write_atomic;
 use lpc_damper::metrics::{Metric, RunSummary};
@@ -39,6 +40,12 @@ pub struct Args {
     /// Write series.csv, impacts.csv and summary.json into this directory.
     #[arg(long)]
     out: Option<PathBuf>,
+    /// What the run keeps of its impacts: every one (impacts.csv, the noise proxy's spreads),
+    /// or only their count, for runs whose impacts outgrow memory (a long run of a pile makes
+    /// hundreds of millions). Their energy is in the account either way; ensemble members
+    /// always count them.
+    #[arg(long, value_name = "every|count", default_value = "every")]
+    impacts: ImpactRecord,
     /// Output format on standard output.
     #[arg(long, value_enum, default_value_t = Format::Text)]
     format: Format,
@@ -71,7 +78,7 @@ pub fn run(a: Args) -> Result<ExitStatus> {
             lpc_damper::scene::human(scene.sample_dt * every as f64)
         );
     }
-    let run = crate::watch::watched(a.model, &scene, RunOptions::limited(limits), a.out.as_deref())?;
+    let run = crate::watch::watched(a.model, &scene, RunOptions { impacts: a.impacts, ..RunOptions::limited(limits) }, a.out.as_deref())?;
     let mut summary = RunSummary::of(&run);
     if scene.structure.is_some() && !scene.balls.is_empty() {
         // The structure alone, for the floors' response without the damper.
@@ -86,7 +93,8 @@ pub fn run(a: Args) -> Result<ExitStatus> {
         Format::Text => {
             print!("{}", text_summary(&summary));
             if let Some(dir) = &a.out {
-                println!("wrote series.csv, impacts.csv, summary.json to {}", dir.display());
+                let files = if summary.impacts_not_kept { "series.csv, summary.json" } else { "series.csv, impacts.csv, summary.json" };
+                println!("wrote {files} to {}", dir.display());
             }
         }
     }
