@@ -102,7 +102,8 @@ fn every_model_counts_its_impacts_when_asked() {
 
 /// `lpc run --impacts count --out` writes the series and a summary that says the list was not
 /// kept, with the count of the run that keeps it; it writes no `impacts.csv`, and removes an
-/// older one, which would be read as this run's.
+/// older one, which would be read as this run's. With `--ensemble`, the nominal run it writes
+/// beside the members counts its impacts too.
 #[test]
 fn a_run_that_counts_its_impacts_writes_no_list() {
     let dir = tempfile::tempdir().unwrap();
@@ -121,6 +122,14 @@ fn a_run_that_counts_its_impacts_writes_no_list() {
     assert!(every["impact_count"].as_u64().unwrap() > 100 && summary["impacts"].as_array().unwrap().is_empty());
     assert_eq!(summary["energy"], every["energy"]);
     assert!(dir.path().join("series.csv").exists() && !dir.path().join("impacts.csv").exists());
+    // An ensemble's nominal run, which --out writes beside the members, counts them too.
+    let ensemble = dir.path().join("ensemble");
+    let args = ["run", "scenes/planar-bed.toml", "--horizon", "0.05", "--ensemble", "2", "--impacts", "count", "--out"];
+    let counted = crate::common::lpc(args.iter().map(std::ffi::OsStr::new).chain([ensemble.as_os_str()]));
+    assert_eq!(counted.status.code(), Some(0), "{}", String::from_utf8_lossy(&counted.stderr));
+    let summary: serde_json::Value = serde_json::from_slice(&std::fs::read(ensemble.join("summary.json")).unwrap()).unwrap();
+    assert_eq!((&summary["impacts_not_kept"], &summary["impact_count"]), (&serde_json::json!(true), &every["impact_count"]));
+    assert!(ensemble.join("members.csv").exists() && !ensemble.join("impacts.csv").exists());
     let bad = crate::common::lpc(["run", "scenes/planar-bed.toml", "--impacts", "some"]);
     assert_eq!(bad.status.code(), Some(2));
     assert!(String::from_utf8_lossy(&bad.stderr).contains("--impacts"), "{}", String::from_utf8_lossy(&bad.stderr));

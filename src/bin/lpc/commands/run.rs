@@ -42,8 +42,8 @@ pub struct Args {
     out: Option<PathBuf>,
     /// What the run keeps of its impacts: every one (impacts.csv, the noise proxy's spreads),
     /// or only their count, for runs whose impacts outgrow memory (a long run of a pile makes
-    /// hundreds of millions). Their energy is in the account either way; ensemble members
-    /// always count them.
+    /// hundreds of millions). Their energy is in the account either way. Ensemble members
+    /// always count them; this applies to the nominal run that --ensemble --out writes.
     #[arg(long, value_name = "every|count", default_value = "every")]
     impacts: ImpactRecord,
     /// Output format on standard output.
@@ -109,7 +109,7 @@ fn run_ensemble(a: &Args, nominal: &lpc_damper::scene::Scene, members: &Ensemble
     work.finish();
     let summary = EnsembleSummary::of(&nominal.name, a.model, members, &runs.metrics, wall_time_s);
     if let Some(dir) = &a.out {
-        write_ensemble_dir(dir, a.model, nominal, members, &runs, &summary)
+        write_ensemble_dir(dir, a.model, a.impacts, nominal, members, &runs, &summary)
             .with_context(|| format!("writing outputs to {}", dir.display()))?;
     }
     print_ensemble(
@@ -221,16 +221,18 @@ pub fn print_ensemble(summary: &EnsembleSummary, format: Format, wrote: Option<(
 }
 
 /// `members.csv` (each member's draws, then every metric), `ensemble.json`, `band.csv`, and
-/// the nominal run's files, which `lpc plot DIR` draws the band over.
+/// the nominal run's files, which `lpc plot DIR` draws the band over; the nominal run keeps of
+/// its impacts what `impacts` asks.
 fn write_ensemble_dir(
     dir: &Path,
     model: Model,
+    impacts: ImpactRecord,
     nominal: &lpc_damper::scene::Scene,
     members: &Ensemble,
     runs: &ensemble::EnsembleRuns,
     summary: &EnsembleSummary,
 ) -> anyhow::Result<()> {
-    let run = model.simulate(nominal, &RunOptions::default())?;
+    let run = model.simulate(nominal, &RunOptions { impacts, ..RunOptions::default() })?;
     write_run_dir(&run, dir)?;
     write_members(dir, model, members.seed, &members.columns, members, &runs.metrics)?;
     write_atomic(&dir.join("ensemble.json"), &serde_json::to_vec_pretty(summary)?)?;
