@@ -25,6 +25,7 @@
 
 pub mod compliant;
 pub mod files;
+pub mod floor_motion;
 pub mod impact_law;
 pub mod metrics;
 pub mod model;

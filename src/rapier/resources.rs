@@ -6,10 +6,10 @@ use bevy::prelude::*;
 
 use std::sync::{Mutex, PoisonError};
 
+use crate::floor_motion::FloorMotion;
 use crate::oscillator::Driven;
 use crate::run::{Impact, Record, Recorder};
 use crate::scene::{Scene, Stepping};
-use crate::storeys::FloorMotion;
 
 /// Rapier's length unit: the balls are centimetres, so are the tolerances.
 pub const LENGTH_UNIT: f32 = 0.01;

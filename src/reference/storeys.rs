@@ -16,9 +16,10 @@ use std::ops::Deref;
 use std::sync::Arc;
 
 use super::segment::illinois;
+use crate::floor_motion::{FloorMotion, Piece};
 use crate::oscillator::ROUNDOFF_ULPS;
 use crate::scene::{Forcing, Structure};
-use crate::storeys::{FloorMotion, Piece, C64};
+use crate::storeys::C64;
 
 use super::ROUNDOFF_RELATIVE;
 

@@ -15,8 +15,8 @@ pub use tally::{MotionMetrics, SampleTally, DISSIPATION_LEVELS, SETTLING_FRACTIO
 use crate::scene::Body;
 
 /// Declares the models the tool has, one line each: the label in outputs and on the command
-/// line, how messages name it, and what its budget counts. The registry
-/// (`crate::registry`) maps each to its implementation.
+/// line, how messages name it, and what its budget counts. Each is mapped to its
+/// implementation above this module, where the models are.
 macro_rules! models {
     ($($(#[$doc:meta])* $variant:ident = $name:literal, $title:literal, $unit:literal;)*) => {
         /// A model of the damper.

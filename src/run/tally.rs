@@ -9,9 +9,8 @@ use crate::scene::Scene;
 pub const SETTLING_FRACTION: f64 = 0.05;
 
 /// The metrics read from the motion itself: peaks of `|xs|` and `|a|` from one bare period on,
-/// RMS of `xs`, the settling time and the dissipation times (see
-/// [`crate::metrics::Metrics`]). Every model
-/// reads them at its samples ([`SampleTally`]); the reference computes them exactly from its
+/// RMS of `xs`, the settling time and the dissipation times, as docs/MODEL.md §7 defines them.
+/// Every model reads them at its samples ([`SampleTally`]); the reference computes them exactly from its
 /// closed-form motion in free vibration.
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
 pub struct MotionMetrics {

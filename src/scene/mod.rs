@@ -13,6 +13,7 @@ mod rules;
 mod settings;
 mod space;
 mod structure;
+mod validator;
 
 use std::path::{Path, PathBuf};
 
@@ -24,10 +25,11 @@ pub use overrides::{with_settings_of, Overrides};
 pub use parameters::{Parameter, Tolerances};
 pub use placement::{move_placed_balls, MAX_BED_BALLS};
 pub use record::GroundRecord;
-pub use rules::{from_file, validate_sample_dt};
+pub use rules::from_file;
 pub use settings::{CompliantSettings, RapierSettings, ReferenceSettings, DEFAULT_COMPLIANT_TOLERANCE, DEFAULT_CONTACT_DURATION};
 pub use space::Space;
 pub use structure::{FloorForce, Frame, Structure};
+pub use validator::validate_sample_dt;
 
 /// Default simulated time, s (docs/MODEL.md §8).
 pub const DEFAULT_HORIZON: f64 = 5.0;

@@ -2,7 +2,8 @@
 //! the file a study rebuilds its variants from so that those settings hold for every variant.
 
 use super::format::{self, ForcingKind, SceneFile, Stepping};
-use super::rules::{compliant_settings, forcing, rapier_settings, Validator};
+use super::rules::{compliant_settings, forcing, rapier_settings};
+use super::validator::Validator;
 use super::{Scene, SceneError};
 
 /// Values typed on the command line that replace a scene's. The flags are collected as plain

@@ -9,7 +9,7 @@ use rand_pcg::Pcg64;
 
 use super::format::{BedFile, ExplicitBallFile, Placement};
 use super::geometry::{ball_radius, Ball, BallKind, Body};
-use super::rules::Validator;
+use super::validator::Validator;
 use super::{human, Scene, SceneError};
 
 /// Most balls a bed may hold: a run keeps every ball's state, and a scene this size already

@@ -8,11 +8,6 @@
 //! `A = V L V^-1` is the state matrix's eigen-decomposition (complex modes; classical damping
 //! is not needed, so balls held on a floor may change its mass).
 
-mod motion;
-
-pub use motion::FloorMotion;
-pub(crate) use motion::Piece;
-
 use nalgebra::{Complex, DMatrix, DVector};
 
 /// A complex number of `f64`.

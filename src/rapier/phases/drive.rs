@@ -7,10 +7,10 @@ use std::sync::Mutex;
 use bevy::prelude::*;
 use bevy_rapier3d::prelude::*;
 
+use crate::floor_motion::FloorMotion;
 use crate::oscillator::{gauss_legendre, Driven, Oscillator};
 use crate::rapier::resources::{held_balls, Bodies, DamperScene, FrameState, StepClock, StepPlan};
 use crate::scene::Scene;
-use crate::storeys::FloorMotion;
 
 /// Inserts the frame's exact state at its initial displacement (on a structure, the carrying
 /// floor's initial state, the ground's motion included).

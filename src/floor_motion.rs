@@ -6,10 +6,10 @@
 use std::cell::RefCell;
 use std::sync::Arc;
 
-use super::{Modes, C64};
 use crate::oscillator::gauss_legendre;
 use crate::scene::record::Stretch;
 use crate::scene::{Forcing, ForcingKind, Structure};
+use crate::storeys::{Modes, C64};
 use nalgebra::DMatrix;
 
 /// One stretch of the segment: on `[start, end)` the record's load (the ground's acceleration
