@@ -29,16 +29,27 @@ pub(super) struct Placed {
     pub(super) velocities: Vec<[f64; 3]>,
 }
 
-/// The box `[length, width, height]` a ball of radius `r` centred at `c` must lie within:
-/// the first axis it leaves, or `None`.
-fn outside(c: [f64; 3], r: f64, size: [f64; 3]) -> Option<usize> {
-    let lo = [r, r - 0.5 * size[1], r - 0.5 * size[2]];
-    let hi = [size[0] - r, 0.5 * size[1] - r, 0.5 * size[2] - r];
-    (0..3).find(|&a| !(lo[a] <= c[a] && c[a] <= hi[a]))
+/// How far a ball may reach past a wall or into another ball and still count as touching: the
+/// round-off of coordinates of the container's size. A user who types touching positions
+/// (centres 0.05 and 0.06 m for radii 0.005 m) gets a distance a few ulps short of the sum of
+/// the radii, and means contact, not overlap.
+fn touching_round_off(size: [f64; 3]) -> f64 {
+    8.0 * f64::EPSILON * size.iter().fold(0.0, |m, s| f64::max(m, s.abs()))
 }
 
-/// The first pair of balls that overlap, found by sweeping along x.
-pub(super) fn first_overlap(balls: &[Ball], centres: &[[f64; 3]]) -> Option<(usize, usize)> {
+/// The box `[length, width, height]` a ball of radius `r` centred at `c` must lie within,
+/// touching a wall within round-off allowed: the first axis it leaves, or `None`.
+fn outside(c: [f64; 3], r: f64, size: [f64; 3]) -> Option<usize> {
+    let tol = touching_round_off(size);
+    let lo = [r, r - 0.5 * size[1], r - 0.5 * size[2]];
+    let hi = [size[0] - r, 0.5 * size[1] - r, 0.5 * size[2] - r];
+    (0..3).find(|&a| !(lo[a] - tol <= c[a] && c[a] <= hi[a] + tol))
+}
+
+/// The first pair of balls that overlap by more than the round-off of the container's `size`,
+/// found by sweeping along x.
+pub(super) fn first_overlap(balls: &[Ball], centres: &[[f64; 3]], size: [f64; 3]) -> Option<(usize, usize)> {
+    let tol = touching_round_off(size);
     let mut order: Vec<usize> = (0..balls.len()).collect();
     order.sort_by(|&a, &b| centres[a][0].total_cmp(&centres[b][0]));
     let largest = balls.iter().map(|b| b.radius).fold(0.0, f64::max);
@@ -48,7 +59,8 @@ pub(super) fn first_overlap(balls: &[Ball], centres: &[[f64; 3]]) -> Option<(usi
                 break;
             }
             let d2: f64 = (0..3).map(|a| (centres[j][a] - centres[i][a]).powi(2)).sum();
-            if d2 < (balls[i].radius + balls[j].radius).powi(2) {
+            let reach = balls[i].radius + balls[j].radius - tol;
+            if reach > 0.0 && d2 < reach * reach {
                 return Some((i.min(j), i.max(j)));
             }
         }
@@ -75,7 +87,7 @@ pub fn move_placed_balls(scene: &mut Scene, by: &[[f64; 3]]) -> Result<(), Strin
             return Err(format!("moves {} outside the container along {}", Body::Ball(i).name(), ["x", "y", "z"][a]));
         }
     }
-    if let Some((i, j)) = first_overlap(&scene.balls, &centres) {
+    if let Some((i, j)) = first_overlap(&scene.balls, &centres, size) {
         return Err(format!("makes {} overlap {}", Body::Ball(j).name(), Body::Ball(i).name()));
     }
     scene.initial_positions = x;
@@ -123,7 +135,7 @@ pub(super) fn explicit(list: &[ExplicitBallFile], size: [f64; 3], v: &Validator)
         placed.centres.push(b.position);
         placed.velocities.push(velocity);
     }
-    if let Some((i, j)) = first_overlap(&placed.balls, &placed.centres) {
+    if let Some((i, j)) = first_overlap(&placed.balls, &placed.centres, size) {
         return Err(v.err(&format!("ball[{j}].position"), &format!("makes ball[{j}] overlap ball[{i}]")));
     }
     Ok(placed)

@@ -27,5 +27,6 @@ pub(crate) mod squeezed_ball_stops;
 mod stale_impulse_bounce;
 mod stiff_frame_rapier_step;
 mod summary_without_bare_floors;
+mod touching_balls_refused;
 mod valid_input_panics;
 mod zero_time_event_loop;
