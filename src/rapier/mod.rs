@@ -120,7 +120,7 @@ pub fn simulate_with(scene: &Scene, settings: StepSettings, options: &RunOptions
     }
     loop {
         let clock = *world.resource::<StepClock>();
-        if clock.t >= scene.horizon * (1.0 - 1e-12) {
+        if scene.reached_horizon(clock.t) {
             break;
         }
         if let Some(budget) = meter.look(clock.t, clock.steps) {

@@ -119,6 +119,19 @@ impl Scene {
         ((self.horizon / self.sample_dt * (1.0 + 1e-12)).floor() as usize).saturating_add(1)
     }
 
+    /// Whether a run's clock at `t` has reached the horizon: within a relative 1e-12, the slack
+    /// of [`Scene::sample_count`], since a clock that adds its steps gathers round-off.
+    pub fn reached_horizon(&self, t: f64) -> bool {
+        t >= self.horizon * (1.0 - 1e-12)
+    }
+
+    /// Whether the sample at `ts` falls on the end `t_end` of a step of length `h`: within
+    /// round-off of the step, or anywhere within the horizon's slack once the run has reached
+    /// it (so the row at the horizon is never lost to the clock's round-off).
+    pub fn sample_at_step_end(&self, ts: f64, t_end: f64, h: f64) -> bool {
+        (ts - t_end).abs() <= 1e-9 * h || (self.reached_horizon(t_end) && self.reached_horizon(ts))
+    }
+
     /// Whether something drives the structure (a sine or a moving ground): then energy is put
     /// in, and dissipation times mean nothing.
     pub fn is_driven(&self) -> bool {

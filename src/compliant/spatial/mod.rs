@@ -430,7 +430,7 @@ impl<'a> Solver<'a> {
         recorder.sample_across(|i| [self.x[i][1], self.x[i][2]]);
         let mut next_sample = 1;
         let energy_in = scene.initial_energy();
-        while self.t < scene.horizon * (1.0 - 1e-12) {
+        while !scene.reached_horizon(self.t) {
             if let Some(budget) = meter.look(self.t, self.steps) {
                 return Ok(Some(budget));
             }
@@ -441,7 +441,7 @@ impl<'a> Solver<'a> {
             let mut sampled = false;
             while next_sample < sample_count {
                 let ts = next_sample as f64 * scene.sample_dt;
-                if ts > self.t + 1e-9 * h {
+                if ts > self.t + 1e-9 * h && !scene.sample_at_step_end(ts, self.t, h) {
                     break;
                 }
                 let back = (self.t - ts).max(0.0);

@@ -30,7 +30,7 @@ pub fn record_samples(
         let k = rec.next_sample;
         let ts = k as f64 * scene.sample_dt;
         // A sample on the step's end (within round-off) belongs to this step, after impulses.
-        let at_end = (ts - t1).abs() <= 1e-9 * dt;
+        let at_end = scene.sample_at_step_end(ts, t1, dt);
         if ts > t1 && !at_end {
             break;
         }

@@ -321,7 +321,7 @@ pub fn simulate_spatial_with(scene: &Scene, solver: SolverSettings, options: &Ru
             wall_time_s: 0.0,
         }
     };
-    while t < scene.horizon * (1.0 - 1e-12) {
+    while !scene.reached_horizon(t) {
         if let Some(budget) = meter.look(t, steps) {
             let wall_s = meter.elapsed();
             let cost = format!("{} impacts so far; {} balls in 3D at steps of {} s", impacts.len(), n, crate::scene::human(solver.dt));
@@ -487,7 +487,7 @@ pub fn simulate_spatial_with(scene: &Scene, solver: SolverSettings, options: &Ru
         // the balls along their straight path with their old velocity.
         while next_sample < sample_count {
             let ts = next_sample as f64 * scene.sample_dt;
-            let at_end = (ts - t1).abs() <= 1e-9 * h;
+            let at_end = scene.sample_at_step_end(ts, t1, h);
             if ts > t1 && !at_end {
                 break;
             }

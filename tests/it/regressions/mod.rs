@@ -12,6 +12,7 @@ mod floor_starting_from_rest;
 mod forced_ball_through_wall;
 mod forced_floor_acceleration;
 mod free_chain_balance_roundoff;
+mod horizon_row_missing;
 mod issue_14_touching_chain;
 mod loaded_contact_sinks;
 mod overdamped_bed_balance;
