@@ -29,7 +29,11 @@ impl Wall {
         match self {
             Wall::Left => Body::LeftWall,
             Wall::Right => Body::RightWall,
-            _ => Body::SideWall,
+            Wall::Front => Body::FrontWall,
+            Wall::Back => Body::BackWall,
+            Wall::Floor => Body::Floor,
+            Wall::Ceiling => Body::Ceiling,
+            Wall::Divider(k) => Body::Divider(k),
         }
     }
 }

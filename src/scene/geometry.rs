@@ -51,19 +51,43 @@ pub enum Body {
     Ball(usize),
     /// The container's right wall (the frame).
     RightWall,
-    /// A wall along the motion (the container's floor, ceiling, front or back, or a divider
-    /// between chains): part of the frame, but its normal has no component along the motion.
-    SideWall,
+    /// The container's floor (z = -height / 2): part of the frame, like every wall below, but
+    /// its normal has no component along the motion.
+    Floor,
+    /// The container's ceiling (z = +height / 2).
+    Ceiling,
+    /// The container's front wall (y = -width / 2).
+    FrontWall,
+    /// The container's back wall (y = +width / 2).
+    BackWall,
+    /// The divider between chains `k - 1` and `k` (`k` from 1).
+    Divider(usize),
 }
 
 impl Body {
-    /// The body's name in outputs: `left-wall`, `right-wall`, `ball1`..`ballN`.
+    /// The body's name in outputs: `left-wall`, `right-wall`, `floor`, `ceiling`,
+    /// `front-wall`, `back-wall`, `divider1`..., `ball1`..`ballN`.
     pub fn name(self) -> String {
         match self {
             Body::LeftWall => "left-wall".into(),
             Body::RightWall => "right-wall".into(),
-            Body::SideWall => "side-wall".into(),
+            Body::Floor => "floor".into(),
+            Body::Ceiling => "ceiling".into(),
+            Body::FrontWall => "front-wall".into(),
+            Body::BackWall => "back-wall".into(),
+            Body::Divider(k) => format!("divider{k}"),
             Body::Ball(i) => format!("ball{}", i + 1),
+        }
+    }
+
+    /// The wall across the motion at the negative (`positive` false) or positive end of
+    /// `axis` (1 for y, 2 for z).
+    pub fn across(axis: usize, positive: bool) -> Body {
+        match (axis, positive) {
+            (1, false) => Body::FrontWall,
+            (1, true) => Body::BackWall,
+            (_, false) => Body::Floor,
+            (_, true) => Body::Ceiling,
         }
     }
 }
@@ -79,19 +103,24 @@ impl TryFrom<String> for Body {
 
     /// The body that [`Body::name`] names `name`.
     fn try_from(name: String) -> Result<Body, String> {
+        // A numbered body: `prefix` then a number from 1 written without sign or leading zero.
+        let numbered = |prefix: &str| {
+            name.strip_prefix(prefix)
+                .filter(|k| !k.starts_with('0') && !k.is_empty() && k.bytes().all(|b| b.is_ascii_digit()))
+                .and_then(|k| k.parse::<usize>().ok())
+        };
         match name.as_str() {
             "left-wall" => Ok(Body::LeftWall),
             "right-wall" => Ok(Body::RightWall),
-            "side-wall" => Ok(Body::SideWall),
-            _ => name
-                .strip_prefix("ball")
-                .filter(|k| k.bytes().all(|b| b.is_ascii_digit()))
-                .and_then(|k| k.parse::<usize>().ok())
-                .filter(|&k| k >= 1)
-                .map(|k| Body::Ball(k - 1))
-                .ok_or_else(|| {
-                    format!("no body is named `{name}`: a body is `left-wall`, `right-wall`, `side-wall` or `ball1`, `ball2`, ...")
-                }),
+            "floor" => Ok(Body::Floor),
+            "ceiling" => Ok(Body::Ceiling),
+            "front-wall" => Ok(Body::FrontWall),
+            "back-wall" => Ok(Body::BackWall),
+            _ => numbered("ball").map(|k| Body::Ball(k - 1)).or_else(|| numbered("divider").map(Body::Divider)).ok_or_else(|| {
+                format!(
+                    "no body is named `{name}`: a body is `left-wall`, `right-wall`, `floor`, `ceiling`, `front-wall`, `back-wall`, `divider1`, ... or `ball1`, `ball2`, ..."
+                )
+            }),
         }
     }
 }
@@ -215,12 +244,22 @@ mod tests {
     /// A body is written by its name and read back from it; a name no body has is refused.
     #[test]
     fn bodies_are_read_back_from_their_names() {
-        for body in [Body::LeftWall, Body::RightWall, Body::SideWall, Body::Ball(0), Body::Ball(11)] {
+        for body in [
+            Body::LeftWall,
+            Body::RightWall,
+            Body::Floor,
+            Body::Ceiling,
+            Body::FrontWall,
+            Body::BackWall,
+            Body::Divider(2),
+            Body::Ball(0),
+            Body::Ball(11),
+        ] {
             let json = serde_json::to_string(&body).unwrap();
             assert_eq!(json, format!("\"{}\"", body.name()));
             assert_eq!(serde_json::from_str::<Body>(&json).unwrap(), body);
         }
-        for name in ["ball0", "ball", "ball+1", "ball1x", "wall", "Ball1"] {
+        for name in ["ball0", "ball", "ball+1", "ball1x", "wall", "Ball1", "side-wall", "divider0", "divider01"] {
             assert!(Body::try_from(name.to_string()).unwrap_err().contains(name), "{name}");
         }
     }

@@ -109,7 +109,7 @@ fn a_dropped_ball_bounces_at_the_closed_form_times() {
     let fall = (2.0 * drop / g).sqrt();
     let scene = one_ball([0.025, 0.0, z], [0.0; 3], -g, e, 0.0, fall * (1.0 + 2.0 * e + 2.0 * e * e) + 0.002);
     let run = Model::Compliant.simulate(&scene, &RunOptions::default()).unwrap();
-    let floor: Vec<_> = run.impacts.iter().filter(|i| i.b == Body::SideWall).collect();
+    let floor: Vec<_> = run.impacts.iter().filter(|i| i.b == Body::Floor).collect();
     assert_eq!(floor.len(), 3, "{:?}", run.impacts);
     // Onsets and ends are extrapolated from the steps either side: a step each at most.
     let step = |i: &lpc_damper::run::Impact| i.contact_duration.unwrap() / STEPS_PER_CONTACT;

@@ -67,7 +67,7 @@ fn a_dropped_ball_rebounds_with_the_scenes_restitution() {
         let scene = drop_scene(drop, e, h, horizon);
         assert!(spatial::needs_spatial(&scene));
         let run = Model::Rapier.simulate(&scene, &RunOptions::default()).unwrap();
-        let floor: Vec<f64> = run.impacts.iter().filter(|i| i.b == Body::SideWall).map(|i| i.approach_speed).collect();
+        let floor: Vec<f64> = run.impacts.iter().filter(|i| i.b == Body::Floor).map(|i| i.approach_speed).collect();
         assert!(floor.len() >= 4, "v0 = {speed}: {:?}", run.impacts);
         let first = floor[0];
         assert!((first - speed).abs() <= 0.5 * g * h + F32_SOLVE * speed, "v0 = {speed}: first approach {first}: {:?}", run.impacts);

@@ -138,7 +138,7 @@ impl Solver<'_> {
                         ball.v[axis] = -side * after;
                         0.5 * ball.mass * (approach * approach - after * after)
                     };
-                    self.record(Body::Ball(i), Body::SideWall, approach, lost);
+                    self.record(Body::Ball(i), Body::across(axis, side > 0.0), approach, lost);
                     self.balls[i].last_impact = self.t;
                     struck = true;
                 }

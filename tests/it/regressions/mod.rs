@@ -30,4 +30,5 @@ mod stiff_frame_rapier_step;
 mod summary_without_bare_floors;
 mod touching_balls_refused;
 mod valid_input_panics;
+mod walls_across_unnamed;
 mod zero_time_event_loop;
