@@ -143,7 +143,7 @@ pub fn book(ledger: Ledger<'_>, n: usize, hit: &PairImpact, t: f64, step: u64) {
     let (a, b) = pair_bodies(p, n);
     last_impact[p] = Some(impacts.len());
     impacts.push(Impact {
-        t,
+        t: after_the_last(impacts, t),
         a,
         b,
         approach_speed: hit.approach_speed,
@@ -152,6 +152,13 @@ pub fn book(ledger: Ledger<'_>, n: usize, hit: &PairImpact, t: f64, step: u64) {
         peak_force: None,
         contact_duration: None,
     });
+}
+
+/// `t`, or the time of the last impact booked when `t` is earlier: an impact is booked after
+/// the impacts that led to it (resolved before it at the same instant, each stamped where its
+/// own gap closes), so it never precedes them, and the list stays in time order.
+pub fn after_the_last(impacts: &[Impact], t: f64) -> f64 {
+    impacts.last().map_or(t, |last| t.max(last.t))
 }
 
 /// Persistent contacts approach slower than this many times what the frame's acceleration

@@ -531,7 +531,7 @@ fn attribute_impacts(
             let gap = pair_gap(&scene.balls, x_before, walls, p).unwrap_or(0.0);
             last_impact[p] = Some(impacts.len());
             impacts.push(Impact {
-                t: start.t + (gap / u).clamp(0.0, start.h),
+                t: contacts::after_the_last(impacts, start.t + (gap / u).clamp(0.0, start.h)),
                 a: pair_bodies(p, n).0,
                 b: pair_bodies(p, n).1,
                 approach_speed: u,

@@ -82,8 +82,9 @@ pub fn resolve_impacts(
     }
     for hit in resolved.iter() {
         *impact_loss += hit.energy_lost;
-        // The steps end just short of contact: the impact is when the gap closes.
-        let t = clock.t + hit.gap.max(0.0) / hit.approach_speed;
+        // The steps end just short of contact: the impact is when the gap closes, within the
+        // last step's length (a slow approach closes a gap of a micrometre late).
+        let t = clock.t + (hit.gap.max(0.0) / hit.approach_speed).min(plan.h);
         book(Ledger { impacts, last_impact, struck_at }, n, hit, t, clock.steps);
     }
     // Before the first step bevy_rapier has not made the bodies yet: it will from `Velocity`.

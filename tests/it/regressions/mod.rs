@@ -13,6 +13,7 @@ mod forced_ball_through_wall;
 mod forced_floor_acceleration;
 mod free_chain_balance_roundoff;
 mod horizon_row_missing;
+mod impacts_out_of_order;
 mod issue_14_touching_chain;
 mod loaded_contact_sinks;
 mod overdamped_bed_balance;
