@@ -15,6 +15,7 @@ mod free_chain_balance_roundoff;
 mod horizon_row_missing;
 mod impacts_out_of_order;
 mod issue_14_touching_chain;
+mod json_prints_every_impact;
 mod loaded_contact_sinks;
 mod overdamped_bed_balance;
 mod plugin_driven_by_app_update;

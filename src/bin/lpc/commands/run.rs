@@ -49,6 +49,10 @@ pub struct Args {
     /// Output format on standard output.
     #[arg(long, value_enum, default_value_t = Format::Text)]
     format: Format,
+    /// With --format json: print every impact in the summary too (by default it gives their
+    /// count and the noise proxy; --out writes them to impacts.csv).
+    #[arg(long)]
+    print_impacts: bool,
     #[command(flatten)]
     ensemble: EnsembleArgs,
     /// With --ensemble: run only shard I (from 0) of K, members I*N/K .. (I+1)*N/K, the ones
@@ -89,7 +93,7 @@ pub fn run(a: Args) -> Result<ExitStatus> {
         write_run_dir_with(&run, &summary, dir).with_context(|| format!("writing outputs to {}", dir.display()))?;
     }
     match a.format {
-        Format::Json => print_json(&summary)?,
+        Format::Json => print_summary_json(summary, a.print_impacts)?,
         Format::Text => {
             print!("{}", text_summary(&summary));
             if let Some(dir) = &a.out {
@@ -99,6 +103,20 @@ pub fn run(a: Args) -> Result<ExitStatus> {
         }
     }
     Ok(ExitStatus::Success)
+}
+
+/// The summary on standard output: without the impact list unless `with_impacts` (a bed makes
+/// millions; `impact_count` and the noise proxy say what they were, `impacts.csv` lists them).
+fn print_summary_json(mut summary: RunSummary, with_impacts: bool) -> Result<()> {
+    if with_impacts {
+        return print_json(&summary);
+    }
+    summary.impacts = Vec::new();
+    let mut value = serde_json::to_value(&summary)?;
+    if let Some(fields) = value.as_object_mut() {
+        fields.remove("impacts");
+    }
+    print_json(&value)
 }
 
 fn run_ensemble(a: &Args, nominal: &lpc_damper::scene::Scene, members: &Ensemble) -> Result<ExitStatus> {
