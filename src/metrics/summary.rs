@@ -90,6 +90,10 @@ pub struct RunSummary {
     /// The same floors without the damper (the structure alone), when the caller ran it.
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub floors_without_damper: Vec<FloorSummary>,
+    /// Present when the run stopped before its horizon (a budget, a broken invariant): why.
+    /// The summary is then of the run so far, up to `horizon`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub stop: Option<String>,
 }
 
 /// One floor's response as a structural engineer reads it.
@@ -168,6 +172,7 @@ impl RunSummary {
             series_every: (run.series.every > 1).then_some(run.series.every),
             floors: FloorSummary::of(&run.series),
             floors_without_damper: vec![],
+            stop: None,
         }
     }
 }

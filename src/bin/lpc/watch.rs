@@ -4,16 +4,13 @@
 //! (a script, a batch job, a log) they are lines on standard error.
 
 use std::io::IsTerminal;
-use std::path::Path;
 use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
 use std::sync::{Arc, Condvar, Mutex};
 use std::time::{Duration, Instant};
 
-use anyhow::Context;
 use indicatif::{ProgressBar, ProgressStyle};
 
-use lpc_damper::model::{cost, Model, Progress, RunOptions};
-use lpc_damper::output::write_run_dir;
+use lpc_damper::model::{cost, Model, ModelError, Progress, RunOptions};
 use lpc_damper::run::Run;
 use lpc_damper::scene::{human, Scene};
 
@@ -30,12 +27,11 @@ fn on_terminal() -> bool {
     std::io::stderr().is_terminal()
 }
 
-/// `model` on `scene` under `options` (whose progress is set here). A run estimated to take a
-/// second or more says so early, with its estimated cost ([`cost`], revised when it moves by
-/// more than twofold), and shows a progress bar (on a terminal) once it has run for
-/// [`QUIET_FOR_S`]; a run stopped by a budget is written to `out`, when given, as far as it got
-/// before the error is reported.
-pub fn watched(model: Model, scene: &Scene, options: RunOptions, out: Option<&Path>) -> Result<Run> {
+/// `model` on `scene` under `options` (whose progress is set here), the model's error as it is.
+/// A run estimated to take a second or more says so early, with its estimated cost ([`cost`],
+/// revised when it moves by more than twofold), and shows a progress bar (on a terminal) once
+/// it has run for [`QUIET_FOR_S`].
+pub fn watched_model(model: Model, scene: &Scene, options: RunOptions) -> std::result::Result<Run, ModelError> {
     let progress = Progress::default();
     let options = RunOptions { progress: Some(&progress), ..options };
     let unit = model.step_unit();
@@ -87,15 +83,12 @@ pub fn watched(model: Model, scene: &Scene, options: RunOptions, out: Option<&Pa
         watcher.thread().unpark();
         result
     });
-    let e = match result {
-        Ok(run) => return Ok(run),
-        Err(e) => e,
-    };
-    if let (Some(partial), Some(dir)) = (e.partial(), out) {
-        write_run_dir(partial, dir).with_context(|| format!("writing outputs to {}", dir.display()))?;
-        eprintln!("wrote the run up to t = {} s to {}", human(partial.horizon), dir.display());
-    }
-    Err(e.into())
+    result
+}
+
+/// [`watched_model`], its error as the command's.
+pub fn watched(model: Model, scene: &Scene, options: RunOptions) -> Result<Run> {
+    Ok(watched_model(model, scene, options)?)
 }
 
 /// What the heartbeat of a study shares with it.

@@ -29,6 +29,7 @@ mod spatial_series_read_back;
 pub(crate) mod squeezed_ball_stops;
 mod stale_impulse_bounce;
 mod stiff_frame_rapier_step;
+mod stopped_run_prints_nothing;
 mod summary_without_bare_floors;
 mod touching_balls_refused;
 mod valid_input_panics;

@@ -64,11 +64,11 @@ pub fn run(a: Args) -> Result<ExitStatus> {
         return compare_ensembles(&a, &nominal.scene.name, &members);
     }
     let scene = nominal.scene;
-    let reference = crate::watch::watched(Model::Reference, &scene, RunOptions::limited(limits), None)?;
+    let reference = crate::watch::watched(Model::Reference, &scene, RunOptions::limited(limits))?;
     let mut models = std::collections::BTreeMap::new();
     let mut runs = vec![];
     for &m in a.models.iter().filter(|m| **m != Model::Reference) {
-        let run = crate::watch::watched(m, &scene, RunOptions::limited(limits), None)?;
+        let run = crate::watch::watched(m, &scene, RunOptions::limited(limits))?;
         models.insert(m.name().to_string(), ModelComparison { summary: RunSummary::of(&run), errors: errors(&run, &reference) });
         runs.push(run);
     }

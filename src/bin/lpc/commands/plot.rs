@@ -113,8 +113,8 @@ pub fn run(a: Args) -> Result<ExitStatus> {
         } else {
             let mut s = loaded.scene.clone().expect("a scene file without [chain] has [frame]");
             override_scene(&mut s, a.settings.overrides(None, None), &a.input)?;
-            let run = crate::watch::watched(a.model, &s, RunOptions::limited(limits), None)?;
-            let bare = crate::watch::watched(lpc_damper::Model::Reference, &s.without_damper(), RunOptions::limited(limits), None)?;
+            let run = crate::watch::watched(a.model, &s, RunOptions::limited(limits))?;
+            let bare = crate::watch::watched(lpc_damper::Model::Reference, &s.without_damper(), RunOptions::limited(limits))?;
             figs.extend(figures::time_histories(&run, (!s.balls.is_empty()).then_some(&bare)));
             let bare_floors = lpc_damper::metrics::FloorSummary::of(&bare.series);
             figs.extend(figures::floor_responses(&run, (!s.balls.is_empty()).then_some(&bare_floors[..])));

@@ -51,7 +51,7 @@ pub fn run(a: Args) -> Result<ExitStatus> {
     let (sample_dt, per_frame) = lpc_damper::run::frame_sampling(a.fps, s.sample_dt);
     let timing = Overrides { horizon: a.horizon, sample_dt: Some(sample_dt), ..Overrides::default() };
     let s = timing.apply(s, &a.scene.display().to_string())?;
-    let run = crate::watch::watched(a.model, &s, RunOptions::limited(a.budget.limits(&a.scene)?), None)?;
+    let run = crate::watch::watched(a.model, &s, RunOptions::limited(a.budget.limits(&a.scene)?))?;
     write_run_dir(&run, &a.out).with_context(|| format!("writing outputs to {}", a.out.display()))?;
     render_run(&s, &run, &a, per_frame)?;
     Ok(ExitStatus::Success)

@@ -6,7 +6,7 @@ use std::path::{Path, PathBuf};
 
 use anyhow::Context;
 
-use lpc_damper::model::RunOptions;
+use lpc_damper::model::{ModelError, RunOptions};
 use lpc_damper::run::ImpactRecord;
 
 use lpc_damper::files::write_atomic;
@@ -17,7 +17,7 @@ use lpc_damper::studies::ensemble::{self, Ensemble, EnsembleSummary, ShardInfo};
 use lpc_damper::Model;
 
 use crate::args::{load_nominal, parse_shard, print_json, BudgetArgs, EnsembleArgs, Format, ModelArgs};
-use crate::exit::{ExitStatus, Result};
+use crate::exit::{CommandError, ExitStatus, Result};
 use crate::table::{left, right, statistic, Table};
 
 #[derive(clap::Args)]
@@ -82,7 +82,10 @@ pub fn run(a: Args) -> Result<ExitStatus> {
             lpc_damper::scene::human(scene.sample_dt * every as f64)
         );
     }
-    let run = crate::watch::watched(a.model, &scene, RunOptions { impacts: a.impacts, ..RunOptions::limited(limits) }, a.out.as_deref())?;
+    let run = match crate::watch::watched_model(a.model, &scene, RunOptions { impacts: a.impacts, ..RunOptions::limited(limits) }) {
+        Ok(run) => run,
+        Err(e) => return Err(stopped(&a, e)),
+    };
     let mut summary = RunSummary::of(&run);
     if scene.structure.is_some() && !scene.balls.is_empty() {
         // The structure alone, for the floors' response without the damper.
@@ -103,6 +106,30 @@ pub fn run(a: Args) -> Result<ExitStatus> {
         }
     }
     Ok(ExitStatus::Success)
+}
+
+/// A run that could not reach its horizon: the run so far, when the model kept it, written to
+/// `--out` and printed as JSON, both with the reason it stopped; then the error.
+fn stopped(a: &Args, e: ModelError) -> CommandError {
+    let reason = e.to_string();
+    let summary = e.partial().map(|partial| (partial, RunSummary { stop: Some(reason.clone()), ..RunSummary::of(partial) }));
+    if let (Some((partial, summary)), Some(dir)) = (&summary, &a.out) {
+        if let Err(w) = write_run_dir_with(partial, summary, dir) {
+            return CommandError::failure(anyhow::Error::new(w).context(format!("writing outputs to {}", dir.display())));
+        }
+        eprintln!("wrote the run up to t = {} s to {}", lpc_damper::scene::human(partial.horizon), dir.display());
+    }
+    if a.format == Format::Json {
+        let printed = match summary {
+            Some((_, summary)) => print_summary_json(summary, a.print_impacts),
+            // Nothing of the run was kept: the reason alone, so a script reads why.
+            None => print_json(&serde_json::json!({ "model": a.model, "stop": reason })),
+        };
+        if let Err(p) = printed {
+            return p;
+        }
+    }
+    e.into()
 }
 
 /// The summary on standard output: without the impact list unless `with_impacts` (a bed makes
