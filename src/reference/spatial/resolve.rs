@@ -138,8 +138,12 @@ impl Solver<'_> {
                         ball.v[axis] = -side * after;
                         0.5 * ball.mass * (approach * approach - after * after)
                     };
-                    self.record(Body::Ball(i), Body::across(axis, side > 0.0), approach, lost);
-                    self.balls[i].last_impact = self.t;
+                    // A ball that only touches the wall (placed on the floor, or come to it at
+                    // rest) settles on it without an impact.
+                    if approach > 0.0 {
+                        self.record(Body::Ball(i), Body::across(axis, side > 0.0), approach, lost);
+                        self.balls[i].last_impact = self.t;
+                    }
                     struck = true;
                 }
                 self.predict(i, struck)?;

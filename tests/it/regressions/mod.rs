@@ -34,4 +34,5 @@ mod summary_without_bare_floors;
 mod touching_balls_refused;
 mod valid_input_panics;
 mod walls_across_unnamed;
+mod zero_speed_impact_at_start;
 mod zero_time_event_loop;
