@@ -143,9 +143,12 @@ impl CountedImpacts {
     }
 }
 
-/// Where the energy went.
+/// Where the energy went, every entry in J with the mechanical energy's zero of
+/// docs/MODEL.md §6 (the frame at rest unstretched, every ball at rest at its lowest place).
 /// `balance_error = (initial + forcing_work - final - damping_loss - impact_loss - contact_loss)
-/// / (|initial| + |forcing_work|)`.
+/// / (|initial| + |forcing_work|)`: the share of the energy put in that the account does not
+/// explain; divided by 1 J instead when nothing was put in (a scene at rest), so that it is
+/// then the residual in J.
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
 pub struct EnergyAccount {
     /// Mechanical energy at t = 0, J.
@@ -162,7 +165,7 @@ pub struct EnergyAccount {
     pub contact_loss: f64,
     /// Work done by the excitation, J (0 in free vibration).
     pub forcing_work: f64,
-    /// Relative balance error.
+    /// The residual relative to the energy put in (see the type's documentation).
     pub balance_error: f64,
 }
 
@@ -278,5 +281,22 @@ impl Run {
                 self.counted_impacts.add(&i);
             }
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::EnergyAccount;
+
+    /// The balance error is the residual over the energy put in, or over 1 J when none was.
+    #[test]
+    fn the_balance_error_is_the_residual_over_the_energy_put_in() {
+        let a = EnergyAccount::forced(2.0, 1.0, 0.5, 0.25, 1.0).with_contact_loss(0.125);
+        assert_eq!(a.residual(), 2.0 + 1.0 - 1.0 - 0.5 - 0.25 - 0.125);
+        assert_eq!(a.balance_error, a.residual() / 3.0);
+        let drained = EnergyAccount::forced(-2.0, -1.0, 0.5, 0.0, -1.0);
+        assert_eq!(drained.balance_error, drained.residual() / 3.0);
+        let at_rest = EnergyAccount::new(0.0, -1e-3, 0.0, 0.0);
+        assert_eq!(at_rest.balance_error, 1e-3);
     }
 }

@@ -446,9 +446,38 @@ impl Recorder {
             tally.add_floors(t, u, &a);
         }
     }
+    /// The sample at `t` of balls that move in space: the frame's state, and each ball's centre
+    /// and velocity `[x, y, z]` from `ball(i)` (`x` as [`Recorder::sample`] takes it, `y` and
+    /// `z` in the container's frame). The energy the dissipation times read is then every
+    /// ball's whole kinetic energy (without spin) and its height energy
+    /// ([`Scene::height_energy`]).
+    pub fn sample_in_space(&mut self, scene: &Scene, t: f64, xs: f64, vs: f64, ball: impl Fn(usize) -> ([f64; 3], [f64; 3])) {
+        let a = scene.frame_acceleration(t, xs, vs);
+        let wants_energy = self.tally.as_ref().is_some_and(|t| t.wants_energy());
+        // What `sample_with` adds to the kinetic energy along the motion.
+        let beyond_along: f64 = if wants_energy {
+            (0..scene.balls.len())
+                .map(|i| {
+                    let (p, v) = ball(i);
+                    0.5 * self.masses[i] * (v[1] * v[1] + v[2] * v[2]) + scene.height_energy(i, p)
+                })
+                .sum()
+        } else {
+            0.0
+        };
+        let frame_energy = |t: f64, xs: f64, vs: f64| scene.frame_energy(t, xs, vs) + beyond_along;
+        self.sample_with(t, xs, vs, a, frame_energy, |i| {
+            let (p, v) = ball(i);
+            (p[0], v[0])
+        });
+        self.sample_across(|i| {
+            let p = ball(i).0;
+            [p[1], p[2]]
+        });
+    }
     /// The balls' centres across the motion, `[y, z]` from `across(i)`, at the sample
     /// [`Recorder::sample`] has just taken (kept with it, or not at all).
-    pub fn sample_across(&mut self, across: impl Fn(usize) -> [f64; 2]) {
+    fn sample_across(&mut self, across: impl Fn(usize) -> [f64; 2]) {
         if let (true, Some(s)) = (self.kept_last, &mut self.series) {
             s.across.extend((0..s.balls).flat_map(across));
         }

@@ -138,7 +138,46 @@ impl Scene {
         self.forcing.is_some() || self.structure.as_ref().is_some_and(|s| s.is_recorded())
     }
 
-    /// Initial mechanical energy: spring energy plus balls' kinetic energy.
+    /// Ball `i`'s height energy at its centre `p` (`x` in the ground's frame, `y` and `z` in
+    /// the container's), J: gravity's potential, measured across the motion from the lowest
+    /// place the ball can reach (its centre one radius from the wall gravity presses it
+    /// against) and along the motion from where the ball starts. A ball resting on the floor
+    /// has none, so a bed at rest has only its pile's height (docs/MODEL.md §6).
+    pub fn height_energy(&self, i: usize, p: [f64; 3]) -> f64 {
+        let g = self.space.gravity;
+        let (radius, start) = (self.balls[i].radius, self.space.lateral_of(i));
+        let across = |a: usize| {
+            let half = 0.5 * self.space.section[a - 1];
+            // A scene on one line has no walls across: its balls stay where they start.
+            let lowest = if half <= 0.0 {
+                start[a - 1]
+            } else if g[a] < 0.0 {
+                radius - half
+            } else {
+                half - radius
+            };
+            -g[a] * (p[a] - lowest)
+        };
+        let along = if g[0] == 0.0 { 0.0 } else { -g[0] * (p[0] - self.initial_positions[i]) };
+        self.balls[i].mass * (along + across(1) + across(2))
+    }
+
+    /// The balls' height energy as they start ([`Scene::height_energy`]), J: what a model whose
+    /// potential counts from the start adds to it.
+    pub fn height_energy_at_start(&self) -> f64 {
+        if self.space.gravity == [0.0; 3] {
+            return 0.0;
+        }
+        (0..self.balls.len())
+            .map(|i| {
+                let [y, z] = self.space.lateral_of(i);
+                self.height_energy(i, [self.initial_positions[i], y, z])
+            })
+            .sum()
+    }
+
+    /// Initial mechanical energy: spring energy, the balls' kinetic energy and their height
+    /// energy ([`Scene::height_energy`]).
     pub fn initial_energy(&self) -> f64 {
         let spring = match &self.structure {
             // The floors start at their velocities relative to a ground that may move (a sine
@@ -155,7 +194,10 @@ impl Scene {
                 0.5 * self.balls[i].mass * (vy * vy + vz * vz)
             })
             .sum();
-        spring + self.balls.iter().zip(&self.initial_velocities).map(|(b, v)| 0.5 * b.mass * v * v).sum::<f64>() + across
+        spring
+            + self.balls.iter().zip(&self.initial_velocities).map(|(b, v)| 0.5 * b.mass * v * v).sum::<f64>()
+            + across
+            + self.height_energy_at_start()
     }
 
     /// The fastest motion the scene sets going, m/s: the frame's free swing from its initial

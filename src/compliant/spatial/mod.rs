@@ -409,10 +409,11 @@ impl<'a> Solver<'a> {
         self.steps += 1;
     }
 
-    /// The energy the system holds: the balls' kinetic and rotational energy, gravity's
-    /// potential from the start, the frame's energy and the open contacts' elastic energy, J.
+    /// The energy the system holds: the balls' kinetic and rotational energy, their height
+    /// energy ([`Scene::height_energy`]), the frame's energy and the open contacts' elastic
+    /// energy, J.
     fn energy(&self) -> f64 {
-        let mut e = self.scene.frame_energy(self.t, self.xs, self.vs);
+        let mut e = self.scene.frame_energy(self.t, self.xs, self.vs) + self.scene.height_energy_at_start();
         for i in 0..self.n {
             let (v, w) = (self.v[i], self.w[i]);
             e += 0.5 * self.mass[i] * dot(v, v) + 0.5 * self.inertia[i] * dot(w, w);
@@ -426,8 +427,7 @@ impl<'a> Solver<'a> {
     fn run(&mut self, meter: &Meter, recorder: &mut Recorder) -> Result<Option<Budget>, ModelError> {
         let scene = self.scene;
         let sample_count = scene.sample_count();
-        recorder.sample(scene, 0.0, self.xs, self.vs, |i| (self.x[i][0], self.v[i][0]));
-        recorder.sample_across(|i| [self.x[i][1], self.x[i][2]]);
+        recorder.sample_in_space(scene, 0.0, self.xs, self.vs, |i| (self.x[i], self.v[i]));
         let mut next_sample = 1;
         let energy_in = scene.initial_energy();
         while !scene.reached_horizon(self.t) {
@@ -446,8 +446,9 @@ impl<'a> Solver<'a> {
                 }
                 let back = (self.t - ts).max(0.0);
                 let (x, v) = (&self.x, &self.v);
-                recorder.sample(scene, ts, self.xs - back * self.vs, self.vs, |i| (x[i][0] - back * v[i][0], v[i][0]));
-                recorder.sample_across(|i| [x[i][1] - back * v[i][1], x[i][2] - back * v[i][2]]);
+                recorder.sample_in_space(scene, ts, self.xs - back * self.vs, self.vs, |i| {
+                    (std::array::from_fn(|k| x[i][k] - back * v[i][k]), v[i])
+                });
                 next_sample += 1;
                 sampled = true;
             }

@@ -232,8 +232,10 @@ pub fn simulate_spatial_with(scene: &Scene, solver: SolverSettings, options: &Ru
     let mut impacts: Vec<Impact> = Vec::new();
     let mut recorder = Recorder::new(scene, options.record);
     let sample_count = scene.sample_count();
-    recorder.sample(scene, 0.0, xs, vs, |i| (scene.initial_positions[i], scene.initial_velocities[i]));
-    recorder.sample_across(|i| scene.space.lateral_of(i));
+    recorder.sample_in_space(scene, 0.0, xs, vs, |i| {
+        let ([y, z], [vy, vz]) = (scene.space.lateral_of(i), scene.space.lateral_velocity_of(i));
+        ([scene.initial_positions[i], y, z], [scene.initial_velocities[i], vy, vz])
+    });
     let mut next_sample = 1;
     let touching = TOUCHING_FRACTION * solver.length_unit;
     // Closings slower than gravity and the frame's acceleration build along a contact's
@@ -255,8 +257,9 @@ pub fn simulate_spatial_with(scene: &Scene, solver: SolverSettings, options: &Ru
     let mut found: Vec<Contact> = Vec::new();
     let mut kicked = vec![false; n];
     let mut cascade = contacts::Cascade::default();
+    let height_at_start = scene.height_energy_at_start();
     let energy_of = |state: &BallState, t: f64, xs: f64, vs: f64| -> f64 {
-        let mut e = scene.frame_energy(t, xs, vs);
+        let mut e = scene.frame_energy(t, xs, vs) + height_at_start;
         for i in 0..n {
             let (v, w, x, x0) = (state.v[i], state.w[i], state.x[i], start_positions[i]);
             e += 0.5 * mass[i] * contacts_dot(v, v) + 0.5 * inertia[i] * contacts_dot(w, w);
@@ -494,16 +497,12 @@ pub fn simulate_spatial_with(scene: &Scene, solver: SolverSettings, options: &Ru
             let (sx, sv) = if at_end { (x1, frame.vs) } else { motion.state(xs, vs, t0, ts.max(t0)) };
             let wgt = ((ts - t0) / h).clamp(0.0, 1.0);
             let (b, a) = (&before, &now);
-            recorder.sample(scene, ts, sx, sv, |i| {
+            recorder.sample_in_space(scene, ts, sx, sv, |i| {
                 if at_end {
-                    (a.x[i][0], a.v[i][0])
+                    (a.x[i], a.v[i])
                 } else {
-                    (b.x[i][0] + wgt * (a.x[i][0] - b.x[i][0]), b.v[i][0])
+                    (std::array::from_fn(|k| b.x[i][k] + wgt * (a.x[i][k] - b.x[i][k])), b.v[i])
                 }
-            });
-            recorder.sample_across(|i| {
-                let at = |k: usize| if at_end { a.x[i][k] } else { b.x[i][k] + wgt * (a.x[i][k] - b.x[i][k]) };
-                [at(1), at(2)]
             });
             next_sample += 1;
         }

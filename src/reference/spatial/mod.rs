@@ -490,14 +490,7 @@ impl<'a> Solver<'a> {
     fn sample(&self, recorder: &mut Recorder, ts: f64) {
         let (xs, vs) = self.frame.state(ts);
         let g = self.gravity;
-        recorder.sample(self.scene, ts, xs, vs, |i| {
-            let (p, v) = self.balls[i].at(ts, g);
-            (p[0], v[0])
-        });
-        recorder.sample_across(|i| {
-            let (p, _) = self.balls[i].at(ts, g);
-            [p[1], p[2]]
-        });
+        recorder.sample_in_space(self.scene, ts, xs, vs, |i| self.balls[i].at(ts, g));
     }
 
     fn stalled(&self, why: String) -> ModelError {
@@ -512,7 +505,7 @@ impl<'a> Solver<'a> {
         let scene = self.scene;
         let (xs, vs) = self.frame.state(t);
         let (damping, work) = self.frame.segment_energy(t, scene);
-        let mut final_ = scene.frame_energy(t, xs, vs);
+        let mut final_ = scene.frame_energy(t, xs, vs) + scene.height_energy_at_start();
         let mut velocities = Vec::with_capacity(self.balls.len());
         for (b, p0) in self.balls.iter().zip(&self.start) {
             let (p, v) = b.at(t, self.gravity);

@@ -1,5 +1,5 @@
-//! Issue 31 (the compliant model in space), found by `lpc stress --beds --models compliant`
-//! (seed 97): one ball set on the floor of a free frame at rest, so that nothing is put in.
+//! Found by `lpc stress --beds --models compliant` (seed 97): one ball set on the floor of a
+//! free frame at rest, so that next to nothing is put in.
 //! The ball settles into its contact, trading 1e-8 J between gravity and the contact, and the
 //! integration error of that (1e-11 J) was judged against the picojoule the stress checks take
 //! for "nothing put in". The balance's tolerance now counts gravity's work on the balls (their
@@ -38,7 +38,11 @@ horizon = 0.00753453591165742
 sample_dt = 0.00001
 "#,
     );
-    assert_eq!(scene.initial_energy(), 0.0);
+    // The lattice leaves the ball a thousandth of its radius above the floor: that height is
+    // all the energy it holds (docs/MODEL.md §6), under a microjoule.
+    let (m, r) = (scene.balls[0].mass, scene.balls[0].radius);
+    let above = m * 9.81 * 1e-3 * r;
+    assert!((scene.initial_energy() - above).abs() <= 1e-9 * above, "{} J, expected {above} J", scene.initial_energy());
     let run = Model::Compliant.simulate(&scene, &RunOptions::default()).unwrap();
     judge(Model::Compliant, &scene, &run).unwrap();
 }
