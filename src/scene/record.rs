@@ -176,12 +176,19 @@ impl KanaiTajimi {
 
 /// Reads the points of a record: a PEER `.AT2` file (by its header, accelerations in g at
 /// `k DT`) or two columns of time (s) and acceleration (m/s^2) separated by a comma or spaces,
-/// `#` starting a comment and a first line of words taken as a header. Returns the times and
-/// accelerations, or the rule the text breaks.
-pub fn read_points(text: &str) -> Result<(Vec<f64>, Vec<f64>), String> {
+/// `#` starting a comment and a first line of words taken as a header. `named_at2` says that
+/// the file's name ends in `.AT2` (any case), which makes it a PEER file even when its header
+/// lacks `NPTS`. Returns the times and accelerations, or the rule the text breaks.
+pub fn read_points(text: &str, named_at2: bool) -> Result<(Vec<f64>, Vec<f64>), String> {
     let lines: Vec<&str> = text.lines().collect();
     if let Some(k) = at2_header(&lines) {
         return read_at2(&lines, k);
+    }
+    if named_at2 || is_peer_banner(&lines) {
+        return Err(format!(
+            "is a PEER .AT2 record, but none of its first {AT2_HEADER_LINES} lines gives NPTS (the number of points) and DT (their \
+             step, s), as `NPTS=  4000, DT=   .0050 SEC`"
+        ));
     }
     let (mut times, mut accel) = (Vec::new(), Vec::new());
     for (n, line) in lines.iter().enumerate() {
@@ -205,14 +212,29 @@ pub fn read_points(text: &str) -> Result<(Vec<f64>, Vec<f64>), String> {
     Ok((times, accel))
 }
 
+/// The lines of a PEER `.AT2` file's header searched for `NPTS`.
+const AT2_HEADER_LINES: usize = 8;
+
 /// The line of a PEER `.AT2` header that gives `NPTS`, when `lines` are one.
 fn at2_header(lines: &[&str]) -> Option<usize> {
-    lines.iter().take(8).position(|l| l.to_ascii_uppercase().contains("NPTS"))
+    lines.iter().take(AT2_HEADER_LINES).position(|l| l.to_ascii_uppercase().contains("NPTS"))
 }
 
-/// Whether `text` is a PEER `.AT2` record (ground accelerations in g).
-pub fn is_at2(text: &str) -> bool {
-    at2_header(&text.lines().collect::<Vec<_>>()).is_some()
+/// Whether `lines` open with the PEER database's banner (its first line names PEER).
+fn is_peer_banner(lines: &[&str]) -> bool {
+    lines.first().is_some_and(|l| l.trim_start().to_ascii_uppercase().starts_with("PEER"))
+}
+
+/// Whether `text` is a PEER `.AT2` record (ground accelerations in g), `named_at2` as in
+/// [`read_points`].
+pub fn is_at2(text: &str, named_at2: bool) -> bool {
+    let lines: Vec<&str> = text.lines().collect();
+    named_at2 || at2_header(&lines).is_some() || is_peer_banner(&lines)
+}
+
+/// Whether a record file's `path` ends in `.AT2`, any case.
+pub fn named_at2(path: &std::path::Path) -> bool {
+    path.extension().is_some_and(|e| e.eq_ignore_ascii_case("at2"))
 }
 
 /// The PEER format: a header whose line `k` gives `NPTS` and `DT`, then the accelerations in g.
@@ -275,16 +297,16 @@ mod tests {
     #[test]
     fn text_and_at2_records_read_alike() {
         let text = "time, accel\n0, 0\n0.01, 0.4903325\n# comment\n0.02 -0.980665\n";
-        let (t, a) = read_points(text).unwrap();
+        let (t, a) = read_points(text, false).unwrap();
         assert_eq!(t, vec![0.0, 0.01, 0.02]);
         let at2 = "PEER NGA STRONG MOTION DATABASE RECORD\nSYNTHETIC\nACCELERATION TIME SERIES IN UNITS OF G\nNPTS=    3, DT=   .0100 SEC\n  0.0  .05  -.1\n";
-        let (t2, a2) = read_points(at2).unwrap();
+        let (t2, a2) = read_points(at2, false).unwrap();
         assert_eq!(t2, t);
         for (x, y) in a.iter().zip(&a2) {
             assert!((x - y).abs() < 1e-15);
         }
-        assert!(read_points("0 1\n0 2\n").unwrap_err().contains("must increase"));
-        assert!(read_points("0 1 2\n").unwrap_err().contains("columns"));
+        assert!(read_points("0 1\n0 2\n", false).unwrap_err().contains("must increase"));
+        assert!(read_points("0 1 2\n", false).unwrap_err().contains("columns"));
     }
 
     /// The filtered noise has the Kanai-Tajimi process's stationary variance: over 2000 s

@@ -4,7 +4,7 @@
 use crate::scene::excitation::Forcing;
 use crate::scene::format::{self};
 use crate::scene::format::{ExcitationKind, ForcingKind};
-use crate::scene::record::{is_at2, read_points, GroundRecord, KanaiTajimi};
+use crate::scene::record::{is_at2, named_at2, read_points, GroundRecord, KanaiTajimi};
 use crate::scene::structure::Frame;
 use crate::scene::validator::Validator;
 use crate::scene::{human, SceneError};
@@ -74,13 +74,14 @@ pub(in crate::scene) fn ground_record(
     let scale = v.finite("forcing.scale", g.scale.unwrap_or(1.0))?;
     let path = std::path::Path::new(v.file).parent().unwrap_or(std::path::Path::new("")).join(file);
     let text = std::fs::read_to_string(&path).map_err(|e| v.err("forcing.file", &format!("cannot be read ({}): {e}", path.display())))?;
-    if g.kind == ExcitationKind::ForceRecord && is_at2(&text) {
+    let at2_name = named_at2(&path);
+    if g.kind == ExcitationKind::ForceRecord && is_at2(&text, at2_name) {
         return Err(v.err(
             "forcing.file",
             &format!("({}) is a PEER ground acceleration in g; a force record is two columns, time (s) and force (N)", path.display()),
         ));
     }
-    let (times, accel) = read_points(&text).map_err(|why| v.err("forcing.file", &format!("({}) {why}", path.display())))?;
+    let (times, accel) = read_points(&text, at2_name).map_err(|why| v.err("forcing.file", &format!("({}) {why}", path.display())))?;
     let record = GroundRecord::new(times, accel, scale);
     within_range(&record, "forcing.scale", v)?;
     Ok(record)

@@ -1,6 +1,7 @@
 //! One test per fixed bug, each on the (shrunk) scene that showed it. A file is named for what
 //! went wrong; its module doc names the issue, the cause and the fix.
 
+mod at2_without_npts;
 mod ball_struck_on_the_floor;
 mod balls_sliding_together;
 mod bed_energy_below_zero;
