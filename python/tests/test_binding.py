@@ -236,7 +236,7 @@ def test_ctrl_c_stops_a_long_ensemble_between_batches(scenes, tmp_path):
 
 
 def test_the_fig9_example_runs(tmp_path):
-    """examples/fig9.py (the README's Python example) runs and draws its figure."""
+    """examples/fig9.py (the user guide's Python example) runs and draws its figure."""
     import os
     import sys
 

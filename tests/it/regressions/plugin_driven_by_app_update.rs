@@ -1,5 +1,5 @@
 //! Issue 12 (found while writing `examples/bevy_app.rs`): in an app driven by `app.update()`,
-//! as the README tells a Bevy user to drive the plug-in, bevy_rapier copies a changed
+//! as the user guide tells a Bevy user to drive the plug-in, bevy_rapier copies a changed
 //! `Velocity` component back into its body before each step. It had written the step's
 //! velocity there before the plug-in's feedback corrected the body (the bounce Rapier skipped),
 //! so every correction was undone one step later and the run drifted millimetres from the
