@@ -84,7 +84,7 @@ pub fn settings(scene: &Scene) -> StepSettings {
 /// Solver iterations when the scene sets none: [`DEFAULT_SOLVER_ITERATIONS`] per decade of
 /// the largest mass ratio of neighbouring balls. Rapier's iterative solver converges more
 /// slowly the more unequal the masses it couples: a light ball squeezed between a heavy one
-/// and a wall sinks into the wall with too few iterations (docs/BENCHMARKS.md, "Stress runs").
+/// and a wall sinks into the wall with too few iterations (docs/BENCHMARKS.md, "Stress").
 pub fn default_iterations(scene: &Scene) -> usize {
     // Past 16 decades the light ball's momentum is below the heavy one's round-off: more
     // iterations cannot couple them (and an infinite ratio must not ask for infinitely many).

@@ -79,7 +79,7 @@ fn generated_scenes_are_reproducible_from_their_seed() {
 
 /// The contact model on the first 25 scenes of the default seed (horizons up to 1 s); a scene
 /// refused with a reason, before or during the run, is a pass (`lpc stress --models rapier
-/// --count 1000` passes all 1000, 235 of them refused; docs/BENCHMARKS.md "Stress runs").
+/// --count 1000` passes all 1000, 235 of them refused; docs/BENCHMARKS.md "Stress").
 #[test]
 fn contact_model_passes_the_first_seeded_scenes() {
     assert_all_pass(&stress(

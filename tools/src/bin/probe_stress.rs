@@ -1,5 +1,5 @@
 //! Classifies contact-model stress outcomes by scene parameters (one JSON line per seed):
-//! `cargo run --release -p lpc-tools --bin probe_stress -- 300` (docs/BENCHMARKS.md, "Stress runs").
+//! `cargo run --release -p lpc-tools --bin probe_stress -- 300` (docs/BENCHMARKS.md, "Stress").
 use rayon::prelude::*;
 fn main() {
     let n: u64 = std::env::args().nth(1).unwrap().parse().unwrap();
