@@ -10,27 +10,25 @@
 
 use std::path::PathBuf;
 
-use numpy::ndarray::{Array2, Array3};
 use numpy::{IntoPyArray, PyArray1};
 use pyo3::create_exception;
 use pyo3::exceptions::{PyRuntimeError, PyValueError};
 use pyo3::prelude::*;
-use pyo3::sync::MutexExt;
 use pyo3::types::PyDict;
 
 use lpc_damper::files::write_atomic;
-use lpc_damper::metrics::{Headline, Metric, RunSummary};
+use lpc_damper::metrics::{Headline, Metric};
 use lpc_damper::model::{Limits, ModelError as RustModelError, RunOptions};
 use lpc_damper::output::parquet::{provenance, table_parquet, Constant, TOOL_VERSION};
-use lpc_damper::scene::{self, Overrides, SceneError as RustSceneError, SceneFile};
+use lpc_damper::scene::{Overrides, SceneError as RustSceneError};
 use lpc_damper::studies::{chain as chains, ensemble as ensembles, frf as frfs, sweep as sweeps};
 use lpc_damper::Model;
 
-mod run;
-mod scene;
+mod run_class;
+mod scene_class;
 
-use run::{floats, Run};
-use scene::{Scene, Settings};
+use run_class::{floats, Run};
+use scene_class::{Scene, Settings};
 
 create_exception!(
     _lpc_damper,

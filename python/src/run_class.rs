@@ -1,7 +1,8 @@
 //! The `Run` class: one run's series as NumPy arrays, made when first read, and its summary.
 
 use numpy::ndarray::{Array2, Array3};
-use numpy::{IntoPyArray, PyArray1};
+use numpy::IntoPyArray;
+use pyo3::exceptions::PyRuntimeError;
 use pyo3::prelude::*;
 use pyo3::sync::MutexExt;
 use pyo3::types::PyDict;

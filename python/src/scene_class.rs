@@ -3,10 +3,11 @@
 
 use std::path::PathBuf;
 
+use pyo3::exceptions::PyRuntimeError;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 
-use lpc_damper::scene::{self, Loaded, Overrides, SceneFile, Stepping};
+use lpc_damper::scene::{self, Loaded, Overrides, SceneError as RustSceneError, SceneFile, Stepping};
 
 use crate::{scene_error, SceneError};
 
