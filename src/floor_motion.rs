@@ -1,7 +1,8 @@
 //! A structure's floors since the last impulse on the carrying floor (docs/MODEL.md §16-17),
-//! in closed form: the modes of [`Building::modes`] stretch by stretch of the record, a sine
-//! load's steady response on top, and the energy the storeys dissipate and the excitation
-//! puts in. Every model that feeds impulses to a structure moves its floors with this.
+//! in closed form: the modes of [`crate::storeys::Building::modes`] stretch by stretch of the
+//! record, a sine load's steady response on top, and the energy the storeys dissipate and the
+//! excitation puts in. Every model that feeds impulses to a structure moves its floors with
+//! this.
 
 use std::cell::RefCell;
 use std::sync::Arc;

@@ -38,6 +38,7 @@ fn balls_at_touching_positions_are_accepted_and_strike_at_once() {
 #[test]
 fn overlapping_balls_are_still_refused_naming_the_ball() {
     let text = two_balls(0.05, 0.0599);
-    let err = lpc_damper::scene::parse(&text, "test.toml", "test").err().expect("an overlap is refused").to_string();
+    let Err(err) = lpc_damper::scene::parse(&text, "test.toml", "test") else { panic!("an overlap is refused") };
+    let err = err.to_string();
     assert!(err.contains("ball[1].position") && err.contains("overlap"), "{err}");
 }
