@@ -15,7 +15,10 @@ if ! dpkg -s mesa-vulkan-drivers libvulkan1 >/dev/null 2>&1; then
 fi
 cargo --version
 
+start=$SECONDS
 cargo test --locked --features render
+echo "test.sh: the Rust tests (build and run) took $((SECONDS - start)) s" >&2
+start=$SECONDS
 
 # The Python package (python/, built by maturin with the locked dependencies) in a virtual
 # environment of its own, with what its tests use (pytest, dask[distributed], pandas,
@@ -28,3 +31,4 @@ MATURIN_PEP517_ARGS="--locked" "$venv/bin/python" -m pip install --quiet --disab
 # instead of building them again.
 cargo build --locked --release -p lpc-damper -p lpc-damper-python --bin lpc
 "$venv/bin/python" -m pytest -q python/tests
+echo "test.sh: the Python package (build, release CLI and tests) took $((SECONDS - start)) s" >&2
