@@ -148,13 +148,16 @@ impl<'a> Meter<'a> {
     pub fn elapsed(&self) -> f64 {
         self.start.elapsed().as_secs_f64()
     }
-    /// The run has taken `steps` steps and reached `t`: on every `every`-th step (and past the
-    /// step budgets) reports it and returns the budget that has run out, if any.
+    /// The run has taken `steps` steps and reached `t`: on every `every`-th step, on the
+    /// steps 1, 2, 4, ... before it, and past the step budgets, reports it and returns the
+    /// budget that has run out, if any. The early looks bound a run of slow steps: it overruns
+    /// its wall-time budget by at most the time it had taken when it last looked.
     #[inline]
     pub fn look(&self, t: f64, steps: u64) -> Option<Budget> {
         let over_steps = self.max_steps.is_some_and(|m| steps > m);
         let over_kept = self.max_kept.is_some_and(|m| steps > m);
-        if !(over_steps | over_kept) && !steps.is_multiple_of(self.every) {
+        let due = steps.is_multiple_of(self.every) || (steps < self.every && steps.is_power_of_two());
+        if !(over_steps | over_kept | due) {
             return None;
         }
         if let Some(p) = self.progress {

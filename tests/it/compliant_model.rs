@@ -324,10 +324,10 @@ fn a_budget_says_what_the_steps_cost() {
     let err = Model::Compliant.simulate(&scene, &RunOptions::limited(Limits { max_steps: Some(20_000), ..Limits::NONE })).unwrap_err();
     let msg = err.to_string();
     assert!(msg.contains("packed-column") && msg.contains("contacts open, the stiffest ball") && msg.contains("Hertz period"), "{msg}");
-    // A wall-time budget of a nanosecond stops at its first look, after PROGRESS_STEPS steps.
+    // A wall-time budget of a nanosecond stops at the meter's first look, before the first step.
     let err = Model::Compliant.simulate(&scene, &RunOptions::limited(Limits { max_wall_s: Some(1e-9), ..Limits::NONE })).unwrap_err();
     let ModelError::OverBudget(stop) = err else { panic!("not a budget stop") };
-    assert_eq!(stop.steps, lpc_damper::compliant::PROGRESS_STEPS - 1);
+    assert_eq!(stop.steps, 0);
     assert!(stop.budget_text().contains("--max-wall-time"), "{}", stop.budget_text());
 }
 

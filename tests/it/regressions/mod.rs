@@ -35,6 +35,7 @@ mod stopped_run_prints_nothing;
 mod summary_without_bare_floors;
 mod touching_balls_refused;
 mod valid_input_panics;
+mod wall_budget_after_slow_steps;
 mod walls_across_unnamed;
 mod zero_speed_impact_at_start;
 mod zero_time_event_loop;
