@@ -22,13 +22,13 @@ start=$SECONDS
 
 # The Python package (python/, built by maturin with the locked dependencies) in a virtual
 # environment of its own, with what its tests use (pytest, dask[distributed], pandas,
-# pyarrow); its tests compare it with the release CLI.
+# pyarrow); its tests compare it with the CLI. Both are the test build's: the extension is
+# built in the same profile and with the same features as the Rust tests above (the binding's
+# Cargo.toml names the features the tests turn on), so it reuses their crates and only the
+# binding and PyO3 are compiled here.
 venv=target/python-venv
 [ -x "$venv/bin/python" ] || python3 -m venv "$venv"
-MATURIN_PEP517_ARGS="--locked" "$venv/bin/python" -m pip install --quiet --disable-pip-version-check "./python[test]"
-# The release CLI, its dependencies resolved together with the binding's (which turns on a few
-# more features of the linear-algebra crates), so that it reuses the binding's release build
-# instead of building them again.
-cargo build --locked --release -p lpc-damper -p lpc-damper-python --bin lpc
-"$venv/bin/python" -m pytest -q python/tests
-echo "test.sh: the Python package (build, release CLI and tests) took $((SECONDS - start)) s" >&2
+MATURIN_PEP517_ARGS="--locked --profile dev --features lpc-damper/render" \
+    "$venv/bin/python" -m pip install --quiet --disable-pip-version-check "./python[test]"
+LPC_BIN=target/debug/lpc "$venv/bin/python" -m pytest -q python/tests
+echo "test.sh: the Python package (build and tests) took $((SECONDS - start)) s" >&2

@@ -1,6 +1,7 @@
-"""Shared fixtures: the repository's scenes and the release `lpc` binary the CLI comparisons run.
+"""Shared fixtures: the repository's scenes and the `lpc` binary the CLI comparisons run.
 
-`test.sh` builds the binary before it runs these tests; `LPC_BIN` may name another one.
+`LPC_BIN` names the binary (`test.sh` passes the Rust tests' own); without it, the release
+build, built here if missing.
 """
 
 from __future__ import annotations
