@@ -39,6 +39,9 @@ pub const DEFAULT_SAMPLE_DT: f64 = 1e-3;
 pub const MAX_SAMPLES: f64 = 2e7;
 /// Horizon used for chain experiments; the reference stops earlier, once no pair approaches.
 pub const CHAIN_HORIZON: f64 = 0.05;
+/// The time in which a scene at rest covers its length at its speed scale
+/// ([`Scene::speed_scale`]), s: the smallest scale a scene has, whatever its horizon.
+pub const REST_TIME: f64 = 1000.0;
 
 /// A scene that cannot exist, or a file that cannot be read: names the file, the field and the rule.
 #[derive(Debug, thiserror::Error)]
@@ -249,11 +252,35 @@ impl Scene {
     }
 
     /// The scene's speed scale, m/s: the fastest motion it sets going
-    /// ([`Scene::motion_speed`]), and at least its length scale covered once over the horizon
-    /// (a scene at rest still has a scale). The one speed every model scales its speed
-    /// tolerances and floors by (docs/MODEL.md §9).
+    /// ([`Scene::motion_speed`]) or the fastest fall its balls start ([`Scene::fall_speed`]),
+    /// and at least the speed of a fall through the smallest ball's radius under gravity and
+    /// the scene's length covered in [`REST_TIME`] (a scene at rest still has a scale). The one
+    /// speed every model scales its speed tolerances, floors and step bounds by; it depends on
+    /// what the scene is, never on how long it is run (docs/MODEL.md §9).
     pub fn speed_scale(&self) -> f64 {
-        self.motion_speed().max(self.length_scale() / self.horizon)
+        let g = self.space.gravity.iter().map(|a| a * a).sum::<f64>().sqrt();
+        let smallest = self.balls.iter().map(|b| b.radius).fold(f64::INFINITY, f64::min);
+        let settling = if smallest.is_finite() { (g * smallest).sqrt() } else { 0.0 };
+        self.motion_speed().max(self.fall_speed()).max(settling).max(self.length_scale() / REST_TIME)
+    }
+
+    /// The fastest speed gravity alone can give a ball from where it starts, m/s: its fall
+    /// to the lowest place it can reach across the motion ([`Scene::height_energy`]) and, with
+    /// gravity along the motion, through the container's length. 0 without gravity.
+    pub fn fall_speed(&self) -> f64 {
+        if self.space.gravity == [0.0; 3] {
+            return 0.0;
+        }
+        let along = self.space.gravity[0].abs() * self.container.map_or(0.0, |c| c.length);
+        (0..self.balls.len())
+            .map(|i| {
+                let [y, z] = self.space.lateral_of(i);
+                // Along the motion the height energy counts from the start, so at the start it
+                // is the fall across the motion alone.
+                let across = self.height_energy(i, [self.initial_positions[i], y, z]) / self.balls[i].mass;
+                (2.0 * (across.max(0.0) + along)).sqrt()
+            })
+            .fold(0.0, f64::max)
     }
 
     /// The frame's harmonic load `(P, Q, w)` (see [`Forcing::harmonic_load`]), when forced.

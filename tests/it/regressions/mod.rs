@@ -30,6 +30,7 @@ mod series_beyond_memory;
 mod spatial_series_read_back;
 pub(crate) mod squeezed_ball_stops;
 mod stale_impulse_bounce;
+mod step_depends_on_horizon;
 mod stiff_frame_rapier_step;
 mod stopped_run_prints_nothing;
 mod summary_without_bare_floors;
