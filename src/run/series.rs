@@ -475,6 +475,26 @@ impl Recorder {
             [p[1], p[2]]
         });
     }
+    /// The sample at `t` of balls that move in space on a structure's floor: the floors as
+    /// [`Recorder::sample_floors`] takes them, and each ball's inertial centre and velocity
+    /// `[x, y, z]` from `ball(i)` (`y` and `z` in the container's frame).
+    pub fn sample_floors_in_space(
+        &mut self,
+        scene: &Scene,
+        t: f64,
+        floors: (&[f64], &[f64]),
+        ground: (f64, f64),
+        ball: impl Fn(usize) -> ([f64; 3], [f64; 3]),
+    ) {
+        self.sample_floors(scene, t, floors, ground, |i| {
+            let (p, v) = ball(i);
+            (p[0], v[0])
+        });
+        self.sample_across(|i| {
+            let p = ball(i).0;
+            [p[1], p[2]]
+        });
+    }
     /// The balls' centres across the motion, `[y, z]` from `across(i)`, at the sample
     /// [`Recorder::sample`] has just taken (kept with it, or not at all).
     fn sample_across(&mut self, across: impl Fn(usize) -> [f64; 2]) {

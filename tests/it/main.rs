@@ -7,6 +7,7 @@ mod common;
 mod regressions;
 
 mod bad_scenes;
+mod beds_on_structures;
 mod bench_matches_compare;
 mod beyond_one_line;
 mod budgets;

@@ -14,7 +14,8 @@ impl Solver<'_> {
             self.torque[i] = [0.0; 3];
             self.open[i].iter_mut().for_each(|c| c.seen = false);
         }
-        self.frame_force = self.scene.frame_force(self.t, self.xs, self.vs);
+        // On a structure the floors' own forces act in their step; here the walls' alone.
+        self.frame_force = if self.floors.is_some() { 0.0 } else { self.scene.frame_force(self.t, self.xs, self.vs) };
         self.stiffness_rate = 0.0;
         self.damping_rate = 0.0;
         let xs = self.xs;

@@ -11,12 +11,14 @@
 
 mod cells;
 mod contacts;
+mod floors;
 
 use super::{contact, FLOOR_SPEED_FRACTION, MAX_STEPS};
 use crate::model::{Budget, Checks, Limits, Meter, Model, ModelError, OverBudget, RunOptions};
 use crate::run::{EnergyAccount, Impact, Recorder, Run};
 use crate::scene::{Body, Chamber, Scene, Wall};
 use cells::Cells;
+use floors::Floors;
 
 /// Steps per elastic Hertz contact of the fastest impact the run can have: the restitution of
 /// an isolated impact then errs by about 1e-3 (velocity Verlet errs as the square of the step).
@@ -127,8 +129,11 @@ struct Solver<'a> {
     open: Vec<Vec<Open>>,
     xs: f64,
     vs: f64,
-    /// Force on the frame: its spring, damper and excitation, and the walls' contacts, N.
+    /// Force on the frame: its spring, damper and excitation, and the walls' contacts, N (on a
+    /// structure's floor, the walls' contacts alone).
     frame_force: f64,
+    /// A structure's floors, when the container rides one.
+    floors: Option<Floors<'a>>,
     frame_mass: f64,
     gravity: [f64; 3],
     e_star: f64,
@@ -293,6 +298,12 @@ impl<'a> Solver<'a> {
         if let Some(forcing) = scene.forcing {
             h_max = h_max.min(FRAME_PERIOD_FRACTION / forcing.frequency);
         }
+        let floors = Floors::new(scene);
+        if let Some(f) = &floors {
+            let fastest = f.structure.building.undamped_modes().0.into_iter().fold(0.0, f64::max);
+            h_max = h_max.min(FRAME_PERIOD_FRACTION * 2.0 * std::f64::consts::PI / fastest);
+        }
+        let (xs, vs) = floors.as_ref().map_or((scene.initial_displacement, 0.0), |f| f.carrying(scene, 0.0));
         let inertia = (0..n).map(|i| 0.4 * mass[i] * radius[i] * radius[i]).collect();
         let mut solver = Solver {
             scene,
@@ -316,9 +327,10 @@ impl<'a> Solver<'a> {
             listed_xs: 0.0,
             skin,
             open: vec![Vec::new(); n],
-            xs: scene.initial_displacement,
-            vs: 0.0,
+            xs,
+            vs,
             frame_force: 0.0,
+            floors,
             frame_mass: scene.frame.map_or(f64::INFINITY, |f| f.mass),
             gravity: scene.space.gravity,
             e_star,
@@ -373,6 +385,8 @@ impl<'a> Solver<'a> {
     /// friction), and the second half kick.
     fn advance(&mut self, h: f64) {
         let (t0, xs0, vs0) = (self.t, self.xs, self.vs);
+        let scene = self.scene;
+        let floor_powers = self.floors.as_ref().map(|f| f.powers(scene, t0));
         let half = 0.5 * h;
         let frame_a = if self.frame_mass.is_finite() { self.frame_force / self.frame_mass } else { 0.0 };
         for i in 0..self.n {
@@ -386,8 +400,14 @@ impl<'a> Solver<'a> {
             }
         }
         let vs_half = self.vs + half * frame_a;
-        self.xs += h * vs_half;
-        self.vs = vs_half + half * frame_a;
+        let contact = self.frame_force;
+        if let Some(f) = &mut self.floors {
+            f.kick_and_drift(scene, t0, h, contact);
+            (self.xs, self.vs) = f.carrying(scene, t0 + h);
+        } else {
+            self.xs += h * vs_half;
+            self.vs = vs_half + half * frame_a;
+        }
         self.t = t0 + h;
         self.forces(h);
         let mut fastest_squared = 0.0f64;
@@ -400,12 +420,20 @@ impl<'a> Solver<'a> {
             fastest_squared = fastest_squared.max(dot(self.v[i], self.v[i]));
         }
         self.fastest = fastest_squared.sqrt();
-        if self.frame_mass.is_finite() {
-            self.vs = vs_half + half * self.frame_force / self.frame_mass;
+        let contact = self.frame_force;
+        if let Some(f) = &mut self.floors {
+            f.kick(scene, self.t, h, contact);
+            (self.xs, self.vs) = f.carrying(scene, self.t);
+            let ((d0, w0), (d1, w1)) = (floor_powers.unwrap_or_default(), f.powers(scene, self.t));
+            self.damping_loss += half * (d0 + d1);
+            self.forcing_work += half * (w0 + w1);
+        } else {
+            if self.frame_mass.is_finite() {
+                self.vs = vs_half + half * self.frame_force / self.frame_mass;
+            }
+            self.damping_loss += half * (scene.damping_power(t0, vs0) + scene.damping_power(self.t, self.vs));
+            self.forcing_work += half * (scene.forcing_power(t0, xs0, vs0) + scene.forcing_power(self.t, self.xs, self.vs));
         }
-        let scene = self.scene;
-        self.damping_loss += half * (scene.damping_power(t0, vs0) + scene.damping_power(self.t, self.vs));
-        self.forcing_work += half * (scene.forcing_power(t0, xs0, vs0) + scene.forcing_power(self.t, self.xs, self.vs));
         self.steps += 1;
     }
 
@@ -413,7 +441,11 @@ impl<'a> Solver<'a> {
     /// energy ([`Scene::height_energy`]), the frame's energy and the open contacts' elastic
     /// energy, J.
     fn energy(&self) -> f64 {
-        let mut e = self.scene.frame_energy(self.t, self.xs, self.vs) + self.scene.height_energy_at_start();
+        let carrier = match &self.floors {
+            Some(f) => f.energy(self.scene, self.t),
+            None => self.scene.frame_energy(self.t, self.xs, self.vs),
+        };
+        let mut e = carrier + self.scene.height_energy_at_start();
         for i in 0..self.n {
             let (v, w) = (self.v[i], self.w[i]);
             e += 0.5 * self.mass[i] * dot(v, v) + 0.5 * self.inertia[i] * dot(w, w);
@@ -427,7 +459,7 @@ impl<'a> Solver<'a> {
     fn run(&mut self, meter: &Meter, recorder: &mut Recorder) -> Result<Option<Budget>, ModelError> {
         let scene = self.scene;
         let sample_count = scene.sample_count();
-        recorder.sample_in_space(scene, 0.0, self.xs, self.vs, |i| (self.x[i], self.v[i]));
+        self.sample(recorder, 0.0, 0.0);
         let mut next_sample = 1;
         let energy_in = scene.initial_energy();
         while !scene.reached_horizon(self.t) {
@@ -444,11 +476,7 @@ impl<'a> Solver<'a> {
                 if ts > self.t + 1e-9 * h && !scene.sample_at_step_end(ts, self.t, h) {
                     break;
                 }
-                let back = (self.t - ts).max(0.0);
-                let (x, v) = (&self.x, &self.v);
-                recorder.sample_in_space(scene, ts, self.xs - back * self.vs, self.vs, |i| {
-                    (std::array::from_fn(|k| x[i][k] - back * v[i][k]), v[i])
-                });
+                self.sample(recorder, ts, (self.t - ts).max(0.0));
                 next_sample += 1;
                 sampled = true;
             }
@@ -457,6 +485,20 @@ impl<'a> Solver<'a> {
             }
         }
         Ok(None)
+    }
+
+    /// Takes the sample at `ts`, `back` before the state now, along the velocities now.
+    fn sample(&self, recorder: &mut Recorder, ts: f64, back: f64) {
+        let (x, v) = (&self.x, &self.v);
+        let ball = |i: usize| (std::array::from_fn(|k| x[i][k] - back * v[i][k]), v[i]);
+        match &self.floors {
+            None => recorder.sample_in_space(self.scene, ts, self.xs - back * self.vs, self.vs, ball),
+            Some(f) => {
+                let u: Vec<f64> = f.u.iter().zip(&f.v).map(|(u, v)| u - back * v).collect();
+                let (xg, vg, _) = self.scene.ground_motion(ts);
+                recorder.sample_floors_in_space(self.scene, ts, (&u, &f.v), (xg, vg), ball);
+            }
+        }
     }
 
     /// Stops the run when its energy balance is off by more than a tenth of the energies that

@@ -10,6 +10,7 @@
 //! write the same few arrays, and the Bevy schedule would add its ECS synchronisation (a copy
 //! of every body per step) and nothing the headless run needs. The one-line path is untouched.
 
+mod carrier;
 mod contacts;
 mod world;
 
@@ -19,9 +20,9 @@ pub use contacts::closing_speed;
 pub use world::SolverSettings;
 
 use crate::model::{Checks, Meter, Model, ModelError, OverBudget, RunOptions, STALL_EVENTS_PER_SIM_S};
-use crate::oscillator::{gauss_legendre, Driven, Oscillator};
 use crate::run::{EnergyAccount, Impact, Recorder, Run};
 use crate::scene::{Body, Chamber, Scene, Wall};
+use carrier::Carrier;
 use contacts::{Balls, Contact, FrameBody, Other};
 
 /// Default step of the spatial path, s: Rapier's steps are plastic and the bounces come from
@@ -60,12 +61,6 @@ pub fn needs_spatial(scene: &Scene) -> bool {
 
 /// Why the spatial path cannot run `scene`, or `None` when it can.
 pub fn refusal(scene: &Scene) -> Option<String> {
-    if scene.structure.is_some() {
-        return Some(
-            "it moves several chains and balls beyond their lines on a frame of one storey only; on a structure of several storeys or under a ground-motion record its balls must stay on one line"
-                .into(),
-        );
-    }
     if scene.frame.is_none() {
         return Some("the scene has no frame; the spatial contact model needs a container on a frame".into());
     }
@@ -221,7 +216,7 @@ pub fn simulate_spatial_with(scene: &Scene, solver: SolverSettings, options: &Ru
     let inertia: Vec<f64> = scene.balls.iter().map(|b| 0.4 * b.mass * b.radius * b.radius).collect();
     let g = scene.space.gravity;
     let e = scene.restitution;
-    let motion = Driven::new(Oscillator::new(f.mass, f.damping, f.stiffness), scene.harmonic_load());
+    let mut carrier = Carrier::new(scene).map_err(ModelError::Refused)?;
     let mut now = BallState { x: vec![[0.0; 3]; n], v: vec![[0.0; 3]; n], w: vec![[0.0; 3]; n] };
     now.read(&world.physics.bodies, &world.balls);
     let start_positions = now.x.clone();
@@ -232,7 +227,7 @@ pub fn simulate_spatial_with(scene: &Scene, solver: SolverSettings, options: &Ru
     let mut impacts: Vec<Impact> = Vec::new();
     let mut recorder = Recorder::new(scene, options.record);
     let sample_count = scene.sample_count();
-    recorder.sample_in_space(scene, 0.0, xs, vs, |i| {
+    sample(&mut recorder, scene, &carrier, 0.0, (xs, vs), |i| {
         let ([y, z], [vy, vz]) = (scene.space.lateral_of(i), scene.space.lateral_velocity_of(i));
         ([scene.initial_positions[i], y, z], [scene.initial_velocities[i], vy, vz])
     });
@@ -258,8 +253,8 @@ pub fn simulate_spatial_with(scene: &Scene, solver: SolverSettings, options: &Ru
     let mut kicked = vec![false; n];
     let mut cascade = contacts::Cascade::default();
     let height_at_start = scene.height_energy_at_start();
-    let energy_of = |state: &BallState, t: f64, xs: f64, vs: f64| -> f64 {
-        let mut e = scene.frame_energy(t, xs, vs) + height_at_start;
+    let energy_of = |carrier: &Carrier, state: &BallState, t: f64, xs: f64, vs: f64| -> f64 {
+        let mut e = carrier.energy(t, xs, vs) + height_at_start;
         for i in 0..n {
             let (v, w, x, x0) = (state.v[i], state.w[i], state.x[i], start_positions[i]);
             e += 0.5 * mass[i] * contacts_dot(v, v) + 0.5 * inertia[i] * contacts_dot(w, w);
@@ -289,11 +284,13 @@ pub fn simulate_spatial_with(scene: &Scene, solver: SolverSettings, options: &Ru
             }
         });
         vs = frame.vs;
+        carrier.restart(0.0, vs).map_err(ModelError::Refused)?;
         now.write_velocities(&mut world.physics.bodies, &world.balls, &struck);
     }
     let mut t = 0.0;
     let mut steps: u64 = 0;
-    let finish = |t: f64,
+    let finish = |carrier: &Carrier,
+                  t: f64,
                   xs: f64,
                   vs: f64,
                   state: &BallState,
@@ -304,7 +301,7 @@ pub fn simulate_spatial_with(scene: &Scene, solver: SolverSettings, options: &Ru
                   contact_loss: f64,
                   forcing_work: f64,
                   steps: u64| {
-        let final_ = energy_of(state, t, xs, vs);
+        let final_ = energy_of(carrier, state, t, xs, vs);
         let (series, motion) = recorder.finish();
         Run {
             scene: scene.name.clone(),
@@ -328,7 +325,8 @@ pub fn simulate_spatial_with(scene: &Scene, solver: SolverSettings, options: &Ru
         if let Some(budget) = meter.look(t, steps) {
             let wall_s = meter.elapsed();
             let cost = format!("{} impacts so far; {} balls in 3D at steps of {} s", impacts.len(), n, crate::scene::human(solver.dt));
-            let mut partial = finish(t, xs, vs, &now, recorder, impacts, damping_loss, impact_loss, contact_loss, forcing_work, steps);
+            let mut partial =
+                finish(&carrier, t, xs, vs, &now, recorder, impacts, damping_loss, impact_loss, contact_loss, forcing_work, steps);
             partial.wall_time_s = wall_s;
             return Err(ModelError::OverBudget(Box::new(OverBudget {
                 scene: scene.name.clone(),
@@ -351,18 +349,10 @@ pub fn simulate_spatial_with(scene: &Scene, solver: SolverSettings, options: &Ru
         // The frame to where its closed form is at the step's end; Rapier moves the walls
         // there in a straight line.
         let (t0, t1) = (t, t + h);
-        let (x1, v1) = motion.state(xs, vs, t0, t1);
-        if motion.xp.is_none() {
-            damping_loss += motion.osc.dissipated(xs, vs, h);
-        } else {
-            let (xa, va) = (xs, vs);
-            let [damping, work] = gauss_legendre(t0, t1, h, |tq| {
-                let (xq, vq) = motion.state(xa, va, t0, tq);
-                [scene.damping_power(tq, vq), scene.forcing_power(tq, xq, vq)]
-            });
-            damping_loss += damping;
-            forcing_work += work;
-        }
+        let (x1, v1) = carrier.state(t1);
+        let (damping, work) = carrier.energy_flows(t0, h);
+        damping_loss += damping;
+        forcing_work += work;
         world.physics.bodies[world.frame].set_next_kinematic_translation(Vector::new(x1 as f32, 0.0, 0.0));
         // The walls' mean velocity over the step: Rapier moves them there in a straight line.
         let mean_vs = (x1 - xs) / h;
@@ -489,31 +479,33 @@ pub fn simulate_spatial_with(scene: &Scene, solver: SolverSettings, options: &Ru
         let step_loss = -(kinetic(&now) - kinetic(&before) - gravity_work + frame_jump) - step_impact_loss;
         contact_loss += step_loss;
         report.worst_step_gain = report.worst_step_gain.max(-step_loss);
-        // Samples in the step: the frame in closed form (impulses land at the step's end),
-        // the balls along their straight path with their old velocity.
+        // Samples in the step: the carrier in closed form (impulses land at the step's end),
+        // the balls along their straight path with their old velocity; then the carrier goes
+        // on from the impulses, and the samples at the step's end see it so.
         while next_sample < sample_count {
             let ts = next_sample as f64 * scene.sample_dt;
-            let at_end = scene.sample_at_step_end(ts, t1, h);
-            if ts > t1 && !at_end {
+            if ts > t1 || scene.sample_at_step_end(ts, t1, h) {
                 break;
             }
-            let (sx, sv) = if at_end { (x1, frame.vs) } else { motion.state(xs, vs, t0, ts.max(t0)) };
             let wgt = ((ts - t0) / h).clamp(0.0, 1.0);
-            let (b, a) = (&before, &now);
-            recorder.sample_in_space(scene, ts, sx, sv, |i| {
-                if at_end {
-                    (a.x[i], a.v[i])
-                } else {
-                    (std::array::from_fn(|k| b.x[i][k] + wgt * (a.x[i][k] - b.x[i][k])), b.v[i])
-                }
+            let b = &before;
+            let a = &now;
+            sample(&mut recorder, scene, &carrier, ts, carrier.state(ts.max(t0)), |i| {
+                (std::array::from_fn(|k| b.x[i][k] + wgt * (a.x[i][k] - b.x[i][k])), b.v[i])
             });
+            next_sample += 1;
+        }
+        carrier.restart(t1, frame.vs).map_err(ModelError::Refused)?;
+        while next_sample < sample_count && scene.sample_at_step_end(next_sample as f64 * scene.sample_dt, t1, h) {
+            let a = &now;
+            sample(&mut recorder, scene, &carrier, next_sample as f64 * scene.sample_dt, (x1, frame.vs), |i| (a.x[i], a.v[i]));
             next_sample += 1;
         }
         xs = x1;
         vs = frame.vs;
         t = t1;
         steps += 1;
-        let energy = energy_of(&now, t, xs, vs);
+        let energy = energy_of(&carrier, &now, t, xs, vs);
         let energy_in = initial_energy + forcing_work;
         if energy > energy_in + energy_gain_allowance(scene, energy_in) {
             return Err(ModelError::Unstable {
@@ -529,11 +521,27 @@ pub fn simulate_spatial_with(scene: &Scene, solver: SolverSettings, options: &Ru
     meter.finish(scene.horizon, steps);
     report.steps = steps;
     report.contact_loss = contact_loss;
-    let mut run = finish(t, xs, vs, &now, recorder, impacts, damping_loss, impact_loss, contact_loss, forcing_work, steps);
+    let mut run = finish(&carrier, t, xs, vs, &now, recorder, impacts, damping_loss, impact_loss, contact_loss, forcing_work, steps);
     // The steps' sum ends within a relative 1e-12 of the horizon; the run covered it.
     run.horizon = scene.horizon;
     run.wall_time_s = meter.elapsed();
     Ok((run, report))
+}
+
+/// Takes the sample at `ts`: the frame at `frame` (displacement and velocity), or a
+/// structure's floors from `carrier`, and each ball's centre and velocity from `ball(i)`.
+fn sample(
+    recorder: &mut Recorder,
+    scene: &Scene,
+    carrier: &Carrier,
+    ts: f64,
+    frame: (f64, f64),
+    ball: impl Fn(usize) -> ([f64; 3], [f64; 3]),
+) {
+    match carrier.floors(ts) {
+        None => recorder.sample_in_space(scene, ts, frame.0, frame.1, ball),
+        Some((z, ground)) => recorder.sample_floors_in_space(scene, ts, z.split_at(z.len() / 2), ground, ball),
+    }
 }
 
 /// The stop of a run in which Rapier's solve left a ball sunk into a wall (`sunk`: the ball,

@@ -68,7 +68,7 @@ pub(super) fn refusal(scene: &Scene) -> Option<String> {
     }
     if scene.structure.is_some() {
         return Some(
-            "the reference runs structures of several storeys and ground-motion records with balls on lines, not yet with beds".into(),
+            "the reference carries balls beyond their lines on a frame only: a container on a structure's floor or under a ground-motion record runs in the contact and compliant models, and in the reference with its balls on lines".into(),
         );
     }
     None

@@ -1,0 +1,90 @@
+//! What carries the container on the spatial path: a frame on its spring, or a floor of a
+//! structure (docs/MODEL.md §16-17). The loop asks the carrier where it is at a time, what a
+//! step dissipated and what the excitation put in, and tells it the velocity the impacts leave
+//! it with at a step's end.
+
+use crate::floor_motion::FloorMotion;
+use crate::oscillator::{gauss_legendre, Driven, Oscillator};
+use crate::scene::Scene;
+
+/// The carrying body's motion since the last step's end (a frame) or since the last impulse
+/// on it (a floor), in closed form.
+pub(super) enum Carrier<'a> {
+    /// A frame: the closed-form oscillator from its state `(x0, v0)` at `t0`.
+    Frame { scene: &'a Scene, motion: Driven, x0: f64, v0: f64, t0: f64 },
+    /// A structure's floors, the container on the carrying one.
+    Floors(Box<FloorMotion>),
+}
+
+impl<'a> Carrier<'a> {
+    /// The carrier of `scene` at its start.
+    pub(super) fn new(scene: &'a Scene) -> Result<Self, String> {
+        if let Some(s) = &scene.structure {
+            return Ok(Carrier::Floors(Box::new(FloorMotion::new(s.clone(), scene.forcing)?)));
+        }
+        let f = scene.frame.ok_or("the scene has no frame")?;
+        let motion = Driven::new(Oscillator::new(f.mass, f.damping, f.stiffness), scene.harmonic_load());
+        Ok(Carrier::Frame { scene, motion, x0: scene.initial_displacement, v0: 0.0, t0: 0.0 })
+    }
+
+    /// The carrying body's absolute displacement and velocity at `t` (not before the last
+    /// restart).
+    pub(super) fn state(&self, t: f64) -> (f64, f64) {
+        match self {
+            Carrier::Frame { motion, x0, v0, t0, .. } => motion.state(*x0, *v0, *t0, t),
+            Carrier::Floors(m) => m.state(t),
+        }
+    }
+
+    /// What the carrier's dampers dissipated and the excitation put in over the step of `h`
+    /// from `from` (since the last restart), J.
+    pub(super) fn energy_flows(&self, from: f64, h: f64) -> (f64, f64) {
+        match self {
+            Carrier::Frame { scene, motion, x0, v0, t0 } => {
+                let (xa, va) = if from == *t0 { (*x0, *v0) } else { motion.state(*x0, *v0, *t0, from) };
+                if motion.xp.is_none() {
+                    (motion.osc.dissipated(xa, va, h), 0.0)
+                } else {
+                    let [damping, work] = gauss_legendre(from, from + h, h, |tq| {
+                        let (xq, vq) = motion.state(xa, va, from, tq);
+                        [scene.damping_power(tq, vq), scene.forcing_power(tq, xq, vq)]
+                    });
+                    (damping, work)
+                }
+            }
+            Carrier::Floors(m) => m.energy_between(from, from + h),
+        }
+    }
+
+    /// The carrying body goes on from `t` at velocity `v`: a frame restarts at every step's end,
+    /// the floors only when an impulse changed the carrying floor's velocity.
+    pub(super) fn restart(&mut self, t: f64, v: f64) -> Result<(), String> {
+        match self {
+            Carrier::Frame { motion, x0, v0, t0, .. } => {
+                let (x, _) = motion.state(*x0, *v0, *t0, t);
+                (*x0, *v0, *t0) = (x, v, t);
+                Ok(())
+            }
+            Carrier::Floors(m) if m.state(t).1 != v => m.restart(t, v, 0.0),
+            Carrier::Floors(_) => Ok(()),
+        }
+    }
+
+    /// The carrier's mechanical energy at `t` with the carrying body at `(x, v)`: the frame's
+    /// kinetic and spring energy, or every floor's, J.
+    pub(super) fn energy(&self, t: f64, x: f64, v: f64) -> f64 {
+        match self {
+            Carrier::Frame { scene, .. } => scene.frame_energy(t, x, v),
+            Carrier::Floors(m) => m.energy(t),
+        }
+    }
+
+    /// The floors' state `[u; u']` relative to the ground at `t` and the ground's displacement
+    /// and velocity, when the carrier is a structure.
+    pub(super) fn floors(&self, t: f64) -> Option<(Vec<f64>, (f64, f64))> {
+        match self {
+            Carrier::Frame { .. } => None,
+            Carrier::Floors(m) => Some(m.floors(t)),
+        }
+    }
+}

@@ -1,0 +1,78 @@
+//! Beds and boxes of balls carried by a structure's floor, under ground-motion records
+//! (docs/MODEL.md §16-17): the contact model and the compliant model run them, the same box
+//! on a frame and on the one-storey structure that frame is gives the same run, and every run
+//! passes the checks the stress study applies.
+
+use lpc_damper::model::{Model, RunOptions};
+use lpc_damper::run::Run;
+use lpc_damper::scene::Scene;
+use lpc_damper::studies::stress::judge;
+
+/// A box of `count` balls (radius 5 mm, steel, frictionless or not) on `carrier`, text that
+/// ends in a table of the carrier's own.
+fn box_on(carrier: &str, count: usize, friction: f64, horizon: f64) -> String {
+    format!(
+        "{carrier}\n\
+         [container]\nlength = 0.06\nwidth = 0.04\nheight = 0.05\n\
+         [world]\ngravity = [0.0, 0.0, -9.81]\nfriction = {friction}\nrestitution = 0.6\n\
+         [bed]\ncount = {count}\nradii = [0.005]\ndensity = 7800.0\nplacement = \"lattice\"\n\
+         [compliant]\nyoungs_modulus = 2e9\n\
+         [rapier]\ndt = 0.0005\n\
+         [run]\nhorizon = {horizon}\nsample_dt = 0.001\n"
+    )
+}
+
+fn record() -> String {
+    std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/records/synthetic-kt.csv").display().to_string()
+}
+
+fn scene(text: &str) -> Scene {
+    lpc_damper::scene::parse(text, "bed-on-structure.toml", "bed-on-structure").unwrap().scene.unwrap()
+}
+
+fn run(model: Model, scene: &Scene) -> Run {
+    let run = model.simulate(scene, &RunOptions::default()).unwrap_or_else(|e| panic!("{model}: {e}"));
+    judge(model, scene, &run).unwrap_or_else(|f| panic!("{model}: {} {}", f.check, f.detail));
+    run
+}
+
+/// The three-storey building of scenes/mdof-3storey-record.toml, the box on its top floor.
+fn building(scale: f64) -> String {
+    format!(
+        "[structure]\nmasses = [1.35, 1.35, 1.35]\nstiffnesses = [4364.0, 4364.0, 4364.0]\n\
+         damping_ratios = [0.016, 0.016, 0.016]\ndamper_floor = 3\n\
+         [forcing]\nkind = \"record\"\nfile = \"{}\"\nscale = {scale}\n",
+        record()
+    )
+}
+
+#[test]
+fn a_box_on_a_building_under_a_record_runs_in_both_models_and_passes_the_checks() {
+    let s = scene(&box_on(&building(2.0), 12, 0.3, 2.5));
+    for model in [Model::Rapier, Model::Compliant] {
+        let r = run(model, &s);
+        assert_eq!(r.series.floor_count(), 3, "{model}: every floor is written");
+        assert!(r.impact_count() > 0, "{model}: the record throws the balls about");
+        assert!(r.energy.forcing_work != 0.0, "{model}: the ground does work");
+    }
+}
+
+/// A frame under a record of a still ground is a one-storey structure (the floors' closed form
+/// in the contact model, the floors' own Verlet step in the compliant model) with the frame's
+/// motion: the same run as on the frame, to round-off.
+#[test]
+fn a_box_on_a_frame_under_a_still_record_is_the_box_on_the_frame() {
+    let dir = tempfile::tempdir().unwrap();
+    let still = dir.path().join("still.csv");
+    std::fs::write(&still, "time_s,accel_m_s2\n0.0,0.0\n1.0,0.0\n").unwrap();
+    let frame = "[frame]\nmass = 1.35\nstiffness = 865.0\ndamping = 1.092\ninitial_displacement = 0.01\n";
+    let on_frame = scene(&box_on(frame, 8, 0.0, 0.1));
+    let on_record = scene(&box_on(&format!("{frame}[forcing]\nkind = \"record\"\nfile = \"{}\"\n", still.display()), 8, 0.0, 0.1));
+    assert!(on_frame.structure.is_none() && on_record.structure.is_some());
+    for model in [Model::Rapier, Model::Compliant] {
+        let (a, b) = (run(model, &on_frame), run(model, &on_record));
+        let worst = a.series.xs().iter().zip(b.series.xs()).map(|(a, b)| (a - b).abs()).fold(0.0, f64::max);
+        assert!(worst <= 1e-9, "{model}: the frame's displacement differs by {worst:e} m");
+        assert_eq!(a.impact_count(), b.impact_count(), "{model}");
+    }
+}
