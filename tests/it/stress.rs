@@ -53,6 +53,20 @@ fn random_buildings_pass_every_check() {
     }
 }
 
+/// Random beds on random buildings (`lpc stress --beds --structures`), a third shaken by random
+/// ground motion: the contact and compliant models run them all (none refused) and every run
+/// passes the checks; a run may stop at its budget of computing, which bounds the test's time.
+#[test]
+fn random_beds_on_buildings_pass_every_check() {
+    let draws =
+        Draws { max_horizon: 2.0, forced: false, extreme: false, max_wall_s: Some(2.0), chains: false, beds: true, structures: true };
+    for (model, count) in [(Model::Rapier, 12), (Model::Compliant, 4)] {
+        let outcomes = stress(model, 30, count, draws, &|| {});
+        assert_all_pass(&outcomes);
+        assert!(outcomes.iter().all(|o| o.refused.is_none()), "{model}: {:?}", outcomes.iter().find_map(|o| o.refused.as_ref()));
+    }
+}
+
 /// The same under a random harmonic force or base motion (`lpc stress --forced`): besides the
 /// free checks, the energy balance against the forcing's work, and no ball inside a wall or
 /// another ball beyond the contact tolerance (issue 17). The full count (2000 scenes, horizons
