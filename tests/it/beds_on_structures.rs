@@ -76,3 +76,23 @@ fn a_box_on_a_frame_under_a_still_record_is_the_box_on_the_frame() {
         assert_eq!(a.impact_count(), b.impact_count(), "{model}");
     }
 }
+
+/// The shipped particle box on a building loads, the two models that carry a box on a
+/// structure accept it, and the reference refuses it with its reasons.
+#[test]
+fn the_shipped_particle_box_on_a_building_is_run_by_the_contact_and_compliant_models() {
+    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/scenes/particle-box-building.toml");
+    let mut s = lpc_damper::scene::load_scene(&path).unwrap();
+    assert_eq!(s.balls.len(), 300);
+    assert_eq!(s.structure.as_ref().map(|st| st.floors()), Some(3));
+    // The reference names friction first; without it, the structure.
+    assert!(Model::Reference.supports(&s).unwrap_err().contains("friction"));
+    let mut smooth = s.clone();
+    smooth.space.friction = 0.0;
+    assert!(Model::Reference.supports(&smooth).unwrap_err().contains("contact and compliant models"));
+    // Its first 20 ms in the contact model pass the stress checks.
+    s.horizon = 0.02;
+    let r = run(Model::Rapier, &s);
+    assert_eq!(r.series.floor_count(), 3);
+    assert!(Model::Compliant.supports(&s).is_ok());
+}
