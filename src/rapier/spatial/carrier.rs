@@ -56,16 +56,25 @@ impl<'a> Carrier<'a> {
         }
     }
 
-    /// The carrying body goes on from `t` at velocity `v`: a frame restarts at every step's end,
-    /// the floors only when an impulse changed the carrying floor's velocity.
-    pub(super) fn restart(&mut self, t: f64, v: f64) -> Result<(), String> {
+    /// The carrying body's displacement and velocity at the last restart (at the start, its
+    /// initial state), exactly.
+    pub(super) fn start(&self) -> (f64, f64) {
         match self {
-            Carrier::Frame { motion, x0, v0, t0, .. } => {
-                let (x, _) = motion.state(*x0, *v0, *t0, t);
-                (*x0, *v0, *t0) = (x, v, t);
+            Carrier::Frame { x0, v0, .. } => (*x0, *v0),
+            Carrier::Floors(m) => m.state(m.t0),
+        }
+    }
+
+    /// The carrying body, at `state` (displacement and velocity) at `t`, goes on from there at
+    /// velocity `v`: a frame restarts at every step's end, the floors only when an impulse
+    /// changed the carrying floor's velocity.
+    pub(super) fn restart(&mut self, t: f64, state: (f64, f64), v: f64) -> Result<(), String> {
+        match self {
+            Carrier::Frame { x0, v0, t0, .. } => {
+                (*x0, *v0, *t0) = (state.0, v, t);
                 Ok(())
             }
-            Carrier::Floors(m) if m.state(t).1 != v => m.restart(t, v, 0.0),
+            Carrier::Floors(m) if v != state.1 => m.restart(t, v, 0.0),
             Carrier::Floors(_) => Ok(()),
         }
     }

@@ -221,7 +221,7 @@ pub fn simulate_spatial_with(scene: &Scene, solver: SolverSettings, options: &Ru
     now.read(&world.physics.bodies, &world.balls);
     let start_positions = now.x.clone();
     let mut before = BallState { x: now.x.clone(), v: now.v.clone(), w: now.w.clone() };
-    let (mut xs, mut vs) = (scene.initial_displacement, 0.0);
+    let (mut xs, mut vs) = carrier.start();
     let (mut damping_loss, mut forcing_work, mut impact_loss, mut contact_loss) = (0.0, 0.0, 0.0, 0.0);
     let mut report = SpatialReport::default();
     let mut impacts: Vec<Impact> = Vec::new();
@@ -283,8 +283,8 @@ pub fn simulate_spatial_with(scene: &Scene, solver: SolverSettings, options: &Ru
                 struck[j] = true;
             }
         });
+        carrier.restart(0.0, (xs, vs), frame.vs).map_err(ModelError::Refused)?;
         vs = frame.vs;
-        carrier.restart(0.0, vs).map_err(ModelError::Refused)?;
         now.write_velocities(&mut world.physics.bodies, &world.balls, &struck);
     }
     let mut t = 0.0;
@@ -495,7 +495,7 @@ pub fn simulate_spatial_with(scene: &Scene, solver: SolverSettings, options: &Ru
             });
             next_sample += 1;
         }
-        carrier.restart(t1, frame.vs).map_err(ModelError::Refused)?;
+        carrier.restart(t1, (x1, v1), frame.vs).map_err(ModelError::Refused)?;
         while next_sample < sample_count && scene.sample_at_step_end(next_sample as f64 * scene.sample_dt, t1, h) {
             let a = &now;
             sample(&mut recorder, scene, &carrier, next_sample as f64 * scene.sample_dt, (x1, frame.vs), |i| (a.x[i], a.v[i]));

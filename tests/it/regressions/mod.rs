@@ -5,6 +5,7 @@ mod at2_without_npts;
 mod ball_struck_on_the_floor;
 mod balls_sliding_together;
 mod bed_energy_below_zero;
+mod box_loses_floor_velocity;
 mod check_bad_scene_exit_status;
 mod closed_pipe;
 mod driven_sweep_energy_left;
