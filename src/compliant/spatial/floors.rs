@@ -10,13 +10,23 @@ pub(super) struct Floors<'a> {
     pub(super) u: Vec<f64>,
     pub(super) v: Vec<f64>,
     v_half: Vec<f64>,
+    /// [`Floors::powers`] at the state now, which starts the next step's sums.
+    pub(super) powers_now: (f64, f64),
 }
 
 impl<'a> Floors<'a> {
     /// The floors of `scene`'s structure at their initial state, if it has one.
     pub(super) fn new(scene: &'a Scene) -> Option<Self> {
         let s = scene.structure.as_deref()?;
-        Some(Floors { structure: s, u: s.initial_displacements.clone(), v: s.initial_velocities.clone(), v_half: vec![0.0; s.floors()] })
+        let mut floors = Floors {
+            structure: s,
+            u: s.initial_displacements.clone(),
+            v: s.initial_velocities.clone(),
+            v_half: vec![0.0; s.floors()],
+            powers_now: (0.0, 0.0),
+        };
+        floors.powers_now = floors.powers(scene, 0.0);
+        Some(floors)
     }
 
     /// The carrying floor's absolute displacement and velocity at `t`.
@@ -39,7 +49,7 @@ impl<'a> Floors<'a> {
     }
 
     /// The power the storeys' dampers take and the one the excitation puts in at `t`, W.
-    pub(super) fn powers(&self, scene: &Scene, t: f64) -> (f64, f64) {
+    fn powers(&self, scene: &Scene, t: f64) -> (f64, f64) {
         let s = self.structure;
         let (_, vg, _) = scene.ground_motion(t);
         let restoring = s.building.restoring_forces(&self.u, &self.v);
@@ -60,12 +70,14 @@ impl<'a> Floors<'a> {
         }
     }
 
-    /// The second half kick of a step of `h` ending at `t1`, with the contact force there.
+    /// The second half kick of a step of `h` ending at `t1`, with the contact force there, and
+    /// the powers at its end.
     pub(super) fn kick(&mut self, scene: &Scene, t1: f64, h: f64, contact: f64) {
         let a = self.accelerations(scene, t1, contact);
         for j in 0..self.u.len() {
             self.v[j] = self.v_half[j] + 0.5 * h * a[j];
         }
+        self.powers_now = self.powers(scene, t1);
     }
 
     /// The floors' mechanical energy at `t` (kinetic in the ground's inertial frame, and the

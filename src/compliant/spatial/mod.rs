@@ -386,7 +386,6 @@ impl<'a> Solver<'a> {
     fn advance(&mut self, h: f64) {
         let (t0, xs0, vs0) = (self.t, self.xs, self.vs);
         let scene = self.scene;
-        let floor_powers = self.floors.as_ref().map(|f| f.powers(scene, t0));
         let half = 0.5 * h;
         let frame_a = if self.frame_mass.is_finite() { self.frame_force / self.frame_mass } else { 0.0 };
         for i in 0..self.n {
@@ -422,9 +421,10 @@ impl<'a> Solver<'a> {
         self.fastest = fastest_squared.sqrt();
         let contact = self.frame_force;
         if let Some(f) = &mut self.floors {
+            let (d0, w0) = f.powers_now;
             f.kick(scene, self.t, h, contact);
             (self.xs, self.vs) = f.carrying(scene, self.t);
-            let ((d0, w0), (d1, w1)) = (floor_powers.unwrap_or_default(), f.powers(scene, self.t));
+            let (d1, w1) = f.powers_now;
             self.damping_loss += half * (d0 + d1);
             self.forcing_work += half * (w0 + w1);
         } else {
