@@ -61,7 +61,8 @@ pub struct Checks {
     /// How closely the energy balance closes, relative to the energies that flow; `None` for a
     /// model that keeps no balance.
     pub balance: Option<f64>,
-    /// Energy an impact may appear to gain, relative to the initial energy.
+    /// Energy an impact may appear to gain, relative to the energy put in (the initial energy
+    /// and the excitation's work).
     pub impact_gain: f64,
     /// Whether each single impact loses at most what Eq. 9-10 can take (exact impulses).
     pub exact_impacts: bool,
