@@ -54,8 +54,9 @@ fn random_buildings_pass_every_check() {
 }
 
 /// Random beds on random buildings (`lpc stress --beds --structures`), a third shaken by random
-/// ground motion: the contact and compliant models run them all (none refused) and every run
-/// passes the checks; a run may stop at its budget of computing, which bounds the test's time.
+/// ground motion: the contact and compliant models run them all (none refused), the reference
+/// all but those with friction, and every run passes the checks; a run may stop at its budget
+/// of computing, which bounds the test's time.
 #[test]
 fn random_beds_on_buildings_pass_every_check() {
     let draws =
@@ -65,6 +66,11 @@ fn random_beds_on_buildings_pass_every_check() {
         assert_all_pass(&outcomes);
         assert!(outcomes.iter().all(|o| o.refused.is_none()), "{model}: {:?}", outcomes.iter().find_map(|o| o.refused.as_ref()));
     }
+    let outcomes = stress(Model::Reference, 1, 40, draws, &|| {});
+    assert_all_pass(&outcomes);
+    let refused: Vec<&String> = outcomes.iter().filter_map(|o| o.refused.as_ref()).collect();
+    assert!(refused.iter().all(|why| why.contains("friction")), "{refused:?}");
+    assert!(refused.len() < outcomes.len(), "some draws are frictionless and run");
 }
 
 /// The same under a random harmonic force or base motion (`lpc stress --forced`): besides the

@@ -1,5 +1,6 @@
 //! The reference beyond one line (docs/MODEL.md §14): smooth balls flying in closed form in the
-//! plane or in space under gravity inside the container the frame carries, their impacts by
+//! plane or in space under gravity inside the container the frame (or a structure's floor)
+//! carries, their impacts by
 //! Eq. 9-10 along the contact normal, found by an event calendar (a list per ball under a
 //! tournament tree, and a heap for the frame's walls; stale entries are dropped when they
 //! surface) over cells as wide as a ball. Ball-ball and
@@ -65,11 +66,6 @@ pub(super) fn refusal(scene: &Scene) -> Option<String> {
     }
     if space.chains() > 1 {
         return Some("the reference beyond one line has one chamber: it has no dividers between chains".into());
-    }
-    if scene.structure.is_some() {
-        return Some(
-            "the reference carries balls beyond their lines on a frame only: a container on a structure's floor or under a ground-motion record runs in the contact and compliant models, and in the reference with its balls on lines".into(),
-        );
     }
     None
 }
@@ -466,6 +462,14 @@ impl<'a> Solver<'a> {
                 return Ok(Some(budget));
             }
             self.resolve(entry)?;
+            if let Some(why) = self.frame.failure() {
+                return Err(ModelError::Unstable {
+                    scene: self.scene.name.clone(),
+                    model: Model::Reference,
+                    t: self.t,
+                    reason: why.to_string(),
+                });
+            }
             if self.calendar.len() + self.frame_calendar.len() > 64 * self.balls.len() + 4096 {
                 let mut calendar = std::mem::replace(&mut self.calendar, Calendar::new(0));
                 calendar.retain(|e| self.valid(e));
@@ -488,9 +492,19 @@ impl<'a> Solver<'a> {
     }
 
     fn sample(&self, recorder: &mut Recorder, ts: f64) {
-        let (xs, vs) = self.frame.state(ts);
         let g = self.gravity;
-        recorder.sample_in_space(self.scene, ts, xs, vs, |i| self.balls[i].at(ts, g));
+        let ball = |i: usize| self.balls[i].at(ts, g);
+        match self.frame.storeys() {
+            // A structure's floors relative to the ground, and the ground, from their closed form.
+            Some(storeys) => {
+                let (z, ground) = storeys.floors(ts);
+                recorder.sample_floors_in_space(self.scene, ts, z.split_at(z.len() / 2), ground, ball);
+            }
+            None => {
+                let (xs, vs) = self.frame.state(ts);
+                recorder.sample_in_space(self.scene, ts, xs, vs, ball);
+            }
+        }
     }
 
     fn stalled(&self, why: String) -> ModelError {
@@ -503,9 +517,8 @@ impl<'a> Solver<'a> {
 
     fn finish(self, recorder: Recorder, t: f64) -> Run {
         let scene = self.scene;
-        let (xs, vs) = self.frame.state(t);
         let (damping, work) = self.frame.segment_energy(t, scene);
-        let mut final_ = scene.frame_energy(t, xs, vs) + scene.height_energy_at_start();
+        let mut final_ = self.frame.energy(t, scene) + scene.height_energy_at_start();
         let mut velocities = Vec::with_capacity(self.balls.len());
         for (b, p0) in self.balls.iter().zip(&self.start) {
             let (p, v) = b.at(t, self.gravity);

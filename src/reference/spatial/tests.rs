@@ -27,6 +27,39 @@ fn balls_on_one_line_give_the_one_line_reference() {
     assert!(spatial.energy.balance_error.abs() <= 1e-12, "{:?}", spatial.energy);
 }
 
+/// The same on a building shaken by a record (docs/MODEL.md §16-17): balls on one line on
+/// the top floor, run in a container with a cross-section, meet the walls that move with the
+/// floors' closed form at the one-line reference's impacts, and every floor moves alike.
+#[test]
+fn balls_on_one_line_on_a_building_give_the_one_line_reference() {
+    let mut scene = crate::scene::load(crate::scene::scenes_dir().join("mdof-3storey-record.toml")).unwrap().scene.unwrap();
+    scene.horizon = 4.0;
+    let line = super::super::Reference.simulate(&scene, &RunOptions::default()).unwrap();
+    scene.space.section = [0.05, 0.05];
+    assert!(refusal(&scene).is_none());
+    let spatial = simulate(&scene, &RunOptions::default()).unwrap();
+    assert!(line.impacts.len() > 20, "{} impacts", line.impacts.len());
+    assert_eq!(spatial.impacts.len(), line.impacts.len());
+    for (a, b) in spatial.impacts.iter().zip(&line.impacts) {
+        assert_eq!((a.a, a.b), (b.a, b.b), "at {} s", b.t);
+        assert!((a.t - b.t).abs() <= 1e-12, "{} s against {} s", a.t, b.t);
+        assert!((a.approach_speed - b.approach_speed).abs() <= 1e-9 * b.approach_speed, "at {} s", b.t);
+    }
+    assert_eq!(spatial.series.floor_count(), 3);
+    let mut worst = 0.0f64;
+    for k in 0..line.series.len() {
+        for i in 0..3 {
+            let (a, b) = (spatial.series.floor(i, k).unwrap(), line.series.floor(i, k).unwrap());
+            worst = worst.max((a.0 - b.0).abs()).max((a.1 - b.1).abs() * 1e-2);
+        }
+    }
+    assert!(worst <= 1e-12, "the floors differ by {worst:e}");
+    let (xa, xb) = (spatial.series.x(0), line.series.x(0));
+    assert!(xa.iter().zip(xb).all(|(a, b)| (a - b).abs() <= 1e-12), "the balls are written alike, in the ground's frame");
+    assert!(spatial.energy.balance_error.abs() <= 1e-12, "{:?}", spatial.energy);
+    assert!(spatial.energy.forcing_work != 0.0, "the ground does work");
+}
+
 /// Balls that wait before searching against the frame's walls, their waits kept across
 /// the frame's segments, meet the walls where balls that search after every event and
 /// every impact on the walls do: `planar-bed`'s first impacts, dozens of them on the end

@@ -43,7 +43,8 @@ pub struct Args {
     /// Draw each plausible scene's frame as a floor of a building of 1 to 5 storeys (floors of
     /// 0.3-3 times its mass, storeys of 0.3-3 times its stiffness, Rayleigh damping), shaken
     /// by random ground motion a third of the time when not forced. With --beds, the bed rides
-    /// the building (the reference refuses it; the contact and compliant models run it).
+    /// the building (the contact and compliant models run it, the reference when it is
+    /// frictionless).
     #[arg(long, conflicts_with = "extreme")]
     structures: bool,
     /// Seconds of computing each run may take; a run that takes longer stops (a typed stop,
