@@ -100,3 +100,49 @@ fn the_shipped_particle_box_on_a_building_loads_and_every_model_accepts_it() {
     assert_eq!(r.series.floor_count(), 3);
     assert!(Model::Compliant.supports(&s).is_ok());
 }
+
+/// `lpc compare` on a box with friction refuses to put the reference beside it unless asked,
+/// naming the flag; with `--frictionless-reference` the reference's run is its run of the
+/// frictionless copy, and the JSON says which friction each side ran with.
+#[test]
+fn compare_puts_the_reference_on_the_frictionless_copy_when_asked() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("box.toml");
+    std::fs::write(&path, format!("name = \"box\"\n{}", box_on(&building(2.0), 12, 0.3, 0.5))).unwrap();
+    let p = path.to_str().unwrap();
+    let refused = crate::common::lpc(["compare", p, "--models", "rapier", "--format", "json"]);
+    assert_eq!(refused.status.code(), Some(1));
+    assert!(refused.stdout.is_empty());
+    assert!(String::from_utf8_lossy(&refused.stderr).contains("--frictionless-reference"));
+    let out = crate::common::lpc(["compare", p, "--models", "rapier", "--format", "json", "--frictionless-reference"]);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!((v["friction"].as_f64(), v["reference_friction"].as_f64()), (Some(0.3), Some(0.0)));
+    let smooth = scene(&box_on(&building(2.0), 12, 0.0, 0.5));
+    let direct = Model::Reference.simulate(&smooth, &RunOptions::default()).unwrap();
+    assert_eq!(v["reference"]["impact_count"].as_u64(), Some(direct.impact_count() as u64));
+    assert!(v["models"]["rapier"]["errors"]["rms_xs"].as_f64().is_some());
+}
+
+/// An ensemble of a box placed at random on a building shaken at random: every member draws its
+/// own bed and its own ground motion (from the seed and its index), and every model runs them.
+#[test]
+fn an_ensemble_draws_a_bed_and_a_ground_motion_per_member() {
+    let shaken = building(1.0).replace(
+        &format!("kind = \"record\"\nfile = \"{}\"\nscale = 1\n", record()),
+        "kind = \"random\"\nground_frequency = 2.5\nground_damping = 0.6\nintensity = 4.0e-4\nduration = 5.0\nstep = 0.01\nseed = 1\n",
+    );
+    let text = box_on(&shaken, 12, 0.0, 0.3).replace("\"lattice\"", "\"random\"");
+    let loaded = lpc_damper::scene::parse(&text, "box.toml", "box").unwrap();
+    let nominal = loaded.scene.as_ref().unwrap();
+    let members = lpc_damper::studies::ensemble::draw(&loaded.file, &loaded.path, nominal, None, 3, Some(7)).unwrap();
+    let (a, b) = (&members.members[0].scene, &members.members[1].scene);
+    assert_ne!(a.initial_positions, b.initial_positions, "each member places its own bed");
+    let ground = |s: &Scene| s.structure.as_ref().and_then(|st| st.ground.as_ref()).map(|g| g.accel.clone()).unwrap();
+    assert_ne!(ground(a), ground(b), "each member draws its own ground motion");
+    for model in [Model::Reference, Model::Rapier, Model::Compliant] {
+        for m in &members.members {
+            run(model, &m.scene);
+        }
+    }
+}

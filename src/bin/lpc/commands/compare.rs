@@ -6,8 +6,9 @@ use std::path::PathBuf;
 use anyhow::Context;
 
 use lpc_damper::metrics::RunSummary;
-use lpc_damper::model::RunOptions;
+use lpc_damper::model::{ModelError, RunOptions};
 use lpc_damper::output::write_run_dir;
+use lpc_damper::scene::Scene;
 use lpc_damper::studies::compare::{errors, Errors};
 use lpc_damper::Model;
 
@@ -40,6 +41,11 @@ pub struct Args {
     out: Option<PathBuf>,
     #[command(flatten)]
     ensemble: EnsembleArgs,
+    /// Run the reference on the scene's frictionless copy (`world.friction = 0`), which it can
+    /// represent; the other models run the scene as given, so their errors hold friction's
+    /// effect as well as their own.
+    #[arg(long)]
+    frictionless_reference: bool,
 }
 
 /// One model's entry in `lpc compare`'s JSON.
@@ -53,6 +59,9 @@ struct ModelComparison {
 #[derive(serde::Serialize)]
 struct Comparison {
     scene: String,
+    /// The friction the reference ran with (0 on the frictionless copy), beside the scene's.
+    reference_friction: f64,
+    friction: f64,
     reference: RunSummary,
     models: std::collections::BTreeMap<String, ModelComparison>,
 }
@@ -64,7 +73,8 @@ pub fn run(a: Args) -> Result<ExitStatus> {
         return compare_ensembles(&a, &nominal.scene.name, &members);
     }
     let scene = nominal.scene;
-    let reference = crate::watch::watched(Model::Reference, &scene, RunOptions::limited(limits))?;
+    let reference_scene = reference_scene(&scene, a.frictionless_reference)?;
+    let reference = crate::watch::watched(Model::Reference, &reference_scene, RunOptions::limited(limits))?;
     let mut models = std::collections::BTreeMap::new();
     let mut runs = vec![];
     for &m in a.models.iter().filter(|m| **m != Model::Reference) {
@@ -78,7 +88,13 @@ pub fn run(a: Args) -> Result<ExitStatus> {
             write_run_dir(run, &d).with_context(|| format!("writing outputs to {}", d.display()))?;
         }
     }
-    let comparison = Comparison { scene: scene.name.clone(), reference: RunSummary::of(&reference), models };
+    let comparison = Comparison {
+        scene: scene.name.clone(),
+        reference_friction: reference_scene.space.friction,
+        friction: scene.space.friction,
+        reference: RunSummary::of(&reference),
+        models,
+    };
     match a.format {
         Format::Json => print_json(&comparison)?,
         Format::Text => {
@@ -90,6 +106,12 @@ pub fn run(a: Args) -> Result<ExitStatus> {
                 st.dt,
                 st.solver_iterations
             );
+            if comparison.reference_friction != comparison.friction {
+                println!(
+                    "the reference runs the frictionless copy; the others friction {}: their errors hold friction's effect too",
+                    comparison.friction
+                );
+            }
             let table = Table::new(vec![
                 right("model", 10),
                 right("wall ms", 10),
@@ -129,6 +151,25 @@ pub fn run(a: Args) -> Result<ExitStatus> {
     Ok(ExitStatus::Success)
 }
 
+/// The scene the reference runs: `scene`, or with `frictionless` its copy without friction. A
+/// scene with friction and no such request is refused with the reason and the flag that runs it.
+fn reference_scene(scene: &Scene, frictionless: bool) -> Result<Scene> {
+    if frictionless {
+        let mut smooth = scene.clone();
+        smooth.space.friction = 0.0;
+        return Ok(smooth);
+    }
+    if scene.space.friction != 0.0 {
+        if let Err(why) = Model::Reference.supports(scene) {
+            return Err(ModelError::Refused(format!(
+                "{why}; `lpc compare --frictionless-reference` compares the others with the reference on the frictionless copy"
+            ))
+            .into());
+        }
+    }
+    Ok(scene.clone())
+}
+
 /// One model's distributions in `lpc compare --ensemble`'s JSON.
 #[derive(serde::Serialize)]
 struct ModelDistributions {
@@ -152,10 +193,15 @@ struct EnsembleComparison {
 /// Every model on the same members; each model's distributions against the reference's.
 fn compare_ensembles(a: &Args, scene: &str, members: &Ensemble) -> Result<ExitStatus> {
     let mut runs = BTreeMap::new();
+    let mut smooth = members.clone();
+    for member in &mut smooth.members {
+        member.scene = reference_scene(&member.scene, a.frictionless_reference)?;
+    }
     for &m in std::iter::once(&Model::Reference).chain(a.models.iter().filter(|m| **m != Model::Reference)) {
         let work = crate::watch::Work::new(Some(members.members.len()), m.name());
         let start = std::time::Instant::now();
-        let r = ensemble::run_members(members, m, a.budget.limits(&a.scene)?, false, &|| work.inc())?;
+        let each = if m == Model::Reference { &smooth } else { members };
+        let r = ensemble::run_members(each, m, a.budget.limits(&a.scene)?, false, &|| work.inc())?;
         work.finish();
         runs.insert(m, (r.metrics, start.elapsed().as_secs_f64()));
     }
