@@ -40,6 +40,10 @@ pub struct Layout {
     pub depth: f32,
     /// The container's inner height, m.
     pub height: f32,
+    /// Floors of the structure that carries the container (1 for a frame).
+    pub floors: usize,
+    /// The floor that carries the container, 0 at the bottom.
+    pub carrying: usize,
 }
 
 impl Layout {
@@ -59,24 +63,36 @@ impl Layout {
             |c| c.length as f32,
         );
         let wall = 0.2 * radius;
-        let column_height = 0.7 * length.max(6.0 * radius);
         let platform = 0.5 * radius;
         // A line of balls gets a box a little wider and higher than its balls; a scene with a
         // cross-section gets that.
         let [width, high] = scene.space.section.map(|a| a as f32);
         let depth = (3.0 * radius).max(width);
         let height = (2.4 * radius).max(high);
+        let (floors, carrying) = scene.structure.as_ref().map_or((1, 0), |s| (s.floors(), s.floor));
+        // A storey above the container is tall enough to clear it.
+        let clear = if carrying + 1 < floors { 1.3 * (wall + height) } else { 0.0 };
+        let column_height = (0.7 * length.max(6.0 * radius)).max(clear);
+        let base = (carrying + 1) as f32 * (column_height + platform);
         Layout {
             length,
             radius,
             wall,
             column_height,
             platform,
-            ball_y: column_height + platform + wall + 0.5 * height,
+            ball_y: base + wall + 0.5 * height,
             overhang: 0.25 * length.max(6.0 * radius),
             depth,
             height,
+            floors,
+            carrying,
         }
+    }
+
+    /// The height of floor `i`'s platform's centre (0 at the bottom): each storey is its
+    /// columns with the platform on them.
+    pub fn floor_y(&self, i: usize) -> f32 {
+        (i + 1) as f32 * self.column_height + (i as f32 + 0.5) * self.platform
     }
 
     /// World position of a ball centre at `x` (the models' coordinate) and `[y, z]` across
@@ -85,9 +101,10 @@ impl Layout {
         Vec3::new(x as f32, self.ball_y + across[1] as f32, across[0] as f32)
     }
 
-    /// The height of the container's top above the ground.
+    /// The height of the structure's top above the ground: the container's top, or the top
+    /// floor above it.
     fn top(&self) -> f32 {
-        self.ball_y + 0.5 * self.height
+        (self.ball_y + 0.5 * self.height).max(self.floor_y(self.floors - 1) + 0.5 * self.platform)
     }
 
     /// The point the camera looks at: mid-container, a little below the balls (below the
@@ -169,9 +186,14 @@ pub struct FramePart(pub Vec3);
 /// A container wall (for its flash).
 #[derive(Component, Debug, Clone, Copy)]
 pub struct WallMesh(pub Body);
-/// A column, leaning with the frame: its foot's position.
+/// A column of storey `1` (0 at the bottom), leaning with its floor over the one below (the
+/// ground under the first): its foot's position when the structure is at rest.
 #[derive(Component, Debug, Clone, Copy)]
-pub struct Column(pub Vec3);
+pub struct Column(pub Vec3, pub usize);
+/// A floor of a structure other than the carrying one (which is the frame's platform): its
+/// index and its centre at rest.
+#[derive(Component, Debug, Clone, Copy)]
+pub struct FloorSlab(pub usize, pub Vec3);
 
 fn srgb(c: [u8; 3]) -> Color {
     Color::srgb_u8(c[0], c[1], c[2])
@@ -206,22 +228,31 @@ pub fn spawn_stage(
         Transform::from_xyz(0.5 * l.length, 0.0, 0.0),
     ));
     let depth = l.depth;
-    // Columns stand under the platform's ends; their feet stay, their tops follow the frame.
+    // Columns stand under each platform's ends; their feet follow the floor below (the ground
+    // stays), their tops the floor they hold.
     let col = 0.35 * l.radius;
-    for foot_x in [-0.6 * l.overhang, l.length + 0.6 * l.overhang] {
-        commands.spawn((
-            Column(Vec3::new(foot_x, 0.0, 0.0)),
-            Mesh3d(meshes.add(Cuboid::new(col, l.column_height, col))),
-            MeshMaterial3d(steel.clone()),
-            Transform::from_xyz(foot_x, 0.5 * l.column_height, 0.0),
-        ));
+    let column = meshes.add(Cuboid::new(col, l.column_height, col));
+    for storey in 0..l.floors {
+        let foot_y = if storey == 0 { 0.0 } else { l.floor_y(storey - 1) + 0.5 * l.platform };
+        for foot_x in [-0.6 * l.overhang, l.length + 0.6 * l.overhang] {
+            commands.spawn((
+                Column(Vec3::new(foot_x, foot_y, 0.0), storey),
+                Mesh3d(column.clone()),
+                MeshMaterial3d(steel.clone()),
+                Transform::from_xyz(foot_x, foot_y + 0.5 * l.column_height, 0.0),
+            ));
+        }
     }
     let frame_part = |commands: &mut Commands, mesh: Handle<Mesh>, material: Handle<StandardMaterial>, centre: Vec3| {
         commands.spawn((FramePart(centre), Mesh3d(mesh), MeshMaterial3d(material), Transform::from_translation(centre))).id()
     };
-    let platform_y = l.column_height + 0.5 * l.platform;
-    frame_part(commands, meshes.add(Cuboid::new(span, l.platform, depth * 1.4)), steel.clone(), Vec3::new(0.5 * l.length, platform_y, 0.0));
-    let floor_y = l.column_height + l.platform + 0.5 * l.wall;
+    let slab = meshes.add(Cuboid::new(span, l.platform, depth * 1.4));
+    frame_part(commands, slab.clone(), steel.clone(), Vec3::new(0.5 * l.length, l.floor_y(l.carrying), 0.0));
+    for i in (0..l.floors).filter(|&i| i != l.carrying) {
+        let centre = Vec3::new(0.5 * l.length, l.floor_y(i), 0.0);
+        commands.spawn((FloorSlab(i, centre), Mesh3d(slab.clone()), MeshMaterial3d(steel.clone()), Transform::from_translation(centre)));
+    }
+    let floor_y = l.floor_y(l.carrying) + 0.5 * l.platform + 0.5 * l.wall;
     frame_part(
         commands,
         meshes.add(Cuboid::new(l.length + 2.0 * l.wall, l.wall, depth)),
@@ -229,7 +260,7 @@ pub fn spawn_stage(
         Vec3::new(0.5 * l.length, floor_y, 0.0),
     );
     let height = l.height;
-    let wall_y = l.column_height + l.platform + l.wall + 0.5 * height;
+    let wall_y = l.ball_y;
     for (body, x) in [(Body::LeftWall, -0.5 * l.wall), (Body::RightWall, l.length + 0.5 * l.wall)] {
         let m = materials.add(StandardMaterial { base_color: Color::srgb(0.5, 0.52, 0.56), ..default() });
         let id = frame_part(commands, meshes.add(Cuboid::new(l.wall, height, depth)), m, Vec3::new(x, wall_y, 0.0));
@@ -289,17 +320,21 @@ type BallParts<'w, 's> = Query<
     'w,
     's,
     (&'static BallMesh, &'static mut Transform, &'static MeshMaterial3d<StandardMaterial>),
-    (Without<FramePart>, Without<Column>),
+    (Without<FramePart>, Without<Column>, Without<FloorSlab>),
 >;
 /// The frame's parts (walls, floor), posed by [`pose`].
 type FrameParts<'w, 's> = Query<
     'w,
     's,
     (&'static FramePart, &'static mut Transform, Option<&'static WallMesh>, &'static MeshMaterial3d<StandardMaterial>),
-    (Without<BallMesh>, Without<Column>),
+    (Without<BallMesh>, Without<Column>, Without<FloorSlab>),
 >;
 /// The columns the frame stands on, posed by [`pose`].
-type Columns<'w, 's> = Query<'w, 's, (&'static Column, &'static mut Transform), (Without<BallMesh>, Without<FramePart>)>;
+type Columns<'w, 's> =
+    Query<'w, 's, (&'static Column, &'static mut Transform), (Without<BallMesh>, Without<FramePart>, Without<FloorSlab>)>;
+/// A structure's floors other than the carrying one, posed by [`pose`].
+type FloorSlabs<'w, 's> =
+    Query<'w, 's, (&'static FloorSlab, &'static mut Transform), (Without<BallMesh>, Without<FramePart>, Without<Column>)>;
 
 /// Poses every part at the playback's sample and lights the flashes.
 pub fn pose(
@@ -308,6 +343,7 @@ pub fn pose(
     mut balls: BallParts,
     mut parts: FrameParts,
     mut columns: Columns,
+    mut slabs: FloorSlabs,
     mut materials: ResMut<Assets<StandardMaterial>>,
 ) {
     let (xs, x) = super::state_at_sample(&playback.run, playback.sample);
@@ -339,10 +375,23 @@ pub fn pose(
             glow(m, playback.flashing(w.0));
         }
     }
+    // Each floor's displacement relative to the ground: a structure's from its series, a
+    // frame's (one floor) its own.
+    let floor_x = |i: usize| -> f32 {
+        if series.floor_count() > 0 {
+            series.floor(i, k).map_or(0.0, |f| f.0) as f32
+        } else {
+            xs as f32
+        }
+    };
+    for (slab, mut t) in &mut slabs {
+        t.translation = slab.1 + Vec3::X * floor_x(slab.0);
+    }
     for (c, mut t) in &mut columns {
-        // Lean so that the top follows the platform while the foot stays.
-        let lean = (xs as f32).atan2(layout.column_height);
+        // Lean so that the top follows the floor it holds while the foot follows the one below.
+        let (foot, top) = (if c.1 == 0 { 0.0 } else { floor_x(c.1 - 1) }, floor_x(c.1));
+        let lean = (top - foot).atan2(layout.column_height);
         t.rotation = Quat::from_rotation_z(-lean);
-        t.translation = c.0 + Vec3::new(0.5 * xs as f32, 0.5 * layout.column_height, 0.0);
+        t.translation = c.0 + Vec3::new(0.5 * (foot + top), 0.5 * layout.column_height, 0.0);
     }
 }

@@ -33,6 +33,12 @@ fn is_shaded_large(p: [u8; 3]) -> bool {
     p[0] as i32 > p[1].max(p[2]) as i32 + 25
 }
 
+/// The structure's grey steel: cool (blue at least red) and darker than the sky; the ground
+/// is warm (red over blue).
+fn is_steel(p: [u8; 3]) -> bool {
+    p[2] >= p[0] && p != BACKGROUND && p[0] < 200
+}
+
 const FPS: f64 = 20.0;
 const SIZE: (u32, u32) = (480, 270);
 
@@ -267,4 +273,63 @@ fn a_damper_on_a_building_renders() {
     ]);
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     assert!(std::fs::read(rendered.join("series.csv")).unwrap() == std::fs::read(headless.join("series.csv")).unwrap());
+}
+
+/// A box of balls on a building (issue 54): every floor is drawn, moving with its own
+/// displacement from the series, the lower ones under the box and the box on the carrying
+/// floor, and each ball where the physics puts it.
+#[test]
+fn a_box_on_a_building_is_drawn_on_its_floor() {
+    let out = tempfile::tempdir().unwrap();
+    let path = "examples/scenes/small-box-building.toml";
+    let size = (640, 480);
+    let o = lpc([
+        "render",
+        path,
+        "--model",
+        "rapier",
+        "--out",
+        out.path().to_str().unwrap(),
+        "--horizon",
+        "0.1",
+        "--fps",
+        "20",
+        "--size",
+        "640x480",
+    ]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let scene = load_scene(path).unwrap();
+    let layout = Layout::of(&scene);
+    assert_eq!((layout.floors, layout.carrying), (3, 2));
+    assert!(layout.floor_y(1) + layout.platform < layout.ball_y - 0.5 * layout.height, "the box rides above the floors under it");
+    let series = read_series_csv(&out.path().join("series.csv")).unwrap();
+    assert_eq!(series.floor_count(), 3);
+    let (_, per_frame) = lpc_damper::run::frame_sampling(FPS, scene.sample_dt);
+    for k in 0..=2 {
+        let (w, h, px, channels) = decode(&out.path().join(format!("frame_{k:05}.png")));
+        assert_eq!((w, h), size);
+        let sample = k * per_frame;
+        let at = |p: bevy::math::Vec2| {
+            assert!(p.x >= 0.0 && p.y >= 0.0 && p.x < w as f32 && p.y < h as f32, "frame {k}: pixel {p} is out of the picture");
+            let i = ((p.y.round() as usize) * w as usize + p.x.round() as usize) * channels;
+            [px[i], px[i + 1], px[i + 2]]
+        };
+        for i in 0..3 {
+            // The slab's end beyond the columns, where nothing else is drawn in front of it.
+            let (u, _, _) = series.floor(i, sample).unwrap();
+            let end = bevy::math::Vec3::new(-0.8 * layout.overhang + u as f32, layout.floor_y(i), 0.0);
+            let slab = at(layout.project(size, end));
+            assert!(is_steel(slab), "frame {k}: floor {} is not drawn ({slab:?})", i + 1);
+            // Half a storey above it, beside the columns: the sky or the ground behind.
+            let above = at(layout.project(size, end + bevy::math::Vec3::Y * (0.5 * layout.column_height)));
+            assert!(!is_steel(above), "frame {k}: something is drawn between floors {} and {} ({above:?})", i + 1, i + 2);
+        }
+        for i in 0..scene.balls.len() {
+            let centre = layout.ball(series.x(i)[sample], series.across(i, sample));
+            let p = layout.project(size, centre);
+            let r_px = layout.projected_radius(size, centre, scene.balls[i].radius as f32);
+            assert!(r_px > 3.0, "ball{} is {r_px} px across: too small to check", i + 1);
+            assert!(is_shaded_large(at(p)) || is_small(at(p)) || is_large(at(p)), "frame {k}: ball{} at pixel {p} is not drawn", i + 1);
+        }
+    }
 }
