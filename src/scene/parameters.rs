@@ -77,6 +77,10 @@ parameters! {
     FillFraction = "fill_fraction", "bed.fill_fraction", false;
     /// The floor of a structure that carries the container, 1 at the bottom (a whole number).
     DamperFloor = "damper_floor", "structure.damper_floor", false;
+    /// Number of balls in a bed (a whole number).
+    BallCount = "ball_count", "bed.count", false;
+    /// A bed's largest ball radius, m: every size scaled alike.
+    BallRadius = "ball_radius", "bed.radii", false;
 }
 
 impl std::fmt::Display for Parameter {
@@ -98,7 +102,7 @@ impl Parameter {
     /// Whether its values are whole numbers (a count, as the number of chains): a study
     /// refines it over the whole numbers, never between them.
     pub fn is_count(self) -> bool {
-        matches!(self, Parameter::Chains | Parameter::DamperFloor)
+        matches!(self, Parameter::Chains | Parameter::DamperFloor | Parameter::BallCount)
     }
 
     /// The parameter whose value a scene file's field holds (`balls.container_length` holds
@@ -133,6 +137,25 @@ impl Parameter {
                 let bed = f.bed.as_mut().ok_or("needs a [bed] table")?;
                 bed.fill_fraction = Some(number()?);
                 bed.count = None;
+            }
+            Parameter::BallCount => {
+                let x = number()?;
+                if !(x >= 1.0 && x <= u32::MAX as f64 && x.fract() == 0.0) {
+                    return Err(format!("`ball_count` must be a whole number from 1 (got {})", super::human(x)));
+                }
+                let bed = f.bed.as_mut().ok_or("needs a [bed] table")?;
+                bed.count = Some(x as u32);
+                bed.fill_fraction = None;
+            }
+            Parameter::BallRadius => {
+                let x = number()?;
+                let bed = f.bed.as_mut().ok_or("needs a [bed] table")?;
+                let largest = bed.radii.iter().copied().fold(0.0, f64::max);
+                if !(x > 0.0 && x.is_finite() && largest > 0.0) {
+                    return Err(format!("`ball_radius` must be a positive length (got {})", super::human(x)));
+                }
+                // Every size keeps its ratio to the largest.
+                bed.radii.iter_mut().for_each(|r| *r *= x / largest);
             }
             Parameter::FrameMass => f.frame.as_mut().ok_or(no_frame)?.mass = number()?,
             Parameter::Stiffness => f.frame.as_mut().ok_or(no_frame)?.stiffness = number()?,
@@ -198,6 +221,8 @@ impl Parameter {
             Parameter::Friction => Some(scene.space.friction),
             Parameter::FillFraction => file.bed.as_ref().and_then(|b| b.fill_fraction),
             Parameter::DamperFloor => scene.structure.as_ref().map(|s| (s.floor + 1) as f64),
+            Parameter::BallCount => file.bed.as_ref().map(|_| scene.balls.len() as f64),
+            Parameter::BallRadius => file.bed.as_ref().map(|b| b.radii.iter().copied().fold(0.0, f64::max)),
         }
     }
 }

@@ -146,3 +146,27 @@ fn an_ensemble_draws_a_bed_and_a_ground_motion_per_member() {
         }
     }
 }
+
+/// The damper's size is a design variable of sweeps and optimize: `ball_count` sets a bed's
+/// number of balls (a whole number) and `ball_radius` its largest radius, every size scaled
+/// alike; a count that is not whole is refused with the field.
+#[test]
+fn sweeps_size_a_bed_by_its_count_and_radius() {
+    use lpc_damper::scene::{format::Length, Parameter};
+    let text = box_on(&building(2.0), 12, 0.3, 0.5).replace("radii = [0.005]", "radii = [0.005, 0.0025]");
+    let loaded = lpc_damper::scene::parse(&text, "box.toml", "box").unwrap();
+    let nominal = loaded.scene.as_ref().unwrap();
+    assert_eq!(Parameter::BallCount.value(&loaded.file, nominal), Some(12.0));
+    assert_eq!(Parameter::BallRadius.value(&loaded.file, nominal), Some(0.005));
+    let file = Parameter::BallCount.apply(&loaded.file, Length::Metres(6.0)).unwrap();
+    let file = Parameter::BallRadius.apply(&file, Length::Metres(0.004)).unwrap();
+    let sized = lpc_damper::scene::from_file(file.clone(), "box", "box").unwrap().scene.unwrap();
+    assert_eq!(sized.balls.len(), 6);
+    let radii: Vec<f64> = sized.balls.iter().map(|b| b.radius).collect();
+    let (largest, smallest) = (radii.iter().copied().fold(0.0, f64::max), radii.iter().copied().fold(1.0, f64::min));
+    assert!((largest - 0.004).abs() <= 1e-15 && (smallest - 0.002).abs() <= 1e-15, "{radii:?}");
+    assert_eq!(Parameter::BallCount.value(&file, &sized), Some(6.0));
+    assert!(Parameter::BallCount.is_count());
+    let err = Parameter::BallCount.apply(&loaded.file, Length::Metres(2.5)).unwrap_err();
+    assert!(err.contains("ball_count") && err.contains("whole number"), "{err}");
+}
