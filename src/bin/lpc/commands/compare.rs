@@ -73,8 +73,9 @@ pub fn run(a: Args) -> Result<ExitStatus> {
         return compare_ensembles(&a, &nominal.scene.name, &members);
     }
     let scene = nominal.scene;
-    let reference_scene = reference_scene(&scene, a.frictionless_reference)?;
-    let reference = crate::watch::watched(Model::Reference, &reference_scene, RunOptions::limited(limits))?;
+    let copy = frictionless_copy(&scene, a.frictionless_reference)?;
+    let reference_scene = copy.as_ref().unwrap_or(&scene);
+    let reference = crate::watch::watched(Model::Reference, reference_scene, RunOptions::limited(limits))?;
     let mut models = std::collections::BTreeMap::new();
     let mut runs = vec![];
     for &m in a.models.iter().filter(|m| **m != Model::Reference) {
@@ -151,13 +152,14 @@ pub fn run(a: Args) -> Result<ExitStatus> {
     Ok(ExitStatus::Success)
 }
 
-/// The scene the reference runs: `scene`, or with `frictionless` its copy without friction. A
-/// scene with friction and no such request is refused with the reason and the flag that runs it.
-fn reference_scene(scene: &Scene, frictionless: bool) -> Result<Scene> {
+/// With `frictionless`, the copy of `scene` without friction that the reference runs; without,
+/// `None` (the reference runs `scene`), and a scene with friction is refused with the reason
+/// and the flag that runs it.
+fn frictionless_copy(scene: &Scene, frictionless: bool) -> Result<Option<Scene>> {
     if frictionless {
         let mut smooth = scene.clone();
         smooth.space.friction = 0.0;
-        return Ok(smooth);
+        return Ok(Some(smooth));
     }
     if scene.space.friction != 0.0 {
         if let Err(why) = Model::Reference.supports(scene) {
@@ -167,7 +169,7 @@ fn reference_scene(scene: &Scene, frictionless: bool) -> Result<Scene> {
             .into());
         }
     }
-    Ok(scene.clone())
+    Ok(None)
 }
 
 /// One model's distributions in `lpc compare --ensemble`'s JSON.
@@ -193,14 +195,17 @@ struct EnsembleComparison {
 /// Every model on the same members; each model's distributions against the reference's.
 fn compare_ensembles(a: &Args, scene: &str, members: &Ensemble) -> Result<ExitStatus> {
     let mut runs = BTreeMap::new();
-    let mut smooth = members.clone();
-    for member in &mut smooth.members {
-        member.scene = reference_scene(&member.scene, a.frictionless_reference)?;
+    // The members the reference runs, when they are not `members` themselves.
+    let mut smooth = None;
+    for (k, member) in members.members.iter().enumerate() {
+        if let Some(copy) = frictionless_copy(&member.scene, a.frictionless_reference)? {
+            smooth.get_or_insert_with(|| members.clone()).members[k].scene = copy;
+        }
     }
     for &m in std::iter::once(&Model::Reference).chain(a.models.iter().filter(|m| **m != Model::Reference)) {
         let work = crate::watch::Work::new(Some(members.members.len()), m.name());
         let start = std::time::Instant::now();
-        let each = if m == Model::Reference { &smooth } else { members };
+        let each = if m == Model::Reference { smooth.as_ref().unwrap_or(members) } else { members };
         let r = ensemble::run_members(each, m, a.budget.limits(&a.scene)?, false, &|| work.inc())?;
         work.finish();
         runs.insert(m, (r.metrics, start.elapsed().as_secs_f64()));
