@@ -345,6 +345,9 @@ pub fn judge(model: Model, scene: &Scene, run: &Run) -> Result<(), Failure> {
     // Losses are never negative, so the energy at the end is at most what there was plus what
     // the excitation put in.
     let work = run.energy.forcing_work;
+    // The energy put in: the initial energy and what the excitation did (a steady forced
+    // response's energy where the excitation is a sine).
+    let put_in = e0 + work.abs() + forced_energy_scale(scene);
     if run.energy.final_ > (e0 + work) * (1.0 + balance_tol) + balance_tol * work.abs() {
         return fail("energy-gained", format!("final energy {} > initial {} + forcing work {work}", run.energy.final_, e0));
     }
@@ -357,16 +360,15 @@ pub fn judge(model: Model, scene: &Scene, run: &Run) -> Result<(), Failure> {
     if let Some(balance_tol) = checks.balance {
         let a = &run.energy;
         let residual = a.residual();
-        let flow = e0 + work.abs() + forced_energy_scale(scene) + a.impact_loss.abs() + a.damping_loss.abs() + a.contact_loss.abs();
+        let flow = put_in + a.impact_loss.abs() + a.damping_loss.abs() + a.contact_loss.abs();
         if residual.abs() > balance_tol * flow {
             return fail("energy-gained", format!("energy balance off by {residual:e} J (energy flows of {flow:e} J)"));
         }
     }
-    // What an impact may appear to gain is judged against the energy put in: the initial
-    // energy and what the excitation did. A scene that starts at rest under a record gets all
-    // its energy from the ground, and the collapse rule's gift to a contact pressed by the
-    // floor's acceleration grows with that acceleration (docs/MODEL.md §14).
-    let put_in = e0 + work.abs() + forced_energy_scale(scene);
+    // What an impact may appear to gain is judged against the energy put in: a scene that
+    // starts at rest under a record gets all its energy from the ground, and the collapse
+    // rule's gift to a contact pressed by the floor's acceleration grows with that
+    // acceleration (docs/MODEL.md §14).
     for imp in &run.impacts {
         // A perfectly inelastic impact at approach speed u loses mu u^2 / 2. A side held by
         // the frame moves with the frame's mass, so mu is bounded by the free ball's mass: at
