@@ -186,7 +186,7 @@ pub struct FramePart(pub Vec3);
 /// A container wall (for its flash).
 #[derive(Component, Debug, Clone, Copy)]
 pub struct WallMesh(pub Body);
-/// A column of storey `1` (0 at the bottom), leaning with its floor over the one below (the
+/// A column of storey `.1` (0 at the bottom), leaning with its floor over the one below (the
 /// ground under the first): its foot's position when the structure is at rest.
 #[derive(Component, Debug, Clone, Copy)]
 pub struct Column(pub Vec3, pub usize);

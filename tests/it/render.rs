@@ -19,6 +19,13 @@ fn decode(path: &Path) -> (u32, u32, Vec<u8>, usize) {
     (info.width, info.height, buf, info.color_type.samples())
 }
 
+/// The colour at pixel `p` of frame `k`, decoded as `(width, height, bytes, channels)`.
+fn pixel((w, h, px, channels): (u32, u32, &[u8], usize), p: bevy::math::Vec2, k: usize) -> [u8; 3] {
+    assert!(p.x >= 0.0 && p.y >= 0.0 && p.x < w as f32 && p.y < h as f32, "frame {k}: pixel {p} is out of the picture");
+    let i = ((p.y.round() as usize) * w as usize + p.x.round() as usize) * channels;
+    [px[i], px[i + 1], px[i + 2]]
+}
+
 /// Large balls are drawn red, small ones blue (see `render::stage`); lighting changes the
 /// shade, not which channel leads.
 fn is_large(p: [u8; 3]) -> bool {
@@ -211,11 +218,7 @@ fn a_box_of_balls_is_drawn_ball_by_ball() {
         let (w, h, px, channels) = decode(&out.path().join(format!("frame_{k:05}.png")));
         assert_eq!((w, h), size);
         let sample = k * per_frame;
-        let at = |p: bevy::math::Vec2| {
-            assert!(p.x >= 0.0 && p.y >= 0.0 && p.x < w as f32 && p.y < h as f32, "frame {k}: pixel {p} is out of the picture");
-            let i = ((p.y.round() as usize) * w as usize + p.x.round() as usize) * channels;
-            [px[i], px[i + 1], px[i + 2]]
-        };
+        let at = |p: bevy::math::Vec2| pixel((w, h, &px, channels), p, k);
         for i in 0..scene.balls.len() {
             let centre = layout.ball(series.x(i)[sample], series.across(i, sample));
             let p = layout.project(size, centre);
@@ -309,11 +312,7 @@ fn a_box_on_a_building_is_drawn_on_its_floor() {
         let (w, h, px, channels) = decode(&out.path().join(format!("frame_{k:05}.png")));
         assert_eq!((w, h), size);
         let sample = k * per_frame;
-        let at = |p: bevy::math::Vec2| {
-            assert!(p.x >= 0.0 && p.y >= 0.0 && p.x < w as f32 && p.y < h as f32, "frame {k}: pixel {p} is out of the picture");
-            let i = ((p.y.round() as usize) * w as usize + p.x.round() as usize) * channels;
-            [px[i], px[i + 1], px[i + 2]]
-        };
+        let at = |p: bevy::math::Vec2| pixel((w, h, &px, channels), p, k);
         for i in 0..3 {
             // The slab's end beyond the columns, where nothing else is drawn in front of it.
             let (u, _, _) = series.floor(i, sample).unwrap();

@@ -4,6 +4,18 @@ use super::*;
 use crate::model::Simulator;
 use crate::scene::Body;
 
+/// The spatial run's impacts are the one-line run's, more than twenty of them: the same bodies,
+/// times to 1e-12 s, approach speeds to 1e-9 of themselves.
+fn assert_same_impacts(spatial: &Run, line: &Run) {
+    assert!(line.impacts.len() > 20, "{} impacts", line.impacts.len());
+    assert_eq!(spatial.impacts.len(), line.impacts.len());
+    for (a, b) in spatial.impacts.iter().zip(&line.impacts) {
+        assert_eq!((a.a, a.b), (b.a, b.b), "at {} s", b.t);
+        assert!((a.t - b.t).abs() <= 1e-12, "{} s against {} s", a.t, b.t);
+        assert!((a.approach_speed - b.approach_speed).abs() <= 1e-9 * b.approach_speed, "at {} s", b.t);
+    }
+}
+
 /// Balls on one line with no gravity across it, run in a container with a cross-section,
 /// meet at the one-line reference's impacts to round-off (the ball-ball times are roots of
 /// the same distance, computed in three dimensions).
@@ -15,13 +27,7 @@ fn balls_on_one_line_give_the_one_line_reference() {
     scene.space.section = [0.05, 0.05];
     assert!(refusal(&scene).is_none());
     let spatial = simulate(&scene, &RunOptions::default()).unwrap();
-    assert!(line.impacts.len() > 20, "{} impacts", line.impacts.len());
-    assert_eq!(spatial.impacts.len(), line.impacts.len());
-    for (a, b) in spatial.impacts.iter().zip(&line.impacts) {
-        assert_eq!((a.a, a.b), (b.a, b.b), "at {} s", b.t);
-        assert!((a.t - b.t).abs() <= 1e-12, "{} s against {} s", a.t, b.t);
-        assert!((a.approach_speed - b.approach_speed).abs() <= 1e-9 * b.approach_speed, "at {} s", b.t);
-    }
+    assert_same_impacts(&spatial, &line);
     let (fa, fb) = (spatial.series.xs(), line.series.xs());
     assert!(fa.iter().zip(fb).all(|(a, b)| (a - b).abs() <= 1e-12), "the frame moves alike");
     assert!(spatial.energy.balance_error.abs() <= 1e-12, "{:?}", spatial.energy);
@@ -38,13 +44,7 @@ fn balls_on_one_line_on_a_building_give_the_one_line_reference() {
     scene.space.section = [0.05, 0.05];
     assert!(refusal(&scene).is_none());
     let spatial = simulate(&scene, &RunOptions::default()).unwrap();
-    assert!(line.impacts.len() > 20, "{} impacts", line.impacts.len());
-    assert_eq!(spatial.impacts.len(), line.impacts.len());
-    for (a, b) in spatial.impacts.iter().zip(&line.impacts) {
-        assert_eq!((a.a, a.b), (b.a, b.b), "at {} s", b.t);
-        assert!((a.t - b.t).abs() <= 1e-12, "{} s against {} s", a.t, b.t);
-        assert!((a.approach_speed - b.approach_speed).abs() <= 1e-9 * b.approach_speed, "at {} s", b.t);
-    }
+    assert_same_impacts(&spatial, &line);
     assert_eq!(spatial.series.floor_count(), 3);
     let mut worst = 0.0f64;
     for k in 0..line.series.len() {
