@@ -83,6 +83,8 @@ pub enum Placement {
     Lattice,
     /// At random positions without overlaps (seeded).
     Random,
+    /// Settled under gravity into a pile at rest from the lattice, nudged at random (seeded).
+    Settled,
 }
 
 /// `[bed]`: a generated bed of balls.
@@ -99,10 +101,10 @@ pub struct BedFile {
     pub proportions: Option<Vec<f64>>,
     /// kg/m^3.
     pub density: f64,
-    /// `"lattice"` (default) or `"random"`.
+    /// `"lattice"` (default), `"random"` or `"settled"`.
     #[serde(default)]
     pub placement: Placement,
-    /// Seed of a random placement (default 1).
+    /// Seed of a random or settled placement (default 1).
     pub seed: Option<u64>,
 }
 

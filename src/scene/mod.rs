@@ -11,6 +11,7 @@ mod placement;
 pub mod record;
 mod rules;
 mod settings;
+mod settle;
 mod space;
 mod structure;
 mod validator;

@@ -15,6 +15,9 @@ use super::{human, Scene, SceneError};
 /// Most balls a bed may hold: a run keeps every ball's state, and a scene this size already
 /// takes minutes per simulated second in the cheapest model.
 pub const MAX_BED_BALLS: u64 = 1_000_000;
+/// Most balls a settled bed may hold: settling 3000 balls takes some 25 s, and the cost grows
+/// faster than the number of balls (docs/MODEL.md §13).
+const MAX_SETTLED_BALLS: usize = 10_000;
 /// Tries to place one ball at random before the bed is declared impossible to place.
 const RANDOM_TRIES: usize = 10_000;
 /// Lattice neighbours are this fraction of a diameter apart, so that rounding never makes
@@ -33,7 +36,7 @@ pub(super) struct Placed {
 /// round-off of coordinates of the container's size. A user who types touching positions
 /// (centres 0.05 and 0.06 m for radii 0.005 m) gets a distance a few ulps short of the sum of
 /// the radii, and means contact, not overlap.
-fn touching_round_off(size: [f64; 3]) -> f64 {
+pub(super) fn touching_round_off(size: [f64; 3]) -> f64 {
     8.0 * f64::EPSILON * size.iter().fold(0.0, |m, s| f64::max(m, s.abs()))
 }
 
@@ -156,8 +159,8 @@ fn sizes_in_order(count: usize, proportions: &[f64]) -> Vec<usize> {
         .collect()
 }
 
-/// A generated bed in a box `[length, width, height]`.
-pub(super) fn bed(b: &BedFile, size: [f64; 3], v: &Validator) -> Result<Placed, SceneError> {
+/// A generated bed in a box `[length, width, height]` under `gravity`.
+pub(super) fn bed(b: &BedFile, size: [f64; 3], gravity: [f64; 3], v: &Validator) -> Result<Placed, SceneError> {
     let density = v.positive("bed.density", b.density)?;
     if b.radii.is_empty() {
         return Err(v.err("bed.radii", "is empty: give the radius of each size of ball"));
@@ -222,6 +225,25 @@ pub(super) fn bed(b: &BedFile, size: [f64; 3], v: &Validator) -> Result<Placed, 
     let centres = match b.placement {
         Placement::Lattice => lattice(&balls, largest, size, v)?,
         Placement::Random => random(&balls, largest, size, b.seed.unwrap_or(1), v)?,
+        Placement::Settled => {
+            if gravity == [0.0; 3] {
+                return Err(v.err("bed.placement", "is \"settled\", which needs gravity to settle the balls: give `world.gravity`"));
+            }
+            if count > MAX_SETTLED_BALLS {
+                return Err(v.err(
+                    if b.count.is_some() { "bed.count" } else { "bed.fill_fraction" },
+                    &format!(
+                        "makes {count} balls; a settled bed holds at most {MAX_SETTLED_BALLS} (settling costs some 25 s per 3000 balls, more than linearly): use placement = \"lattice\" or \"random\""
+                    ),
+                ));
+            }
+            let start = lattice(&balls, largest, size, v)?;
+            let centres = super::settle::settle(&balls, &start, size, gravity, b.seed.unwrap_or(1)).map_err(|why| v.err("bed", &why))?;
+            if let Some((i, j)) = first_overlap(&balls, &centres, size) {
+                return Err(v.err("bed", &format!("cannot be settled: ball {} still overlaps ball {}", j + 1, i + 1)));
+            }
+            centres
+        }
     };
     let velocities = vec![[0.0; 3]; count];
     Ok(Placed { balls, centres, velocities })

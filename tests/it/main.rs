@@ -27,6 +27,7 @@ mod masri_caughey;
 mod rapier_model;
 mod rapier_space;
 mod render;
+mod settled_beds;
 mod spatial_reference;
 mod stability_map;
 mod sticking;

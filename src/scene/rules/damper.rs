@@ -282,7 +282,7 @@ fn placed_damper(f: &SceneFile, name: &str, v: &Validator, frame: Frame, world: 
     }
     let xs0 = v.finite("frame.initial_displacement", fr.initial_displacement.metres(0.0))?;
     let placed = match (&f.bed, &f.explicit_balls) {
-        (Some(bed), _) => crate::scene::placement::bed(bed, size, v)?,
+        (Some(bed), _) => crate::scene::placement::bed(bed, size, world.gravity, v)?,
         (None, Some(list)) => crate::scene::placement::explicit(list, size, v)?,
         (None, None) => unreachable!("checked by caller"),
     };

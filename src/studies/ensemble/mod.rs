@@ -65,9 +65,10 @@ pub fn member_rng(seed: u64, k: usize) -> Pcg64 {
     Pcg64::seed_from_u64(Pcg64::seed_from_u64(seed).random::<u64>() ^ k as u64)
 }
 
-/// Whether `file` places a bed at random: its members then each place their own.
+/// Whether `file` places a bed at random (or settles one from random nudges): its members
+/// then each place their own.
 pub fn places_bed_at_random(file: &SceneFile) -> bool {
-    file.bed.as_ref().is_some_and(|b| b.placement == scene::format::Placement::Random)
+    file.bed.as_ref().is_some_and(|b| matches!(b.placement, scene::format::Placement::Random | scene::format::Placement::Settled))
 }
 
 /// Whether `file` shakes its ground at random: its members then each draw their own motion.
