@@ -4,23 +4,29 @@
 # lattice, gravity, friction 0.3, e 0.6), on a frame whose mass and stiffness are in proportion
 # to the balls' mass (the particle box's frequency and mass ratio), shaken by its initial
 # displacement. Prints a table row per box: steps of 1 ms, impacts and the computing time.
-#   bash benches/spatial_rapier.sh [LPC] [HORIZON] [N...]
-#   (default: target/release/lpc, 0.5 s, 10 100 1000 10000)
+# With SHAPE=floor the box grows along x and y only, so the bed keeps the particle box's depth
+# (seven layers) whatever N: the cost at a constant depth.
+#   [SHAPE=box|floor] bash benches/spatial_rapier.sh [LPC] [HORIZON] [N...]
+#   (default: box, target/release/lpc, 0.5 s, 10 100 1000 10000)
 set -euo pipefail
 lpc=${1:-target/release/lpc}
 horizon=${2:-0.5}
 shift 2 || shift $# || true
 counts=${*:-10 100 1000 10000}
+shape=${SHAPE:-box}
 dir=$(mktemp -d)
 printf '| balls | horizon | impacts | computed in | per simulated second | per ball and simulated second |\n|---|---|---|---|---|---|\n'
 for n in $counts; do
-  python3 - "$n" "$horizon" "$dir/box$n.toml" <<'PY'
+  python3 - "$n" "$horizon" "$dir/box$n.toml" "$shape" <<'PY'
 import sys
-n, horizon, path = int(sys.argv[1]), float(sys.argv[2]), sys.argv[3]
-scale = (n / 300) ** (1 / 3)
+n, horizon, path, shape = int(sys.argv[1]), float(sys.argv[2]), sys.argv[3], sys.argv[4]
+# The lattice fills 9 x 5 cells a layer in the particle box: a floor of N / 300 times its area
+# (whole cells) keeps its depth.
+scale = (n / 300) ** (1 / 2 if shape == "floor" else 1 / 3)
+height = 0.1 if shape == "floor" else 0.1 * scale
 lines = [f'name = "rapier-box-{n}"', "[frame]", f"mass = {1.35 * n / 300:.6g}", f"stiffness = {865.0 * n / 300:.6g}",
          "damping = 1.092", "initial_displacement = 0.0185", "[container]", f"length = {0.1 * scale:.6g}",
-         f"width = {0.06 * scale:.6g}", f"height = {0.1 * scale:.6g}", "[world]", "gravity = [0.0, 0.0, -9.81]",
+         f"width = {0.06 * scale:.6g}", f"height = {height:.6g}", "[world]", "gravity = [0.0, 0.0, -9.81]",
          "friction = 0.3", "restitution = 0.6", "[bed]", f"count = {n}", "radii = [0.005]", "density = 7800.0",
          'placement = "lattice"', "[rapier]", "dt = 0.001", "[run]", f"horizon = {horizon}", "sample_dt = 0.001"]
 open(path, "w").write("\n".join(lines) + "\n")

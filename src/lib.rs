@@ -23,6 +23,7 @@
 // Comparisons written `!(a > b)` hold for NaN on purpose: a NaN must fail the test they guard.
 #![allow(clippy::neg_cmp_op_on_partial_ord)]
 
+mod cells;
 pub mod compliant;
 pub mod files;
 pub mod floor_motion;

@@ -8,6 +8,7 @@ use rand::{Rng, SeedableRng};
 use rand_pcg::Pcg64;
 
 use super::geometry::Ball;
+use crate::cells::Cells;
 
 /// How far each ball is nudged across gravity before it settles, as a fraction of its radius:
 /// enough that no ball balances on the one below it, as the lattice's columns do.
@@ -51,7 +52,6 @@ pub(super) fn settle(balls: &[Ball], start: &[[f64; 3]], size: [f64; 3], gravity
     debug_assert!(g_norm > 0.0, "the caller checks that gravity is set");
     let down = gravity.map(|g| g / g_norm);
     let smallest = balls.iter().map(|b| b.radius).fold(f64::INFINITY, f64::min);
-    let largest = balls.iter().map(|b| b.radius).fold(0.0, f64::max);
     let mut rng = Pcg64::seed_from_u64(seed);
     let mut centres: Vec<[f64; 3]> = start
         .iter()
@@ -65,7 +65,7 @@ pub(super) fn settle(balls: &[Ball], start: &[[f64; 3]], size: [f64; 3], gravity
         })
         .collect();
     let skin = SKIN_RADII * smallest;
-    let mut grid = Grid::new(size, 2.0 * largest + skin);
+    let mut grid = Grid::new(size, balls, skin);
     let mut listed_at = centres.clone();
     grid.list_pairs(&centres, balls, down, skin);
     let mut step = FIRST_STEP_RADII * smallest;
@@ -106,70 +106,37 @@ pub(super) fn settle(balls: &[Ball], start: &[[f64; 3]], size: [f64; 3], gravity
     Err(format!("cannot be settled: its balls still overlap after {FINAL_SWEEPS} sweeps (the container is too full for a pile)"))
 }
 
-/// Cells as wide as the largest diameter and the skin, and the pairs of balls they find.
+/// The pairs of balls that may touch, found on a grid of cells.
 struct Grid {
-    cells: [usize; 3],
-    width: f64,
-    origin: [f64; 3],
-    /// Scratch: each ball's cell, the balls in cell order, and where each cell starts.
-    cell_of: Vec<usize>,
-    order: Vec<usize>,
-    starts: Vec<usize>,
-    /// Pairs within the skin of touching, listed by `list_pairs`.
+    cells: Cells,
+    /// Pairs within the skin of touching, listed by `list_pairs`, the lower ball first.
     pairs: Vec<(u32, u32)>,
 }
 
 impl Grid {
-    fn new(size: [f64; 3], width: f64) -> Grid {
-        let cells = size.map(|s| ((s / width).ceil() as usize).max(1));
-        Grid { cells, width, origin: [0.0, -0.5 * size[1], -0.5 * size[2]], cell_of: vec![], order: vec![], starts: vec![], pairs: vec![] }
+    /// A grid over the box `size` for `balls`, finding pairs up to `skin` apart.
+    fn new(size: [f64; 3], balls: &[Ball], skin: f64) -> Grid {
+        let largest = balls.iter().map(|b| b.radius).fold(0.0, f64::max);
+        let (low, high) = ([0.0, -0.5 * size[1], -0.5 * size[2]], [size[0], 0.5 * size[1], 0.5 * size[2]]);
+        Grid { cells: Cells::new(low, high, 2.0 * largest + skin, balls.len()), pairs: vec![] }
     }
 
-    fn key(&self, c: [f64; 3]) -> [usize; 3] {
-        std::array::from_fn(|a| (((c[a] - self.origin[a]) / self.width).floor().max(0.0) as usize).min(self.cells[a] - 1))
-    }
-
-    /// Lists the pairs of balls closer than `skin` (the cells are at least as wide as the
-    /// largest reach and the skin), the lower ball of each first, lowest pairs first.
+    /// Lists the pairs of balls closer than `skin`, the lower ball of each first, lowest
+    /// pairs first.
     fn list_pairs(&mut self, centres: &[[f64; 3]], balls: &[Ball], down: [f64; 3], skin: f64) {
-        let [nx, ny, nz] = self.cells;
-        let index = |k: [usize; 3]| (k[2] * ny + k[1]) * nx + k[0];
-        self.cell_of = centres.iter().map(|c| index(self.key(*c))).collect();
-        self.starts = vec![0; nx * ny * nz + 1];
-        for &k in &self.cell_of {
-            self.starts[k + 1] += 1;
-        }
-        for k in 0..nx * ny * nz {
-            self.starts[k + 1] += self.starts[k];
-        }
-        let mut next = self.starts.clone();
-        self.order = vec![0; centres.len()];
-        for (i, &k) in self.cell_of.iter().enumerate() {
-            self.order[next[k]] = i;
-            next[k] += 1;
-        }
+        self.cells.rebuild(|i| centres[i]);
         self.pairs.clear();
         let depth = |c: [f64; 3]| dot(c, down);
         for (i, c) in centres.iter().enumerate() {
-            let k = self.key(*c);
-            for dz in -1i64..=1 {
-                for dy in -1i64..=1 {
-                    for dx in -1i64..=1 {
-                        let n = [k[0] as i64 + dx, k[1] as i64 + dy, k[2] as i64 + dz];
-                        if (0..3).any(|a| n[a] < 0 || n[a] >= self.cells[a] as i64) {
-                            continue;
-                        }
-                        let cell = index(n.map(|x| x as usize));
-                        for &j in &self.order[self.starts[cell]..self.starts[cell + 1]] {
-                            let reach = balls[i].radius + balls[j].radius + skin;
-                            if j > i && dot(sub(centres[j], *c), sub(centres[j], *c)) < reach * reach {
-                                let (lower, upper) = if depth(centres[i]) >= depth(centres[j]) { (i, j) } else { (j, i) };
-                                self.pairs.push((lower as u32, upper as u32));
-                            }
-                        }
-                    }
+            let pairs = &mut self.pairs;
+            self.cells.neighbours(i, |j| {
+                let reach = balls[i].radius + balls[j].radius + skin;
+                let d = sub(centres[j], *c);
+                if dot(d, d) < reach * reach {
+                    let (lower, upper) = if depth(*c) >= depth(centres[j]) { (i, j) } else { (j, i) };
+                    pairs.push((lower as u32, upper as u32));
                 }
-            }
+            });
         }
         self.pairs.sort_by(|a, b| depth(centres[b.0 as usize]).total_cmp(&depth(centres[a.0 as usize])));
     }

@@ -9,15 +9,14 @@
 //! than a skin in O(n), again only when a ball has moved half the skin: every step then costs
 //! what its candidate pairs do.
 
-mod cells;
 mod contacts;
 mod floors;
 
 use super::{contact, FLOOR_SPEED_FRACTION, MAX_STEPS};
+use crate::cells::Cells;
 use crate::model::{Budget, Checks, Limits, Meter, Model, ModelError, OverBudget, RunOptions};
 use crate::run::{EnergyAccount, Impact, Recorder, Run};
 use crate::scene::{Body, Chamber, Scene, Wall};
-use cells::Cells;
 use floors::Floors;
 
 /// Steps per elastic Hertz contact of the fastest impact the run can have: the restitution of

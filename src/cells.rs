@@ -1,9 +1,10 @@
-//! A grid of cells over the container's inside, rebuilt every step by a counting sort, so that
-//! finding every touching pair costs O(n) a step: balls touch only balls in their own or the
-//! 26 cells around, as a cell is at least as wide as the largest ball.
+//! A grid of cells over a container's inside, rebuilt by a counting sort, so that finding every
+//! close pair of balls costs O(n): balls closer than a cell's width lie in the same or
+//! neighbouring cells. The compliant model, the contact model and settled beds find their
+//! pairs with it.
 
 /// The cells and which balls lie in each.
-pub(super) struct Cells {
+pub(crate) struct Cells {
     /// Lower corner of the grid in the container's frame, m.
     low: [f64; 3],
     /// Width of a cell along each axis, m.
@@ -23,8 +24,9 @@ pub(super) struct Cells {
 const CELLS_PER_BALL: f64 = 16.0;
 
 impl Cells {
-    /// A grid over the box from `low` to `high` (m) for `n` balls no larger than `diameter`.
-    pub(super) fn new(low: [f64; 3], high: [f64; 3], diameter: f64, n: usize) -> Cells {
+    /// A grid over the box from `low` to `high` (m) for `n` balls, whose cells are at least
+    /// `diameter` wide (the farthest apart a pair may be and still be found).
+    pub(crate) fn new(low: [f64; 3], high: [f64; 3], diameter: f64, n: usize) -> Cells {
         let extent: [f64; 3] = std::array::from_fn(|k| (high[k] - low[k]).max(diameter));
         let most = CELLS_PER_BALL * n as f64 + 64.0;
         let mut width = diameter.max(f64::MIN_POSITIVE);
@@ -47,7 +49,7 @@ impl Cells {
     }
 
     /// Sorts the balls at `p(i)` (the container's frame) into their cells.
-    pub(super) fn rebuild(&mut self, p: impl Fn(usize) -> [f64; 3]) {
+    pub(crate) fn rebuild(&mut self, p: impl Fn(usize) -> [f64; 3]) {
         self.start.iter_mut().for_each(|s| *s = 0);
         for i in 0..self.cell_of.len() {
             let c = self.index(self.coordinates(p(i)));
@@ -65,7 +67,7 @@ impl Cells {
     }
 
     /// Calls `visit(j)` for every ball `j > i` in ball `i`'s cell and the cells around it.
-    pub(super) fn neighbours(&self, i: usize, mut visit: impl FnMut(usize)) {
+    pub(crate) fn neighbours(&self, i: usize, mut visit: impl FnMut(usize)) {
         let c = self.cell_of[i] as usize;
         let at = [c / (self.dims[1] * self.dims[2]), (c / self.dims[2]) % self.dims[1], c % self.dims[2]];
         let range = |k: usize| at[k].saturating_sub(1)..=(at[k] + 1).min(self.dims[k] - 1);
