@@ -9,6 +9,7 @@
 use std::cmp::Ordering;
 use std::collections::BinaryHeap;
 
+use crate::cells::Cells;
 use crate::scene::{Chamber, Wall};
 
 /// What a ball touches.
@@ -41,41 +42,47 @@ pub struct Balls<'a> {
     pub mass: &'a [f64],
 }
 
-/// Finds every pair closer than `touching` (balls and walls), sweeping along x in `order`
-/// (kept between steps: nearly sorted already, so the insertion sort is linear).
-pub fn find(geometry: &Chamber, x: &[[f64; 3]], radius: &[f64], xs: f64, touching: f64, order: &mut Vec<usize>, out: &mut Vec<Contact>) {
-    out.clear();
-    let n = x.len();
-    if order.len() != n {
-        *order = (0..n).collect();
-    }
-    for k in 1..n {
-        let mut j = k;
-        while j > 0 && x[order[j - 1]][0] > x[order[j]][0] {
-            order.swap(j - 1, j);
-            j -= 1;
+/// Finds the contacts of a step on a grid of cells over the container, kept between steps and
+/// made anew with wider cells when a step asks for a longer reach: every step costs what its
+/// balls do, whatever the bed's shape.
+#[derive(Default)]
+pub struct Finder {
+    cells: Option<(Cells, f64)>,
+}
+
+impl Finder {
+    /// Finds every pair closer than `touching` (balls and walls), the frame at `xs`, into
+    /// `out`: each ball's walls, then the balls of larger index it touches.
+    pub fn find(&mut self, geometry: &Chamber, x: &[[f64; 3]], radius: &[f64], xs: f64, touching: f64, out: &mut Vec<Contact>) {
+        out.clear();
+        let n = x.len();
+        let reach = 2.0 * geometry.largest_radius + touching;
+        if self.cells.as_ref().is_none_or(|(_, width)| *width < reach) {
+            let (low, high) =
+                ([0.0, -0.5 * geometry.width, -0.5 * geometry.height], [geometry.length, 0.5 * geometry.width, 0.5 * geometry.height]);
+            // Wider than asked, so that a slowly growing reach does not make the grid anew each step.
+            let width = 1.25 * reach;
+            self.cells = Some((Cells::new(low, high, width, n), width));
         }
-    }
-    let reach = geometry.largest_radius + touching;
-    for (k, &i) in order.iter().enumerate() {
-        let local = [x[i][0] - xs, x[i][1], x[i][2]];
-        for wall in geometry.walls_near(local) {
-            let (gap, normal) = geometry.gap(wall, local, radius[i]);
-            if gap <= touching {
-                out.push(Contact { ball: i, other: Other::Wall(wall), gap, normal });
+        let Some((cells, _)) = self.cells.as_mut() else { return };
+        let local = |i: usize| [x[i][0] - xs, x[i][1], x[i][2]];
+        cells.rebuild(local);
+        for i in 0..n {
+            let p = local(i);
+            for wall in geometry.walls_near(p) {
+                let (gap, normal) = geometry.gap(wall, p, radius[i]);
+                if gap <= touching {
+                    out.push(Contact { ball: i, other: Other::Wall(wall), gap, normal });
+                }
             }
-        }
-        for &j in &order[k + 1..] {
-            if x[j][0] - x[i][0] > radius[i] + reach {
-                break;
-            }
-            let d = [x[j][0] - x[i][0], x[j][1] - x[i][1], x[j][2] - x[i][2]];
-            let dist = (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt();
-            let gap = dist - radius[i] - radius[j];
-            if gap <= touching && dist > 0.0 {
-                let (a, b, s) = if i < j { (i, j, 1.0) } else { (j, i, -1.0) };
-                out.push(Contact { ball: a, other: Other::Ball(b), gap, normal: d.map(|c| s * c / dist) });
-            }
+            cells.neighbours(i, |j| {
+                let d = [x[j][0] - x[i][0], x[j][1] - x[i][1], x[j][2] - x[i][2]];
+                let dist = (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt();
+                let gap = dist - radius[i] - radius[j];
+                if gap <= touching && dist > 0.0 {
+                    out.push(Contact { ball: i, other: Other::Ball(j), gap, normal: d.map(|c| c / dist) });
+                }
+            });
         }
     }
 }

@@ -246,7 +246,7 @@ pub fn simulate_spatial_with(scene: &Scene, solver: SolverSettings, options: &Ru
     // may sink deeper into each other: Rapier's solve holds a pile by the overlaps of its
     // balls, which nothing outside the run sees.)
     let sink_limit = wall_sink_limit(scene);
-    let mut order = Vec::new();
+    let mut finder = contacts::Finder::default();
     // How fast pairs may close, m/s: twice the fastest expected speed.
     let reach = 2.0 * speed;
     let mut found: Vec<Contact> = Vec::new();
@@ -268,7 +268,7 @@ pub fn simulate_spatial_with(scene: &Scene, solver: SolverSettings, options: &Ru
     // first with their knock-ons (§3 along normals), as a step's impacts do at its end: left
     // to Rapier's plastic solve, a ball touching a row would move the whole row as one block.
     {
-        contacts::find(&geometry, &now.x, &radius, xs, touching, &mut order, &mut found);
+        finder.find(&geometry, &now.x, &radius, xs, touching, &mut found);
         kicked.iter_mut().for_each(|k| *k = true);
         let mut struck = vec![false; n];
         let mut balls = Balls { v: &mut now.v, mass: &mass };
@@ -372,7 +372,7 @@ pub fn simulate_spatial_with(scene: &Scene, solver: SolverSettings, options: &Ru
         let mut frame = FrameBody { vs: v1 - dpx / f.mass, mass: f.mass };
         // Pairs Rapier may have stopped: its speculative contacts slow a pair a little before
         // it touches, within what it closes in a step or two.
-        contacts::find(&geometry, &now.x, &radius, x1, touching + reach * h, &mut order, &mut found);
+        finder.find(&geometry, &now.x, &radius, x1, touching + reach * h, &mut found);
         // Contacts whose approach Rapier stopped, the fastest first.
         let mut new: Vec<Closing> = Vec::new();
         let sunk = found.iter().filter_map(|c| match c.other {
