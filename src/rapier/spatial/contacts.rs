@@ -87,6 +87,75 @@ impl Finder {
     }
 }
 
+/// The balls whose velocities the impacts of a step start from their free flight: the groups
+/// of balls touching one another (closer than `touching` at the step's start, positions
+/// `start`, or at its end) joined by the new impacts between balls (`struck`, pairs of
+/// balls), that have more than one ball and touch no wall. Rapier's plastic solve passes part of a strike
+/// through a group's touching contacts, so that the impact law applied to its velocities
+/// afterwards gives neither the sequence of §3 nor its energy, and it may part the group's
+/// contacts within the step; a group a wall holds keeps Rapier's support (docs/MODEL.md §9).
+/// Marks them in `free`, and gives their contacts the gap they had at the start when it was
+/// closer, so that the knock-ons strike them.
+pub fn free_flying_groups(
+    found: &mut [Contact],
+    start: &[[f64; 3]],
+    radius: &[f64],
+    touching: f64,
+    struck: &[(usize, usize)],
+    free: &mut [bool],
+) {
+    let n = free.len();
+    let mut parent: Vec<usize> = (0..n).collect();
+    fn root(parent: &mut [usize], mut i: usize) -> usize {
+        while parent[i] != i {
+            parent[i] = parent[parent[i]];
+            i = parent[i];
+        }
+        i
+    }
+    let start_gap = |c: &Contact, j: usize| {
+        let d: [f64; 3] = std::array::from_fn(|a| start[j][a] - start[c.ball][a]);
+        dot(d, d).sqrt() - radius[c.ball] - radius[j]
+    };
+    let mut held = vec![false; n];
+    for c in found.iter() {
+        match c.other {
+            Other::Ball(j) if c.gap.min(start_gap(c, j)) <= touching => {
+                let (a, b) = (root(&mut parent, c.ball), root(&mut parent, j));
+                parent[a.max(b)] = a.min(b);
+            }
+            Other::Wall(_) if c.gap <= touching => held[c.ball] = true,
+            _ => {}
+        }
+    }
+    for &(i, j) in struck {
+        let (a, b) = (root(&mut parent, i), root(&mut parent, j));
+        parent[a.max(b)] = a.min(b);
+    }
+    let mut size = vec![0usize; n];
+    let mut group_held = vec![false; n];
+    for i in 0..n {
+        let r = root(&mut parent, i);
+        size[r] += 1;
+        group_held[r] |= held[i];
+    }
+    let mut chosen = vec![false; n];
+    for &(i, _) in struck {
+        let r = root(&mut parent, i);
+        chosen[r] = size[r] > 2 && !group_held[r];
+    }
+    for (i, f) in free.iter_mut().enumerate() {
+        *f = chosen[root(&mut parent, i)];
+    }
+    for c in found.iter_mut() {
+        if let Other::Ball(j) = c.other {
+            if free[c.ball] {
+                c.gap = c.gap.min(start_gap(c, j));
+            }
+        }
+    }
+}
+
 fn dot(a: [f64; 3], b: [f64; 3]) -> f64 {
     a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
 }
