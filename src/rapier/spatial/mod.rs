@@ -186,19 +186,6 @@ impl BallState {
         }
     }
 
-    /// Gives Rapier the positions of the balls marked in `which`, keeping what it will read
-    /// back (the `f32` position).
-    fn write_positions(&mut self, bodies: &mut RigidBodySet, handles: &[RigidBodyHandle], which: &[bool]) {
-        for (k, &h) in handles.iter().enumerate() {
-            if which[k] {
-                let x = self.x[k];
-                bodies[h].set_translation(Vector::new(x[0] as f32, x[1] as f32, x[2] as f32), true);
-                let r = bodies[h].translation();
-                self.x[k] = [r.x as f64, r.y as f64, r.z as f64];
-            }
-        }
-    }
-
     /// Gives Rapier the velocities of the balls marked in `which`, keeping what it will read
     /// back (the `f32` velocity).
     fn write_velocities(&mut self, bodies: &mut RigidBodySet, handles: &[RigidBodyHandle], which: &[bool]) {
@@ -264,8 +251,6 @@ pub fn simulate_spatial_with(scene: &Scene, solver: SolverSettings, options: &Ru
     let reach = 2.0 * speed;
     let mut found: Vec<Contact> = Vec::new();
     let mut kicked = vec![false; n];
-    let mut free = vec![false; n];
-    let mut cold_start = false;
     let mut cascade = contacts::Cascade::default();
     let height_at_start = scene.height_energy_at_start();
     let energy_of = |carrier: &Carrier, state: &BallState, t: f64, xs: f64, vs: f64| -> f64 {
@@ -379,7 +364,6 @@ pub fn simulate_spatial_with(scene: &Scene, solver: SolverSettings, options: &Ru
         let closing = (2.0 * fastest * h + g_norm * h * h) as f32 / lu;
         world.physics.integration_parameters.normalized_prediction_distance = prediction.max(closing);
         std::mem::swap(&mut before, &mut now);
-        world.physics.integration_parameters.warmstart_coefficient = if std::mem::take(&mut cold_start) { 0.0 } else { 1.0 };
         world.physics.step();
         now.read(&world.physics.bodies, &world.balls);
         // Rapier's walls are infinitely heavy: the frame takes the opposite of the x momentum
@@ -435,52 +419,6 @@ pub fn simulate_spatial_with(scene: &Scene, solver: SolverSettings, options: &Ru
         }
         new.sort_by(|a, b| b.approach.total_cmp(&a.approach));
         kicked.iter_mut().for_each(|k| *k = false);
-        // A group of touching balls struck by a ball from a gap: its impacts start from its
-        // free flight over the step, not from what Rapier's solve passed through it.
-        let struck: Vec<(usize, usize)> = new
-            .iter()
-            .filter_map(|closing| match found[closing.k].other {
-                Other::Ball(j) => Some((found[closing.k].ball, j)),
-                Other::Wall(_) => None,
-            })
-            .collect();
-        if !struck.is_empty() {
-            contacts::free_flying_groups(&mut found, &before.x, &radius, touching, &struck, &mut free);
-            if free.iter().any(|&f| f) {
-                // The group flies freely over the step, and each ball that strikes into it is
-                // stopped at contact, as Rapier's speculative contact stops it; the knock-ons
-                // land at the step's end, up to a step late, as every impact of this path.
-                for i in (0..n).filter(|&i| free[i]) {
-                    now.v[i] = std::array::from_fn(|a| before.v[i][a] + g[a] * h);
-                    now.x[i] = std::array::from_fn(|a| before.x[i][a] + (before.v[i][a] + 0.5 * g[a] * h) * h);
-                    kicked[i] = true;
-                }
-                for closing in &new {
-                    let c = found[closing.k];
-                    let Other::Ball(j) = c.other else { continue };
-                    if !free[c.ball] {
-                        continue;
-                    }
-                    let d: [f64; 3] = std::array::from_fn(|a| now.x[j][a] - now.x[c.ball][a]);
-                    let dist = contacts_dot(d, d).sqrt();
-                    let overlap = radius[c.ball] + radius[j] - dist;
-                    if overlap > 0.0 && dist > 0.0 {
-                        // The faster of the pair along the normal is the one that struck.
-                        let normal = d.map(|x| x / dist);
-                        let (mover, sign) = if contacts_dot(before.v[c.ball], normal) >= -contacts_dot(before.v[j], normal) {
-                            (c.ball, -1.0)
-                        } else {
-                            (j, 1.0)
-                        };
-                        now.x[mover] = std::array::from_fn(|a| now.x[mover][a] + sign * overlap * normal[a]);
-                    }
-                }
-                now.write_positions(&mut world.physics.bodies, &world.balls, &free);
-                // Rapier would start its next solve from the impulses its solve passed through
-                // the group, pushing it as before; the next step starts from none.
-                cold_start = true;
-            }
-        }
         let mut step_impact_loss = 0.0;
         {
             let mut balls = Balls { v: &mut now.v, mass: &mass };
