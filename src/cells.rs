@@ -24,10 +24,12 @@ pub(crate) struct Cells {
 const CELLS_PER_BALL: f64 = 16.0;
 
 impl Cells {
-    /// A grid over the box from `low` to `high` (m) for `n` balls, whose cells are at least
-    /// `diameter` wide (the farthest apart a pair may be and still be found).
-    pub(crate) fn new(low: [f64; 3], high: [f64; 3], diameter: f64, n: usize) -> Cells {
-        let extent: [f64; 3] = std::array::from_fn(|k| (high[k] - low[k]).max(diameter));
+    /// A grid over a container's inside, `[length, width, height]` in its frame (x from the
+    /// left wall, y and z about the axis), for `n` balls, whose cells are at least `diameter`
+    /// wide (the farthest apart a pair may be and still be found).
+    pub(crate) fn new(inside: [f64; 3], diameter: f64, n: usize) -> Cells {
+        let low = [0.0, -0.5 * inside[1], -0.5 * inside[2]];
+        let extent: [f64; 3] = std::array::from_fn(|k| inside[k].max(diameter));
         let most = CELLS_PER_BALL * n as f64 + 64.0;
         let mut width = diameter.max(f64::MIN_POSITIVE);
         let count = |w: f64| extent.iter().map(|e| (e / w).floor().max(1.0)).product::<f64>();
@@ -103,7 +105,7 @@ mod tests {
             })
             .collect();
         for n_cells_cap in [1usize, 200] {
-            let mut cells = Cells::new([0.0, -0.5, -0.15], [1.0, 0.5, 0.15], diameter, n_cells_cap);
+            let mut cells = Cells::new([1.0, 1.0, 0.3], diameter, n_cells_cap);
             cells.items = vec![0; p.len()];
             cells.cell_of = vec![0; p.len()];
             cells.rebuild(|i| p[i]);

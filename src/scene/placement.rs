@@ -44,9 +44,14 @@ pub(super) fn touching_round_off(size: [f64; 3]) -> f64 {
 /// touching a wall within round-off allowed: the first axis it leaves, or `None`.
 fn outside(c: [f64; 3], r: f64, size: [f64; 3]) -> Option<usize> {
     let tol = touching_round_off(size);
-    let lo = [r, r - 0.5 * size[1], r - 0.5 * size[2]];
-    let hi = [size[0] - r, 0.5 * size[1] - r, 0.5 * size[2] - r];
+    let (lo, hi) = centre_bounds(r, size);
     (0..3).find(|&a| !(lo[a] - tol <= c[a] && c[a] <= hi[a] + tol))
+}
+
+/// The lowest and highest centre along each axis of a ball of radius `r` that touches no wall
+/// of the box `[length, width, height]` from outside.
+pub(super) fn centre_bounds(r: f64, size: [f64; 3]) -> ([f64; 3], [f64; 3]) {
+    ([r, r - 0.5 * size[1], r - 0.5 * size[2]], [size[0] - r, 0.5 * size[1] - r, 0.5 * size[2] - r])
 }
 
 /// The first pair of balls that overlap by more than the round-off of the container's `size`,

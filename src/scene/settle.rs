@@ -70,6 +70,7 @@ pub(super) fn settle(balls: &[Ball], start: &[[f64; 3]], size: [f64; 3], gravity
     grid.list_pairs(&centres, balls, down, skin);
     let mut step = FIRST_STEP_RADII * smallest;
     while step >= LAST_STEP_RADII * smallest {
+        let lift = step >= LIFT_UNTIL_RADII * smallest;
         for _ in 0..WINDOWS_PER_STEP {
             let window_start = centres.clone();
             for _ in 0..WINDOW {
@@ -81,7 +82,6 @@ pub(super) fn settle(balls: &[Ball], start: &[[f64; 3]], size: [f64; 3], gravity
                     grid.list_pairs(&centres, balls, down, skin);
                     listed_at.clone_from(&centres);
                 }
-                let lift = step >= LIFT_UNTIL_RADII * smallest;
                 for _ in 0..SWEEPS_PER_STEP {
                     if grid.part_overlaps(&mut centres, balls, size, down, lift) <= OVERLAP_PER_STEP * step {
                         break;
@@ -117,8 +117,7 @@ impl Grid {
     /// A grid over the box `size` for `balls`, finding pairs up to `skin` apart.
     fn new(size: [f64; 3], balls: &[Ball], skin: f64) -> Grid {
         let largest = balls.iter().map(|b| b.radius).fold(0.0, f64::max);
-        let (low, high) = ([0.0, -0.5 * size[1], -0.5 * size[2]], [size[0], 0.5 * size[1], 0.5 * size[2]]);
-        Grid { cells: Cells::new(low, high, 2.0 * largest + skin, balls.len()), pairs: vec![] }
+        Grid { cells: Cells::new(size, 2.0 * largest + skin, balls.len()), pairs: vec![] }
     }
 
     /// Lists the pairs of balls closer than `skin`, the lower ball of each first, lowest
@@ -174,8 +173,7 @@ impl Grid {
 
 /// `c` moved into the box where a ball of radius `r` touches no wall from outside.
 fn clamp(c: [f64; 3], r: f64, size: [f64; 3]) -> [f64; 3] {
-    let lo = [r, r - 0.5 * size[1], r - 0.5 * size[2]];
-    let hi = [size[0] - r, 0.5 * size[1] - r, 0.5 * size[2] - r];
+    let (lo, hi) = super::placement::centre_bounds(r, size);
     std::array::from_fn(|a| c[a].clamp(lo[a], hi[a]))
 }
 

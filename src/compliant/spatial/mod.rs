@@ -269,7 +269,7 @@ impl<'a> Solver<'a> {
         let smallest = scene.balls.iter().map(|b| b.radius).fold(f64::INFINITY, f64::min).min(largest);
         let skin = SKIN_RADII * smallest;
         // Listed pairs may be a skin apart: the cells are as wide as that reach.
-        let cells = Cells::new([0.0, -0.5 * width, -0.5 * height], [chamber.length, 0.5 * width, 0.5 * height], 2.0 * largest + skin, n);
+        let cells = Cells::new([chamber.length, width, height], 2.0 * largest + skin, n);
         let mass: Vec<f64> = scene.balls.iter().map(|b| b.mass).collect();
         let radius: Vec<f64> = scene.balls.iter().map(|b| b.radius).collect();
         let e_star = contact::effective_modulus(&scene.compliant);

@@ -58,11 +58,9 @@ impl Finder {
         let n = x.len();
         let reach = 2.0 * geometry.largest_radius + touching;
         if self.cells.as_ref().is_none_or(|(_, width)| *width < reach) {
-            let (low, high) =
-                ([0.0, -0.5 * geometry.width, -0.5 * geometry.height], [geometry.length, 0.5 * geometry.width, 0.5 * geometry.height]);
             // Wider than asked, so that a slowly growing reach does not make the grid anew each step.
             let width = 1.25 * reach;
-            self.cells = Some((Cells::new(low, high, width, n), width));
+            self.cells = Some((Cells::new([geometry.length, geometry.width, geometry.height], width, n), width));
         }
         let Some((cells, _)) = self.cells.as_mut() else { return };
         let local = |i: usize| [x[i][0] - xs, x[i][1], x[i][2]];
