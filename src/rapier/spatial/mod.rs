@@ -12,9 +12,10 @@
 
 mod carrier;
 mod contacts;
+mod strikes;
 mod world;
 
-use bevy_rapier3d::rapier::prelude::{RigidBodyHandle, RigidBodySet, Vector};
+use bevy_rapier3d::rapier::prelude::{ActiveHooks, RigidBodyHandle, RigidBodySet, Vector};
 
 pub use contacts::closing_speed;
 pub use world::SolverSettings;
@@ -252,6 +253,8 @@ pub fn simulate_spatial_with(scene: &Scene, solver: SolverSettings, options: &Ru
     let mut found: Vec<Contact> = Vec::new();
     let mut kicked = vec![false; n];
     let mut cascade = contacts::Cascade::default();
+    let mut strikes = strikes::Strikes::default();
+    let mut unsolved = Vec::new();
     let height_at_start = scene.height_energy_at_start();
     let energy_of = |carrier: &Carrier, state: &BallState, t: f64, xs: f64, vs: f64| -> f64 {
         let mut e = carrier.energy(t, xs, vs) + height_at_start;
@@ -268,7 +271,8 @@ pub fn simulate_spatial_with(scene: &Scene, solver: SolverSettings, options: &Ru
     // first with their knock-ons (§3 along normals), as a step's impacts do at its end: left
     // to Rapier's plastic solve, a ball touching a row would move the whole row as one block.
     {
-        finder.find(&geometry, &now.x, &radius, xs, touching, &mut found);
+        // As far as the first step may close a pair, for its strikes.
+        finder.find(&geometry, &now.x, &radius, xs, touching + reach * solver.dt, &mut found);
         kicked.iter_mut().for_each(|k| *k = true);
         let mut struck = vec![false; n];
         let mut balls = Balls { v: &mut now.v, mass: &mass };
@@ -363,9 +367,25 @@ pub fn simulate_spatial_with(scene: &Scene, solver: SolverSettings, options: &Ru
         let fastest = now.v.iter().map(|v| ((v[0] - mean_vs).powi(2) + v[1] * v[1] + v[2] * v[2]).sqrt()).fold(0.0, f64::max);
         let closing = (2.0 * fastest * h + g_norm * h * h) as f32 / lu;
         world.physics.integration_parameters.normalized_prediction_distance = prediction.max(closing);
+        // Strikes on touching groups are kept out of Rapier's solve of their pair (`strikes`).
+        strikes.predict(&found, &now.v, vs, touching, h, resting_speed);
+        unsolved.clear();
+        unsolved.extend(strikes.list.iter().map(|s| (world.colliders[s.striker], world.colliders[s.target])));
+        for s in &strikes.list {
+            world.physics.colliders[world.colliders[s.striker]].set_active_hooks(ActiveHooks::MODIFY_SOLVER_CONTACTS);
+        }
         std::mem::swap(&mut before, &mut now);
-        world.physics.step();
+        world.physics.step_with_events(&strikes::Unsolved { pairs: &unsolved }, &());
         now.read(&world.physics.bodies, &world.balls);
+        for s in &strikes.list {
+            world.physics.colliders[world.colliders[s.striker]].set_active_hooks(ActiveHooks::empty());
+            if strikes::bring_back(*s, &mut now.x, &now.v, mean_vs, &radius, h) {
+                let p = now.x[s.striker].map(|c| c as f32);
+                let body = &mut world.physics.bodies[world.balls[s.striker]];
+                body.set_translation(Vector::new(p[0], p[1], p[2]), true);
+                now.x[s.striker] = p.map(f64::from);
+            }
+        }
         // Rapier's walls are infinitely heavy: the frame takes the opposite of the x momentum
         // they gave the balls (ball-ball impulses cancel in the sum; gravity's is not theirs).
         let dpx: f64 = (0..n).map(|i| mass[i] * (now.v[i][0] - before.v[i][0] - g[0] * h)).sum();
@@ -384,6 +404,15 @@ pub fn simulate_spatial_with(scene: &Scene, solver: SolverSettings, options: &Ru
         }
         for (k, c) in found.iter().enumerate() {
             report.deepest_overlap = report.deepest_overlap.max(-c.gap);
+            if strikes.holds(c) {
+                // Rapier did not solve the pair: it strikes at the speed it touches with.
+                let balls = Balls { v: &mut now.v, mass: &mass };
+                let approach = -contacts::relative(c, &balls, &frame).0;
+                if c.gap <= touching && approach > 0.0 {
+                    new.push(Closing { approach, k, gap0: 0.0, w0: -approach, g_n: 0.0 });
+                }
+                continue;
+            }
             let (gap0, w0, w_end, g_n) = match c.other {
                 Other::Ball(j) => {
                     let d: [f64; 3] = std::array::from_fn(|a| before.x[j][a] - before.x[c.ball][a]);

@@ -14,6 +14,8 @@ pub struct SpatialWorld {
     pub frame: RigidBodyHandle,
     /// One dynamic body per ball, in the scene's order.
     pub balls: Vec<RigidBodyHandle>,
+    /// Each ball's collider, in the same order.
+    pub colliders: Vec<ColliderHandle>,
 }
 
 /// How stiff Rapier's contacts are and how it steps.
@@ -77,6 +79,7 @@ pub fn build(scene: &Scene, geometry: &Chamber, solver: SolverSettings) -> Spati
         physics.insert_collider(collider, Some(frame));
     }
     let mut balls = Vec::with_capacity(scene.balls.len());
+    let mut colliders = Vec::with_capacity(scene.balls.len());
     for (i, ball) in scene.balls.iter().enumerate() {
         let [y, z] = scene.space.lateral_of(i);
         let [vy, vz] = scene.space.lateral_velocity_of(i);
@@ -85,9 +88,11 @@ pub fn build(scene: &Scene, geometry: &Chamber, solver: SolverSettings) -> Spati
             .linvel(Vector::new(scene.initial_velocities[i] as f32, vy as f32, vz as f32))
             .can_sleep(false);
         let collider = plastic(ColliderBuilder::ball(ball.radius as f32)).mass(ball.mass as f32);
-        balls.push(physics.insert(body, collider).0);
+        let (body, collider) = physics.insert(body, collider);
+        balls.push(body);
+        colliders.push(collider);
     }
-    SpatialWorld { physics, frame, balls }
+    SpatialWorld { physics, frame, balls, colliders }
 }
 
 /// The box of a wall in the frame's coordinates (origin at the left wall's inner face on the
