@@ -1,12 +1,12 @@
 //! Strikes on touching groups (docs/MODEL.md §9, "Rapier"). Rapier solves a step's new contact
 //! together with the touching contacts of the ball it strikes, so its solve passes part of the
 //! strike through them at once, and the impact law applied afterwards cannot undo that. A ball
-//! that touches no other ball and will close, within the step, on exactly one ball that
-//! touches something (a row, a pile, the floor) is therefore kept out of Rapier's solve of that
-//! one pair: the pair's solver contacts are removed for the step. After the step the striker,
-//! which flew through the other ball's surface, is set back along the pair's relative path to
-//! contact; the impact law and its knock-ons then give the sequence of §3 from velocities that
-//! Rapier's solve of the pair never touched.
+//! in flight (touching no other ball and no end wall) that will close, within two steps, on
+//! exactly one ball that touches something (a row, a pile, the floor) is therefore kept out of
+//! Rapier's solve of that one pair: the pair's solver contacts are removed for the step. After
+//! the step the striker, which flew into the other ball, is set back along its path among the
+//! walls to contact; the impact law and its knock-ons then give the sequence of §3 from
+//! velocities that Rapier's solve of the pair never touched.
 
 use bevy_rapier3d::rapier::prelude::{ColliderHandle, ContactModificationContext, PhysicsHooks};
 
@@ -26,6 +26,7 @@ pub struct Strike {
 pub struct Strikes {
     touches_ball: Vec<bool>,
     touches_any: Vec<bool>,
+    touches_end_wall: Vec<bool>,
     closings: Vec<u32>,
     /// Each ball's partner in a strike of the step, if it is in one.
     partner: Vec<Option<usize>>,
@@ -42,12 +43,13 @@ impl Strikes {
     /// `touching` and those a step may close, at the step's start) and the balls' velocities
     /// `v` (the walls moving along x at `walls_v`): pairs of balls apart by more than `touching` whose free flight closes them within
     /// two steps, approaching faster than `resting(normal)`, of which one ball (the striker)
-    /// touches no other ball, closes on nothing else and carries half the approach or more
-    /// relative to the walls, and the other touches something. A ball is in one strike at most.
+    /// touches no other ball and no end wall (one that the frame drives is not in flight),
+    /// closes on nothing else and carries half the approach or more relative to the walls, and
+    /// the other touches something. A ball is in one strike at most.
     pub fn predict(&mut self, found: &[Contact], v: &[[f64; 3]], walls_v: f64, touching: f64, h: f64, resting: impl Fn([f64; 3]) -> f64) {
         let n = v.len();
         self.list.clear();
-        for flags in [&mut self.touches_ball, &mut self.touches_any] {
+        for flags in [&mut self.touches_ball, &mut self.touches_any, &mut self.touches_end_wall] {
             flags.clear();
             flags.resize(n, false);
         }
@@ -73,7 +75,10 @@ impl Strikes {
                     self.closings[c.ball] += 1;
                     self.closings[j] += 1;
                 }
-                Other::Wall(_) if c.gap <= touching => self.touches_any[c.ball] = true,
+                Other::Wall(_) if c.gap <= touching => {
+                    self.touches_any[c.ball] = true;
+                    self.touches_end_wall[c.ball] |= c.normal[0] != 0.0;
+                }
                 _ => {}
             }
         }
@@ -89,7 +94,7 @@ impl Strikes {
             let free = |k: usize| {
                 let among_walls = dot(v[k], c.normal) - walls_v * c.normal[0];
                 let own = if k == c.ball { among_walls } else { -among_walls };
-                !self.touches_ball[k] && self.closings[k] == 1 && own >= 0.5 * approach
+                !self.touches_ball[k] && !self.touches_end_wall[k] && self.closings[k] == 1 && own >= 0.5 * approach
             };
             // The striker is the ball that touches nothing at all when both could strike.
             let (striker, target) = match (free(c.ball), free(j)) {
