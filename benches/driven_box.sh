@@ -20,7 +20,7 @@ for a in $amplitudes; do
     printf '\n[reference]\ncontact_duration = %s\n' "$contact_duration" >> "$dir/box-$a.toml"
   fi
   for m in $models; do
-    "$lpc" run "$dir/box-$a.toml" --model "$m" --max-wall-time "$budget" --format json > "$dir/$m-$a.json" 2> /dev/null || true
+    "$lpc" run "$dir/box-$a.toml" --model "$m" --max-wall-time "$budget" --format json --print-impacts > "$dir/$m-$a.json" 2> /dev/null || true
   done
 done
 python3 - "$dir" "$amplitudes" $models <<'PY'
