@@ -31,6 +31,6 @@ mod settled_beds;
 mod spatial_reference;
 mod stability_map;
 mod sticking;
-mod struck_groups;
 mod stress;
+mod struck_groups;
 mod structures;
