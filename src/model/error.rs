@@ -95,7 +95,7 @@ impl OverBudget {
             Budget::Steps => format!("more than {} {}{flag}", human(self.limit), self.model.step_unit()),
             Budget::WallTime => format!("more than {} s of computing{flag}", human(self.limit)),
             Budget::Memory => {
-                format!("more than {} {}, the most whose impacts a run keeps in memory", human(self.limit), self.model.step_unit())
+                format!("more than {} {}, the most whose impacts a run keeps in memory", human(self.limit), self.model.kept_unit())
             }
         }
     }

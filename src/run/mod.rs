@@ -15,10 +15,10 @@ pub use tally::{MotionMetrics, SampleTally, DISSIPATION_LEVELS, SETTLING_FRACTIO
 use crate::scene::Body;
 
 /// Declares the models the tool has, one line each: the label in outputs and on the command
-/// line, how messages name it, and what its budget counts. Each is mapped to its
+/// line, how messages name it, what its budget counts and what its bound on memory counts. Each is mapped to its
 /// implementation above this module, where the models are.
 macro_rules! models {
-    ($($(#[$doc:meta])* $variant:ident = $name:literal, $title:literal, $unit:literal;)*) => {
+    ($($(#[$doc:meta])* $variant:ident = $name:literal, $title:literal, $unit:literal, $kept:literal;)*) => {
         /// A model of the damper.
         #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord, serde::Serialize, serde::Deserialize)]
         #[serde(rename_all = "lowercase")]
@@ -50,17 +50,24 @@ macro_rules! models {
                     $(Model::$variant => $unit,)*
                 }
             }
+
+            /// What its bound on the impacts it keeps in memory counts (`events`, `impacts`).
+            pub fn kept_unit(self) -> &'static str {
+                match self {
+                    $(Model::$variant => $kept,)*
+                }
+            }
         }
     };
 }
 
 models! {
     /// The exact event-driven impulse solver.
-    Reference = "reference", "the reference", "events";
+    Reference = "reference", "the reference", "events", "events";
     /// Rapier colliders in a headless Bevy app.
-    Rapier = "rapier", "the contact model", "steps";
+    Rapier = "rapier", "the contact model", "steps", "impacts";
     /// Hertz contacts with Hunt-Crossley damping, integrated through every contact.
-    Compliant = "compliant", "the compliant model", "steps";
+    Compliant = "compliant", "the compliant model", "steps", "impacts";
 }
 
 impl std::fmt::Display for Model {
@@ -140,6 +147,52 @@ impl CountedImpacts {
         if let Some(f) = impact.peak_force {
             self.peak_force = Some(self.peak_force.map_or(f, |p| p.max(f)));
         }
+    }
+}
+
+/// Most impacts a run keeps in memory (96 bytes each, some 2 GB with the list's spare room):
+/// a run that keeps every impact stops past it with the run so far; one that counts them goes on.
+pub const MAX_KEPT_IMPACTS: usize = 20_000_000;
+
+/// A run's impacts as the model makes them: every one kept, or only counted
+/// ([`ImpactRecord`]).
+#[derive(Debug, Default)]
+pub struct Impacts {
+    counts_only: bool,
+    /// The impacts kept.
+    pub kept: Vec<Impact>,
+    /// The impacts counted.
+    pub counted: CountedImpacts,
+}
+
+impl Impacts {
+    /// An empty record that keeps or counts as `record` asks.
+    pub fn new(record: ImpactRecord) -> Self {
+        Impacts { counts_only: record == ImpactRecord::Count, ..Impacts::default() }
+    }
+
+    /// Keeps or counts `impact`.
+    pub fn push(&mut self, impact: Impact) {
+        if self.counts_only {
+            self.counted.add(&impact);
+        } else {
+            self.kept.push(impact);
+        }
+    }
+
+    /// How many so far.
+    pub fn len(&self) -> usize {
+        self.kept.len() + self.counted.count
+    }
+
+    /// Whether there are none.
+    pub fn is_empty(&self) -> bool {
+        self.len() == 0
+    }
+
+    /// Whether the impacts kept have passed [`MAX_KEPT_IMPACTS`].
+    pub fn beyond_memory(&self) -> bool {
+        self.kept.len() > MAX_KEPT_IMPACTS
     }
 }
 

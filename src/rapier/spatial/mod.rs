@@ -20,8 +20,8 @@ use bevy_rapier3d::rapier::prelude::{ActiveHooks, RigidBodyHandle, RigidBodySet,
 pub use contacts::closing_speed;
 pub use world::SolverSettings;
 
-use crate::model::{Checks, Meter, Model, ModelError, OverBudget, RunOptions, STALL_EVENTS_PER_SIM_S};
-use crate::run::{EnergyAccount, Impact, Recorder, Run};
+use crate::model::{Budget, Checks, Meter, Model, ModelError, OverBudget, RunOptions, STALL_EVENTS_PER_SIM_S};
+use crate::run::{EnergyAccount, Impact, Impacts, Recorder, Run, MAX_KEPT_IMPACTS};
 use crate::scene::{Body, Chamber, Scene, Wall};
 use carrier::Carrier;
 use contacts::{Balls, Contact, FrameBody, Other};
@@ -225,7 +225,7 @@ pub fn simulate_spatial_with(scene: &Scene, solver: SolverSettings, options: &Ru
     let (mut xs, mut vs) = carrier.start();
     let (mut damping_loss, mut forcing_work, mut impact_loss, mut contact_loss) = (0.0, 0.0, 0.0, 0.0);
     let mut report = SpatialReport::default();
-    let mut impacts: Vec<Impact> = Vec::new();
+    let mut impacts = Impacts::new(options.impacts);
     let mut recorder = Recorder::new(scene, options.record);
     let sample_count = scene.sample_count();
     sample(&mut recorder, scene, &carrier, 0.0, (xs, vs), |i| {
@@ -299,7 +299,7 @@ pub fn simulate_spatial_with(scene: &Scene, solver: SolverSettings, options: &Ru
                   vs: f64,
                   state: &BallState,
                   recorder: Recorder,
-                  impacts: Vec<Impact>,
+                  impacts: Impacts,
                   damping_loss: f64,
                   impact_loss: f64,
                   contact_loss: f64,
@@ -316,8 +316,8 @@ pub fn simulate_spatial_with(scene: &Scene, solver: SolverSettings, options: &Ru
             damped_period: f.damped_period(),
             series,
             motion,
-            impacts,
-            counted_impacts: crate::run::CountedImpacts::default(),
+            impacts: impacts.kept,
+            counted_impacts: impacts.counted,
             energy: EnergyAccount::forced(initial_energy, final_, damping_loss, impact_loss, forcing_work).with_contact_loss(contact_loss),
             events: steps,
             final_velocities: state.v.iter().map(|v| v[0]).collect(),
@@ -326,9 +326,15 @@ pub fn simulate_spatial_with(scene: &Scene, solver: SolverSettings, options: &Ru
         }
     };
     while !scene.reached_horizon(t) {
-        if let Some(budget) = meter.look(t, steps) {
+        // A run that keeps its impacts stops past the most memory holds (a resting pile at fine
+        // steps strikes its pressed contacts every step); one that counts them goes on.
+        let beyond_memory = impacts.beyond_memory().then_some(Budget::Memory);
+        if let Some(budget) = beyond_memory.or_else(|| meter.look(t, steps)) {
             let wall_s = meter.elapsed();
-            let cost = format!("{} impacts so far; {} balls in 3D at steps of {} s", impacts.len(), n, crate::scene::human(solver.dt));
+            let mut cost = format!("{} impacts so far; {} balls in 3D at steps of {} s", impacts.len(), n, crate::scene::human(solver.dt));
+            if budget == Budget::Memory {
+                cost += "; a run that counts its impacts instead of keeping them (`--impacts count`) is not bounded by memory";
+            }
             let mut partial =
                 finish(&carrier, t, xs, vs, &now, recorder, impacts, damping_loss, impact_loss, contact_loss, forcing_work, steps);
             partial.wall_time_s = wall_s;
@@ -340,7 +346,7 @@ pub fn simulate_spatial_with(scene: &Scene, solver: SolverSettings, options: &Ru
                 steps,
                 wall_s,
                 budget,
-                limit: meter.limit(budget),
+                limit: if budget == Budget::Memory { MAX_KEPT_IMPACTS as f64 } else { meter.limit(budget) },
                 cost,
                 partial,
             })));
