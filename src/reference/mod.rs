@@ -46,7 +46,7 @@ use crate::scene::{Body, Scene};
 /// rule makes a pile's events at a steady rate, a run that keeps its impacts stops there with
 /// the run so far (or as stalled, if it made them faster than the rule makes a pile's), and
 /// one that counts them goes on.
-pub const MAX_EVENTS: u64 = 20_000_000;
+pub const MAX_EVENTS: u64 = crate::run::MAX_KEPT_IMPACTS as u64;
 /// Most events at one instant: everything at an instant is resolved by one `resolve`, so a
 /// second event at the same time already means two judgements disagree.
 const MAX_EVENTS_PER_INSTANT: u64 = 1000;

@@ -15,8 +15,8 @@ pub use tally::{MotionMetrics, SampleTally, DISSIPATION_LEVELS, SETTLING_FRACTIO
 use crate::scene::Body;
 
 /// Declares the models the tool has, one line each: the label in outputs and on the command
-/// line, how messages name it, what its budget counts and what its bound on memory counts. Each is mapped to its
-/// implementation above this module, where the models are.
+/// line, how messages name it, what its budget counts and what its bound on memory counts.
+/// Each is mapped to its implementation above this module, where the models are.
 macro_rules! models {
     ($($(#[$doc:meta])* $variant:ident = $name:literal, $title:literal, $unit:literal, $kept:literal;)*) => {
         /// A model of the damper.

@@ -27,7 +27,7 @@ use super::geometry::Limits;
 use super::MAX_EVENTS;
 use crate::impact_law::{reduced_mass, separate};
 use crate::model::{Budget, Meter, Model, ModelError, OverBudget, RunOptions, STALL_EVENTS_PER_SIM_S};
-use crate::run::{CountedImpacts, EnergyAccount, Impact, ImpactRecord, Recorder, Run};
+use crate::run::{EnergyAccount, Impact, ImpactRecord, Impacts, Recorder, Run};
 use crate::scene::Scene;
 use calendar::Calendar;
 use cells::Cells;
@@ -181,10 +181,8 @@ struct Solver<'a> {
     t: f64,
     horizon: f64,
     events: u64,
-    /// Whether the run keeps every impact ([`ImpactRecord::Every`]) or counts them.
-    keeps_impacts: bool,
-    impacts: Vec<Impact>,
-    counted_impacts: CountedImpacts,
+    /// The impacts, every one kept or only counted ([`ImpactRecord`]).
+    impacts: Impacts,
     impact_loss: f64,
     damping_loss: f64,
     forcing_work: f64,
@@ -300,7 +298,7 @@ fn simulate_with(scene: &Scene, options: &RunOptions, waits: bool, max_events: u
             let wall_s = meter.elapsed();
             let steps = s.events;
             let rate = steps as f64 / t;
-            let mut cost = format!("{} impacts so far; {} balls", s.impacts.len() + s.counted_impacts.count, s.balls.len());
+            let mut cost = format!("{} impacts so far; {} balls", s.impacts.len(), s.balls.len());
             if budget == Budget::Memory {
                 // Past the rate the collapse rule makes on a pile, the events are a flood that
                 // no part of it resolves; below it, a pile's steady price.
@@ -385,9 +383,7 @@ impl<'a> Solver<'a> {
             t: 0.0,
             horizon: scene.horizon,
             events: 0,
-            keeps_impacts: impacts == ImpactRecord::Every,
-            impacts: Vec::new(),
-            counted_impacts: CountedImpacts::default(),
+            impacts: Impacts::new(impacts),
             impact_loss: 0.0,
             damping_loss: 0.0,
             forcing_work: 0.0,
@@ -535,8 +531,8 @@ impl<'a> Solver<'a> {
             damped_period: scene.frame.map_or(0.0, |f| f.damped_period()),
             series,
             motion,
-            impacts: self.impacts,
-            counted_impacts: self.counted_impacts,
+            impacts: self.impacts.kept,
+            counted_impacts: self.impacts.counted,
             energy: EnergyAccount::forced(
                 scene.initial_energy(),
                 final_,

@@ -37,11 +37,7 @@ impl Solver<'_> {
         self.impact_loss += lost;
         let impact =
             Impact { t: self.t, a, b, approach_speed: approach, energy_lost: lost, impulses: 1, peak_force: None, contact_duration: None };
-        if self.keeps_impacts {
-            self.impacts.push(impact);
-        } else {
-            self.counted_impacts.add(&impact);
-        }
+        self.impacts.push(impact);
     }
 
     /// A ball resting on a wall keeps none of its velocity into it (the wall takes it, a
