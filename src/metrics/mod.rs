@@ -107,7 +107,8 @@ pub struct Metrics {
     pub rms_displacement: f64,
     /// Last time |xs| >= 5 % of |xs0|; `None` when that still holds at the horizon.
     pub settling_time: Option<f64>,
-    /// Mechanical energy at the horizon / initial energy (`None` when the initial energy is 0).
+    /// Mechanical energy at the horizon / initial energy (`None` when an excitation drives the
+    /// run, which puts energy in as it goes, or when the initial energy is 0).
     pub energy_remaining: Option<f64>,
     /// First time at which the mechanical energy has fallen to 10 % of its initial value
     /// (`None` when forced, when the initial energy is 0, or not reached).
@@ -208,7 +209,7 @@ pub fn metrics(run: &Run) -> Metrics {
         peak_acceleration: m.peak_acceleration,
         rms_displacement: m.rms_displacement,
         settling_time: m.settling_time,
-        energy_remaining: (run.energy.initial != 0.0).then(|| run.energy.final_ / run.energy.initial),
+        energy_remaining: (!m.driven && run.energy.initial != 0.0).then(|| run.energy.final_ / run.energy.initial),
         dissipation_time_90: m.dissipation_times[0],
         dissipation_time_99: m.dissipation_times[1],
         peak_contact_force: run.peak_contact_force(),

@@ -27,6 +27,22 @@ fn noise_line(n: &Noise) -> String {
     line
 }
 
+/// The energy left at the end as a share of the initial energy, or, where that means nothing
+/// (an excitation puts energy in as it goes, or there was none at the start), the share of the
+/// energy dissipated that the damper's impacts and contacts took.
+fn energy_remaining(remaining: Option<f64>, e: &crate::metrics::EnergySummary) -> String {
+    if let Some(x) = remaining {
+        return format!("{:.4} %", x * 100.0);
+    }
+    let why = if e.forcing_work != 0.0 { "- (driven: energy is put in as it goes)" } else { "- (no energy at the start)" };
+    let dissipated = e.damping_loss + e.impact_loss + e.contact_loss;
+    if dissipated > 0.0 {
+        format!("{why}; the damper took {:.1} % of the energy dissipated", 100.0 * (e.impact_loss + e.contact_loss) / dissipated)
+    } else {
+        why.into()
+    }
+}
+
 /// A readable multi-line summary of a run.
 pub fn text_summary(s: &RunSummary) -> String {
     let m = &s.metrics;
@@ -57,7 +73,7 @@ pub fn text_summary(s: &RunSummary) -> String {
         },
         m.rms_displacement * 1e3,
         opt(m.settling_time, "s", 1.0),
-        opt(m.energy_remaining.map(|x| x * 100.0), "%", 1.0),
+        energy_remaining(m.energy_remaining, e),
         e.initial,
         if e.forcing_work != 0.0 { format!(" + forcing {:.6e}", e.forcing_work) } else { String::new() },
         e.final_,

@@ -192,6 +192,8 @@ impl ExactTally {
             peak_drift: None,
             peak_roof_displacement: None,
             peak_floor_acceleration: None,
+            // Read in closed form only in free vibration.
+            driven: false,
         }
     }
 }

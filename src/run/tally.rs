@@ -31,6 +31,9 @@ pub struct MotionMetrics {
     pub peak_roof_displacement: Option<f64>,
     /// The largest absolute acceleration of any floor for t >= T, m/s^2.
     pub peak_floor_acceleration: Option<f64>,
+    /// Whether an excitation drives the run: energy is then put in as it goes, and what is
+    /// left at the end says nothing of the damper.
+    pub driven: bool,
 }
 
 /// Energy fractions left at which the dissipation times are read: 10 % and 1 %.
@@ -49,6 +52,7 @@ pub struct SampleTally {
     /// Initial mechanical energy when the dissipation times are watched (free vibration with
     /// energy), else 0.
     initial_energy: f64,
+    driven: bool,
     peak_displacement: f64,
     peak_acceleration: f64,
     sum_sq: f64,
@@ -70,6 +74,7 @@ impl SampleTally {
             band: SETTLING_FRACTION * scene.initial_displacement.abs(),
             // Energy only falls in free vibration: a forced run has no dissipation time.
             initial_energy: if !scene.is_driven() && initial_energy > 0.0 { initial_energy } else { 0.0 },
+            driven: scene.is_driven(),
             ..Default::default()
         }
     }
@@ -112,6 +117,7 @@ impl SampleTally {
             peak_drift: self.peak_drift,
             peak_roof_displacement: self.peak_roof_displacement,
             peak_floor_acceleration: self.peak_floor_acceleration,
+            driven: self.driven,
         }
     }
     /// Adds a structure's floors at `t`, bottom to top: displacements `u` relative to the

@@ -8,6 +8,7 @@ mod bed_energy_below_zero;
 mod box_loses_floor_velocity;
 mod check_bad_scene_exit_status;
 mod closed_pipe;
+mod driven_energy_remaining;
 mod driven_sweep_energy_left;
 mod ensemble_without_tolerances;
 mod fast_ball_into_wall;
