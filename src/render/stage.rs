@@ -7,6 +7,9 @@ use bevy::prelude::*;
 use crate::run::Run;
 use crate::scene::{BallKind, Body, Scene};
 
+/// Storeys the camera frames under the container at most: the floors moving under the box,
+/// close enough to see its balls.
+pub const STOREYS_SHOWN_BELOW: usize = 3;
 /// Vertical field of view of the camera, rad (Bevy's default perspective).
 pub const FOV: f32 = std::f32::consts::FRAC_PI_4;
 /// Large balls' colour (sRGB).
@@ -107,17 +110,29 @@ impl Layout {
         (self.ball_y + 0.5 * self.height).max(self.floor_y(self.floors - 1) + 0.5 * self.platform)
     }
 
-    /// The point the camera looks at: mid-container, a little below the balls (below the
-    /// middle of a tall box's inside).
-    pub fn camera_target(&self) -> Vec3 {
-        Vec3::new(0.5 * self.length, 0.6 * self.top(), 0.0)
+    /// The heights the camera frames, bottom and top: the container and the storeys around it,
+    /// at most [`STOREYS_SHOWN_BELOW`] under it (from the ground when it rides no higher) and one
+    /// above it. A tall building shown whole would leave its damper a few pixels wide.
+    pub fn shown(&self) -> (f32, f32) {
+        let bottom =
+            if self.carrying < STOREYS_SHOWN_BELOW { 0.0 } else { self.floor_y(self.carrying - STOREYS_SHOWN_BELOW) - 0.5 * self.platform };
+        let above = self.floor_y((self.carrying + 1).min(self.floors - 1)) + 0.5 * self.platform;
+        (bottom, self.top().min(above.max(self.ball_y + 0.5 * self.height)))
     }
 
-    /// The camera: in front of the structure, a little above and to the right, framing it
-    /// from the ground to the container's top.
+    /// The point the camera looks at: mid-container, a little below the balls (below the
+    /// middle of a tall box's inside), or 0.6 of the way up what it frames ([`Layout::shown`]).
+    pub fn camera_target(&self) -> Vec3 {
+        let (bottom, top) = self.shown();
+        Vec3::new(0.5 * self.length, bottom + 0.6 * (top - bottom), 0.0)
+    }
+
+    /// The camera: in front of the structure, a little above and to the right, framing what
+    /// [`Layout::shown`] gives (from the ground to the container's top on a low structure).
     pub fn camera(&self) -> Transform {
         let target = self.camera_target();
-        let span = (self.length + 2.0 * self.overhang).max(self.top());
+        let (bottom, top) = self.shown();
+        let span = (self.length + 2.0 * self.overhang).max(top - bottom);
         let eye = target + Vec3::new(0.1 * span, 0.3 * span, 1.1 * span);
         Transform::from_translation(eye).looking_at(target, Vec3::Y)
     }

@@ -8,7 +8,7 @@ use crate::common::{lpc, lpc_command};
 use std::path::Path;
 
 use lpc_damper::output::figures::read_series_csv;
-use lpc_damper::render::stage::{Layout, BACKGROUND};
+use lpc_damper::render::stage::{Layout, BACKGROUND, STOREYS_SHOWN_BELOW};
 use lpc_damper::scene::{load_scene, BallKind};
 
 fn decode(path: &Path) -> (u32, u32, Vec<u8>, usize) {
@@ -329,6 +329,49 @@ fn a_box_on_a_building_is_drawn_on_its_floor() {
             let r_px = layout.projected_radius(size, centre, scene.balls[i].radius as f32);
             assert!(r_px > 3.0, "ball{} is {r_px} px across: too small to check", i + 1);
             assert!(is_shaded_large(at(p)) || is_small(at(p)) || is_large(at(p)), "frame {k}: ball{} at pixel {p} is not drawn", i + 1);
+        }
+    }
+}
+
+/// A box on the top floor of a tall building is framed with the storeys under it, not the
+/// whole building: shown whole, twenty storeys left the box a twentieth of the picture.
+#[test]
+fn a_tall_buildings_damper_fills_the_picture() {
+    let text = std::fs::read_to_string("examples/scenes/small-box-building.toml").unwrap();
+    let storeys = |n: usize, floor: usize| {
+        let list = |x: f64| format!("[{}]", vec![x.to_string(); n].join(", "));
+        let structure = format!(
+            "[structure]\nmasses = {}\nstiffnesses = {}\ndamping_ratios = {}\ndamper_floor = {floor}\n",
+            list(1.35),
+            list(4364.0 * n as f64),
+            list(0.016)
+        );
+        let start = text.find("[structure]").unwrap();
+        let end = text.find("[forcing]").unwrap();
+        let file = format!("{}{structure}\n{}", &text[..start], &text[end..]);
+        Layout::of(&lpc_damper::scene::parse(&file, "examples/scenes/tall.toml", "tall").unwrap().scene.unwrap())
+    };
+    let size = (640, 480);
+    let low = storeys(3, 3);
+    let box_width = |l: &Layout| {
+        let y = l.ball_y;
+        l.project(size, bevy::math::Vec3::new(l.length, y, 0.0)).x - l.project(size, bevy::math::Vec3::new(0.0, y, 0.0)).x
+    };
+    for (n, floor) in [(10, 10), (20, 20), (20, 12)] {
+        let tall = storeys(n, floor);
+        assert_eq!((tall.floors, tall.carrying), (n, floor - 1));
+        // On the top floor the box is about as wide as on the three-storey building (its
+        // framing reaches a little higher); below the top, the storey above is framed too and
+        // the box is narrower, by less than half. Shown whole, twenty storeys leave it a
+        // twentieth of the picture's width (34 px here).
+        let (wide, low_wide) = (box_width(&tall), box_width(&low));
+        let least = if floor == n { 0.95 } else { 0.5 };
+        assert!(wide >= least * low_wide, "{n} storeys, box on floor {floor}: {wide} px wide, {low_wide} px on three");
+        // The floors under it in view, the lowest framed cut at the picture's edge as the
+        // ground is on three storeys.
+        for i in floor - STOREYS_SHOWN_BELOW..floor {
+            let p = tall.project(size, bevy::math::Vec3::new(0.0, tall.floor_y(i), 0.0));
+            assert!((0.0..size.1 as f32).contains(&p.y), "{n} storeys: floor {} is out of the picture at {p}", i + 1);
         }
     }
 }
