@@ -85,6 +85,26 @@ impl Finder {
     }
 }
 
+/// A contact between balls whose normal has at least this component along gravity leans across
+/// it: one ball rests partly on the other (a row lying on the floor has none, to round-off).
+pub const PILE_LEANING: f64 = 1e-3;
+
+/// Marks in `in_pile` (one flag a ball) the balls of `found` in a pile: those touching (closer
+/// than `touching`) a ball along a normal that leans across gravity, of unit direction `down`,
+/// by [`PILE_LEANING`] or more. The weight such a contact carries presses the balls' other
+/// contacts, whatever their direction.
+pub fn mark_piles(found: &[Contact], touching: f64, down: [f64; 3], in_pile: &mut [bool]) {
+    in_pile.iter_mut().for_each(|p| *p = false);
+    for c in found {
+        if let Other::Ball(j) = c.other {
+            if c.gap <= touching && dot(c.normal, down).abs() >= PILE_LEANING {
+                in_pile[c.ball] = true;
+                in_pile[j] = true;
+            }
+        }
+    }
+}
+
 fn dot(a: [f64; 3], b: [f64; 3]) -> f64 {
     a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
 }
@@ -228,7 +248,7 @@ fn moves_with_frame(c: &Contact) -> bool {
 
 impl Cascade {
     /// Strikes, one at a time and the fastest first, the contacts of `found` closer than
-    /// `touching` that approach faster than `resting(normal)`, beginning with those of the
+    /// `touching` that approach faster than `resting(contact)`, beginning with those of the
     /// `kicked` balls and going on to those of each ball struck, until none approaches or after
     /// four strikes a contact on average (a collapse within the step). `strike` applies one
     /// strike, given the contact and its approach speed; struck balls are marked in `kicked`.
@@ -237,7 +257,7 @@ impl Cascade {
         found: &[Contact],
         touching: f64,
         kicked: &mut [bool],
-        resting: impl Fn([f64; 3]) -> f64,
+        resting: impl Fn(&Contact) -> f64,
         bodies: (&mut Balls, &mut FrameBody),
         mut strike: impl FnMut(&Contact, f64, &mut Balls, &mut FrameBody),
     ) {
@@ -270,7 +290,7 @@ impl Cascade {
             let mut fastest: Option<(f64, usize)> = None;
             while let Some(top) = self.calendar.peek() {
                 let c = &found[top.k];
-                if top.stamp == self.stamp[top.k] && top.w < -resting(c.normal) {
+                if top.stamp == self.stamp[top.k] && top.w < -resting(c) {
                     fastest = Some((top.w, top.k));
                     break;
                 }
@@ -280,7 +300,7 @@ impl Cascade {
             for &k in &self.end_walls {
                 let c = &found[k];
                 let w = relative(c, balls, frame).0;
-                if w < -resting(c.normal) && fastest.is_none_or(|(fw, fk)| w.total_cmp(&fw).then(k.cmp(&fk)).is_lt()) {
+                if w < -resting(c) && fastest.is_none_or(|(fw, fk)| w.total_cmp(&fw).then(k.cmp(&fk)).is_lt()) {
                     fastest = Some((w, k));
                 }
             }
@@ -301,7 +321,7 @@ impl Cascade {
 
     /// Lists ball `i`'s touching contacts as they stand now: the end-wall ones once, the
     /// others in the calendar with a new stamp when they approach.
-    fn list(&mut self, i: usize, found: &[Contact], resting: &impl Fn([f64; 3]) -> f64, balls: &Balls, frame: &FrameBody) {
+    fn list(&mut self, i: usize, found: &[Contact], resting: &impl Fn(&Contact) -> f64, balls: &Balls, frame: &FrameBody) {
         for &k in &self.by_ball[i] {
             let c = &found[k];
             if moves_with_frame(c) {
@@ -313,7 +333,7 @@ impl Cascade {
             }
             self.stamp[k] += 1;
             let w = relative(c, balls, frame).0;
-            if w < -resting(c.normal) {
+            if w < -resting(c) {
                 self.calendar.push(Listed { w, k, stamp: self.stamp[k] });
             }
         }
@@ -375,7 +395,7 @@ mod tests {
         found: &[Contact],
         touching: f64,
         kicked: &mut [bool],
-        resting: impl Fn([f64; 3]) -> f64,
+        resting: impl Fn(&Contact) -> f64,
         balls: &mut Balls,
         frame: &mut FrameBody,
         e: f64,
@@ -398,7 +418,7 @@ mod tests {
             let mut fastest: Option<(f64, usize)> = None;
             for (k, c) in found.iter().enumerate() {
                 let w = relative(c, balls, frame).0;
-                if listed[k] && w < -resting(c.normal) && fastest.is_none_or(|(fw, fk)| w.total_cmp(&fw).then(k.cmp(&fk)).is_lt()) {
+                if listed[k] && w < -resting(c) && fastest.is_none_or(|(fw, fk)| w.total_cmp(&fw).then(k.cmp(&fk)).is_lt()) {
                     fastest = Some((w, k));
                 }
             }
@@ -421,7 +441,7 @@ mod tests {
     #[test]
     fn the_calendar_strikes_as_the_rule_states() {
         let mut rng = Pcg64::seed_from_u64(30);
-        let resting = |n: [f64; 3]| 0.05 * n[2].abs() + 0.1 * n[0].abs() + 1e-9;
+        let resting = |c: &Contact| 0.05 * c.normal[2].abs() + 0.1 * c.normal[0].abs() + 1e-9;
         for _ in 0..300 {
             let (nx, ny, nz) = (rng.random_range(1..6), rng.random_range(1..4), rng.random_range(1..5));
             let (found, v, mass) = pile(&mut rng, nx, ny, nz);

@@ -235,14 +235,21 @@ pub fn simulate_spatial_with(scene: &Scene, solver: SolverSettings, options: &Ru
     let mut next_sample = 1;
     let touching = TOUCHING_FRACTION * solver.length_unit;
     // Closings slower than gravity and the frame's acceleration build along a contact's
-    // normal in two steps are resting contacts, left to Rapier's plastic solve.
+    // normal in two steps are resting contacts, left to Rapier's plastic solve. A ball in a
+    // pile (touching a ball across gravity) carries weight along every one of its contacts, so
+    // there gravity counts whole, whatever the normal.
     let frame_acceleration = crate::rapier::peak_frame_acceleration(scene);
     let speed_floor = 1e-9 * speed;
-    let resting_speed =
-        |normal: [f64; 3]| 2.0 * (contacts_dot(g, normal).abs() + normal[0].abs() * frame_acceleration) * solver.dt + speed_floor;
+    let g_norm = contacts_dot(g, g).sqrt();
+    let down = if g_norm > 0.0 { g.map(|c| c / g_norm) } else { [0.0; 3] };
+    let mut in_pile = vec![false; n];
+    let resting_speed = |c: &Contact, in_pile: &[bool]| {
+        let piled = in_pile[c.ball] || matches!(c.other, Other::Ball(j) if in_pile[j]);
+        let pressing = if piled { g_norm } else { contacts_dot(g, c.normal).abs() };
+        2.0 * (pressing + c.normal[0].abs() * frame_acceleration) * solver.dt + speed_floor
+    };
     let prediction = world.physics.integration_parameters.normalized_prediction_distance;
     let lu = world.physics.integration_parameters.length_unit;
-    let g_norm = contacts_dot(g, g).sqrt();
     // A ball sunk deeper into a wall stops the run rather than leave the container. (Balls
     // may sink deeper into each other: Rapier's solve holds a pile by the overlaps of its
     // balls, which nothing outside the run sees.)
@@ -273,11 +280,13 @@ pub fn simulate_spatial_with(scene: &Scene, solver: SolverSettings, options: &Ru
     {
         // As far as the first step may close a pair, for its strikes.
         finder.find(&geometry, &now.x, &radius, xs, touching + reach * solver.dt, &mut found);
+        contacts::mark_piles(&found, touching, down, &mut in_pile);
         kicked.iter_mut().for_each(|k| *k = true);
         let mut struck = vec![false; n];
         let mut balls = Balls { v: &mut now.v, mass: &mass };
         let mut frame = FrameBody { vs, mass: f.mass };
-        cascade.run(&found, touching, &mut kicked, resting_speed, (&mut balls, &mut frame), |c, approach, balls, frame| {
+        let resting = |c: &Contact| resting_speed(c, &in_pile);
+        cascade.run(&found, touching, &mut kicked, resting, (&mut balls, &mut frame), |c, approach, balls, frame| {
             let lost = contacts::strike(c, approach, e, balls, frame);
             impact_loss += lost;
             impacts.push(impact_record(0.0, c, approach, lost));
@@ -326,8 +335,8 @@ pub fn simulate_spatial_with(scene: &Scene, solver: SolverSettings, options: &Ru
         }
     };
     while !scene.reached_horizon(t) {
-        // A run that keeps its impacts stops past the most memory holds (a resting pile at fine
-        // steps strikes its pressed contacts every step); one that counts them goes on.
+        // A run that keeps its impacts stops past the most memory holds (a long run of a bed
+        // thrown about makes millions); one that counts them goes on.
         let beyond_memory = impacts.beyond_memory().then_some(Budget::Memory);
         if let Some(budget) = beyond_memory.or_else(|| meter.look(t, steps)) {
             let wall_s = meter.elapsed();
@@ -374,7 +383,7 @@ pub fn simulate_spatial_with(scene: &Scene, solver: SolverSettings, options: &Ru
         let closing = (2.0 * fastest * h + g_norm * h * h) as f32 / lu;
         world.physics.integration_parameters.normalized_prediction_distance = prediction.max(closing);
         // Strikes on touching groups are kept out of Rapier's solve of their pair (`strikes`).
-        strikes.predict(&found, &now.v, vs, touching, h, resting_speed);
+        strikes.predict(&found, &now.v, vs, touching, h, |c| resting_speed(c, &in_pile));
         unsolved.clear();
         unsolved.extend(strikes.list.iter().map(|s| (world.colliders[s.striker], world.colliders[s.target])));
         for s in &strikes.list {
@@ -399,6 +408,7 @@ pub fn simulate_spatial_with(scene: &Scene, solver: SolverSettings, options: &Ru
         // Pairs Rapier may have stopped: its speculative contacts slow a pair a little before
         // it touches, within what it closes in a step or two.
         finder.find(&geometry, &now.x, &radius, x1, touching + reach * h, &mut found);
+        contacts::mark_piles(&found, touching, down, &mut in_pile);
         // Contacts whose approach Rapier stopped, the fastest first.
         let mut new: Vec<Closing> = Vec::new();
         let sunk = found.iter().filter_map(|c| match c.other {
@@ -445,7 +455,7 @@ pub fn simulate_spatial_with(scene: &Scene, solver: SolverSettings, options: &Ru
             };
             // An impact is a contact Rapier's plastic solve stopped in this step: it was
             // approaching faster than a resting contact, and the step took its approach.
-            let resting = resting_speed(c.normal);
+            let resting = resting_speed(c, &in_pile);
             let approach = closing_speed(gap0, w0, g_n, h);
             let stopped = w_end - (w0 - g_n * h) > resting;
             if approach > resting && stopped && c.gap <= touching + 2.0 * (-w0).max(0.0) * h {
@@ -493,7 +503,8 @@ pub fn simulate_spatial_with(scene: &Scene, solver: SolverSettings, options: &Ru
             }
             // Touching pairs the impacts set approaching strike in turn, the fastest first.
             if !new.is_empty() {
-                cascade.run(&found, touching, &mut kicked, resting_speed, (&mut balls, &mut frame), |c, approach, balls, frame| {
+                let resting = |c: &Contact| resting_speed(c, &in_pile);
+                cascade.run(&found, touching, &mut kicked, resting, (&mut balls, &mut frame), |c, approach, balls, frame| {
                     let lost = contacts::strike(c, approach, e, balls, frame);
                     step_impact_loss += lost;
                     impacts.push(impact_record(t1, c, approach, lost));

@@ -42,11 +42,11 @@ impl Strikes {
     /// Lists the strikes of a step of length `h` from `found` (every pair closer than
     /// `touching` and those a step may close, at the step's start) and the balls' velocities
     /// `v` (the walls moving along x at `walls_v`): pairs of balls apart by more than `touching` whose free flight closes them within
-    /// two steps, approaching faster than `resting(normal)`, of which one ball (the striker)
+    /// two steps, approaching faster than `resting(contact)`, of which one ball (the striker)
     /// touches no other ball and no end wall (one that the frame drives is not in flight),
     /// closes on nothing else and carries half the approach or more relative to the walls, and
     /// the other touches something. A ball is in one strike at most.
-    pub fn predict(&mut self, found: &[Contact], v: &[[f64; 3]], walls_v: f64, touching: f64, h: f64, resting: impl Fn([f64; 3]) -> f64) {
+    pub fn predict(&mut self, found: &[Contact], v: &[[f64; 3]], walls_v: f64, touching: f64, h: f64, resting: impl Fn(&Contact) -> f64) {
         let n = v.len();
         self.list.clear();
         for flags in [&mut self.touches_ball, &mut self.touches_any, &mut self.touches_end_wall] {
@@ -61,7 +61,7 @@ impl Strikes {
         // apart, so a pair left to Rapier's solve there could be taken for an impact early.
         let closes = |c: &Contact, j: usize| {
             let w = dot(v[j], c.normal) - dot(v[c.ball], c.normal);
-            c.gap > touching && w < -resting(c.normal) && c.gap + 2.0 * w * h <= touching
+            c.gap > touching && w < -resting(c) && c.gap + 2.0 * w * h <= touching
         };
         for c in found {
             match c.other {

@@ -22,6 +22,7 @@ mod issue_14_touching_chain;
 mod json_prints_every_impact;
 mod loaded_contact_sinks;
 mod overdamped_bed_balance;
+mod pile_at_rest_struck;
 mod plugin_driven_by_app_update;
 mod pressed_at_the_horizon;
 mod record_beyond_double_range;
