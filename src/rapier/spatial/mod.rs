@@ -18,7 +18,7 @@ mod world;
 use bevy_rapier3d::rapier::prelude::{ActiveHooks, RigidBodyHandle, RigidBodySet, Vector};
 
 pub use contacts::closing_speed;
-pub use world::SolverSettings;
+pub use world::{SolverSettings, SpatialWorld};
 
 use crate::model::{Budget, Checks, Meter, Model, ModelError, OverBudget, RunOptions, STALL_EVENTS_PER_SIM_S};
 use crate::run::{EnergyAccount, Impact, Impacts, Recorder, Run, MAX_KEPT_IMPACTS};
@@ -81,6 +81,17 @@ pub fn refusal(scene: &Scene) -> Option<String> {
         return Some("the spatial contact model finds contacts with Rapier's speculative margin and has no swept CCD".into());
     }
     None
+}
+
+/// The Rapier world the spatial path steps for `scene`: the frame's walls and a sphere per
+/// ball, every contact plastic, Rapier set as [`solver_settings`] gives; or why the path
+/// cannot run the scene.
+pub fn rapier_world(scene: &Scene) -> Result<SpatialWorld, String> {
+    if let Some(why) = refusal(scene) {
+        return Err(why);
+    }
+    let geometry = Chamber::new(scene)?;
+    Ok(world::build(scene, &geometry, solver_settings(scene)))
 }
 
 /// Rapier's settings for `scene` on the spatial path: the scene's `[rapier] dt` (default
