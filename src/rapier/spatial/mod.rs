@@ -245,19 +245,18 @@ pub fn simulate_spatial_with(scene: &Scene, solver: SolverSettings, options: &Ru
     });
     let mut next_sample = 1;
     let touching = TOUCHING_FRACTION * solver.length_unit;
-    // Closings slower than gravity and the frame's acceleration build along a contact's
-    // normal in two steps are resting contacts, left to Rapier's plastic solve. A ball in a
-    // pile (touching a ball across gravity) carries weight along every one of its contacts, so
-    // there gravity counts whole, whatever the normal.
-    let frame_acceleration = crate::rapier::peak_frame_acceleration(scene);
+    // Closings slower than gravity and the frame's acceleration over the step (`walls_a`)
+    // build along a contact's normal in two steps are resting contacts, left to Rapier's
+    // plastic solve. A ball in a pile (touching a ball across gravity) carries weight along
+    // every one of its contacts, so there gravity counts whole, whatever the normal.
     let speed_floor = 1e-9 * speed;
     let g_norm = contacts_dot(g, g).sqrt();
     let down = if g_norm > 0.0 { g.map(|c| c / g_norm) } else { [0.0; 3] };
     let mut in_pile = vec![false; n];
-    let resting_speed = |c: &Contact, in_pile: &[bool]| {
+    let resting_speed = |c: &Contact, in_pile: &[bool], walls_a: f64| {
         let piled = in_pile[c.ball] || matches!(c.other, Other::Ball(j) if in_pile[j]);
         let pressing = if piled { g_norm } else { contacts_dot(g, c.normal).abs() };
-        2.0 * (pressing + c.normal[0].abs() * frame_acceleration) * solver.dt + speed_floor
+        2.0 * (pressing + c.normal[0].abs() * walls_a) * solver.dt + speed_floor
     };
     let prediction = world.physics.integration_parameters.normalized_prediction_distance;
     let lu = world.physics.integration_parameters.length_unit;
@@ -296,7 +295,9 @@ pub fn simulate_spatial_with(scene: &Scene, solver: SolverSettings, options: &Ru
         let mut struck = vec![false; n];
         let mut balls = Balls { v: &mut now.v, mass: &mass };
         let mut frame = FrameBody { vs, mass: f.mass };
-        let resting = |c: &Contact| resting_speed(c, &in_pile);
+        // The walls' mean acceleration over the first step.
+        let walls_a = ((carrier.state(solver.dt).1 - vs) / solver.dt).abs();
+        let resting = |c: &Contact| resting_speed(c, &in_pile, walls_a);
         cascade.run(&found, touching, &mut kicked, resting, (&mut balls, &mut frame), |c, approach, balls, frame| {
             let lost = contacts::strike(c, approach, e, balls, frame);
             impact_loss += lost;
@@ -394,7 +395,9 @@ pub fn simulate_spatial_with(scene: &Scene, solver: SolverSettings, options: &Ru
         let closing = (2.0 * fastest * h + g_norm * h * h) as f32 / lu;
         world.physics.integration_parameters.normalized_prediction_distance = prediction.max(closing);
         // Strikes on touching groups are kept out of Rapier's solve of their pair (`strikes`).
-        strikes.predict(&found, &now.v, vs, touching, h, |c| resting_speed(c, &in_pile));
+        // The walls' mean acceleration over the step, as its closed form moves them.
+        let walls_a = ((v1 - vs) / h).abs();
+        strikes.predict(&found, &now.v, vs, touching, h, |c| resting_speed(c, &in_pile, walls_a));
         unsolved.clear();
         unsolved.extend(strikes.list.iter().map(|s| (world.colliders[s.striker], world.colliders[s.target])));
         for s in &strikes.list {
@@ -466,7 +469,7 @@ pub fn simulate_spatial_with(scene: &Scene, solver: SolverSettings, options: &Ru
             };
             // An impact is a contact Rapier's plastic solve stopped in this step: it was
             // approaching faster than a resting contact, and the step took its approach.
-            let resting = resting_speed(c, &in_pile);
+            let resting = resting_speed(c, &in_pile, walls_a);
             let approach = closing_speed(gap0, w0, g_n, h);
             let stopped = w_end - (w0 - g_n * h) > resting;
             if approach > resting && stopped && c.gap <= touching + 2.0 * (-w0).max(0.0) * h {
@@ -514,7 +517,7 @@ pub fn simulate_spatial_with(scene: &Scene, solver: SolverSettings, options: &Ru
             }
             // Touching pairs the impacts set approaching strike in turn, the fastest first.
             if !new.is_empty() {
-                let resting = |c: &Contact| resting_speed(c, &in_pile);
+                let resting = |c: &Contact| resting_speed(c, &in_pile, walls_a);
                 cascade.run(&found, touching, &mut kicked, resting, (&mut balls, &mut frame), |c, approach, balls, frame| {
                     let lost = contacts::strike(c, approach, e, balls, frame);
                     step_impact_loss += lost;

@@ -10,6 +10,7 @@ mod check_bad_scene_exit_status;
 mod closed_pipe;
 mod driven_energy_remaining;
 mod driven_sweep_energy_left;
+mod end_wall_plastic_after_ring_down;
 mod ensemble_without_tolerances;
 mod fast_ball_into_wall;
 mod floor_starting_from_rest;
