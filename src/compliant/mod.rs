@@ -59,10 +59,10 @@ impl Simulator for Compliant {
         if !(tolerance > 0.0 && tolerance <= 1e-2) {
             return Err(format!("its error tolerance must lie in (0, 1e-2] (got {})", crate::scene::human(tolerance)));
         }
-        match scene.space.beyond_lines(&scene.initial_positions) {
-            Some(_) => spatial::refusal(scene).map_or(Ok(()), Err),
-            None => Ok(()),
+        if beyond_lines(scene) {
+            return spatial::refusal(scene).map_or(Ok(()), Err);
         }
+        Ok(())
     }
 
     fn simulate(&self, scene: &Scene, options: &RunOptions) -> Result<Run, ModelError> {
@@ -112,8 +112,10 @@ impl Simulator for Compliant {
 
 /// Whether `scene` goes to the spatial path: balls off their lines, motion across them,
 /// gravity or friction (several chains on lines stay on the one-line path, exactly).
+/// Whether `scene` goes to the spatial path: balls beyond lines, or several dampers (which the
+/// one-line path does not carry).
 fn beyond_lines(scene: &Scene) -> bool {
-    scene.space.beyond_lines(&scene.initial_positions).is_some()
+    scene.has_several_dampers() || scene.space.beyond_lines(&scene.initial_positions).is_some()
 }
 
 /// How far the compliant model's balls may legitimately overlap a wall: twice the elastic

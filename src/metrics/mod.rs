@@ -5,7 +5,7 @@
 
 mod summary;
 
-pub use summary::{EnergySummary, FloorSummary, Headline, ImpactSummary, RunSummary};
+pub use summary::{DamperSummary, EnergySummary, FloorSummary, Headline, ImpactSummary, RunSummary};
 
 use crate::run::Run;
 

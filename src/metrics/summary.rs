@@ -90,6 +90,10 @@ pub struct RunSummary {
     /// The same floors without the damper (the structure alone), when the caller ran it.
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub floors_without_damper: Vec<FloorSummary>,
+    /// Each damper's impacts and losses, when the scene carries several (empty otherwise, and
+    /// when the run counted its impacts without keeping them).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub dampers: Vec<DamperSummary>,
     /// Present when the run stopped before its horizon (a budget, a broken invariant): why.
     /// The summary is then of the run so far, up to `horizon`.
     #[serde(default, skip_serializing_if = "Option::is_none")]
@@ -136,6 +140,59 @@ impl FloorSummary {
     }
 }
 
+/// One damper's share of a run of several: what its balls' impacts did.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct DamperSummary {
+    /// 1 for the first `[[damper]]`.
+    pub damper: usize,
+    /// The floor that carries it, 1 at the bottom.
+    pub floor: usize,
+    /// Its number of balls.
+    pub balls: usize,
+    /// Its impacts: between its balls, and of its balls on its walls.
+    pub impacts: usize,
+    /// Of which on its walls.
+    pub wall_impacts: usize,
+    /// The energy its impacts lost, J.
+    pub impact_loss: f64,
+}
+
+impl DamperSummary {
+    /// Each damper of `scene` in `run` (none for a scene of one damper, or a run that did not
+    /// keep its impacts).
+    pub fn of(scene: &crate::scene::Scene, run: &Run) -> Vec<DamperSummary> {
+        if !scene.has_several_dampers() || run.counted_impacts.count > 0 {
+            return Vec::new();
+        }
+        let mut out: Vec<DamperSummary> = scene
+            .dampers
+            .iter()
+            .enumerate()
+            .map(|(k, d)| DamperSummary {
+                damper: k + 1,
+                floor: d.floor + 1,
+                balls: d.balls.len(),
+                impacts: 0,
+                wall_impacts: 0,
+                impact_loss: 0.0,
+            })
+            .collect();
+        for impact in &run.impacts {
+            // Every impact has a ball; the other body is a ball of the same damper or a wall.
+            let (ball, wall) = match (impact.a, impact.b) {
+                (Body::Ball(i), Body::Ball(_)) => (i, false),
+                (Body::Ball(i), _) | (_, Body::Ball(i)) => (i, true),
+                _ => continue,
+            };
+            let d = &mut out[scene.damper_of(ball)];
+            d.impacts += 1;
+            d.wall_impacts += usize::from(wall);
+            d.impact_loss += impact.energy_lost;
+        }
+        out
+    }
+}
+
 impl RunSummary {
     /// The summary of `run`.
     pub fn of(run: &Run) -> Self {
@@ -172,6 +229,7 @@ impl RunSummary {
             series_every: (run.series.every > 1).then_some(run.series.every),
             floors: FloorSummary::of(&run.series),
             floors_without_damper: vec![],
+            dampers: vec![],
             stop: None,
         }
     }

@@ -15,6 +15,17 @@ pub use options::{Budget, Limits, Meter, Progress, RunOptions};
 use crate::run::Run;
 use crate::scene::Scene;
 
+/// Why a model that carries one damper cannot run `scene`, when it has several.
+pub fn one_damper(scene: &Scene) -> Result<(), String> {
+    if !scene.has_several_dampers() {
+        return Ok(());
+    }
+    Err(format!(
+        "the scene has {} dampers; this model carries one damper (the compliant model runs several; give one [[damper]] to run here)",
+        scene.dampers.len()
+    ))
+}
+
 /// A model of the damper.
 pub trait Simulator: Sync {
     /// Which model this is.

@@ -83,6 +83,22 @@ pub fn text_summary(s: &RunSummary) -> String {
         e.balance_error,
         noise_line(&s.noise),
     ) + &floors_table(s)
+        + &dampers_table(s)
+}
+
+/// Each damper's impacts and losses, when the run has several.
+fn dampers_table(s: &RunSummary) -> String {
+    if s.dampers.is_empty() {
+        return String::new();
+    }
+    let mut out = String::from("damper  floor  balls  impacts  on walls  impact loss (J)\n");
+    for d in &s.dampers {
+        out += &format!(
+            "{:<6}  {:>5}  {:>5}  {:>7}  {:>8}  {:>15.6e}\n",
+            d.damper, d.floor, d.balls, d.impacts, d.wall_impacts, d.impact_loss
+        );
+    }
+    out
 }
 
 /// A structure's floors, with and without the damper when both are known.

@@ -241,6 +241,7 @@ mod tests {
             compliant: Default::default(),
             forcing: None,
             structure: None,
+            dampers: vec![],
         }
     }
 

@@ -91,6 +91,7 @@ impl Simulator for Reference {
     }
 
     fn supports(&self, scene: &Scene) -> Result<(), String> {
+        crate::model::one_damper(scene)?;
         if runs_in_space(scene) {
             spatial::refusal(scene).map_or(Ok(()), Err)
         } else {

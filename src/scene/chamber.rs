@@ -2,7 +2,7 @@
 //! the container's axis): its walls and the dividers between chains, and the gap and normal
 //! from a ball to each of them, stated once for every model that moves balls off their lines.
 
-use super::{Body, Scene};
+use super::{Body, Damper, Scene};
 
 /// A wall of the container, or a divider between chains `k - 1` and `k`.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
@@ -61,16 +61,25 @@ pub struct Chamber {
 const DIVIDER_FRACTION: f64 = 0.01;
 
 impl Chamber {
-    /// The inside of `scene`'s container, or why it has none beyond a line.
+    /// The inside of `scene`'s container (its first damper's), or why it has none beyond a
+    /// line.
     pub fn new(scene: &Scene) -> Result<Chamber, String> {
-        let Some(c) = scene.container else { return Err("the scene has no container".into()) };
-        let [width, height] = scene.space.section;
+        match scene.damper_list().first() {
+            Some(d) => Chamber::of_damper(scene, d),
+            None => Err("the scene has no container".into()),
+        }
+    }
+
+    /// The inside of damper `d`'s container, or why it has none beyond a line.
+    pub fn of_damper(scene: &Scene, d: &Damper) -> Result<Chamber, String> {
+        let [width, height] = d.section;
         if !(width > 0.0 && height > 0.0) {
             return Err("the scene gives the container no cross-section (width and height)".into());
         }
-        let chains = scene.space.chains().max(1);
-        let channel = if chains > 1 { scene.space.channel } else { width };
-        let largest_radius = scene.balls.iter().map(|b| b.radius).fold(0.0, f64::max);
+        let starts = &scene.space.chain_starts;
+        let chains = starts.iter().filter(|&&s| d.balls.contains(&s)).count().max(1);
+        let channel = if chains > 1 { d.channel } else { width };
+        let largest_radius = scene.balls[d.balls.clone()].iter().map(|b| b.radius).fold(0.0, f64::max);
         // A divider fits in what the balls leave of their channels, each side half of it.
         let divider_half_thickness = (DIVIDER_FRACTION * channel).min(0.25 * (channel - 2.0 * largest_radius));
         if chains > 1 && divider_half_thickness <= 1e-6 * channel {
@@ -79,7 +88,7 @@ impl Chamber {
                 super::human(channel)
             ));
         }
-        Ok(Chamber { length: c.length, width, height, chains, channel, divider_half_thickness, largest_radius })
+        Ok(Chamber { length: d.container.length, width, height, chains, channel, divider_half_thickness, largest_radius })
     }
 
     /// The length of the inside's diagonal, m: the farthest a ball can fall or be thrown in it.

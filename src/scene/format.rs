@@ -47,6 +47,29 @@ pub struct SceneFile {
     /// Explicit balls, one `[[ball]]` table each.
     #[serde(rename = "ball")]
     pub explicit_balls: Option<Vec<ExplicitBallFile>>,
+    /// Several dampers, one `[[damper]]` table each, instead of one `[container]` with its
+    /// balls.
+    #[serde(rename = "damper")]
+    pub dampers: Option<Vec<DamperFile>>,
+}
+
+/// `[[damper]]`: one of several dampers, a container with its own balls (given as the scene
+/// gives one damper's: `[damper.balls]`, `[damper.bed]` or `[[damper.ball]]`, with
+/// `[damper.container]`) on a floor of its choice. `[world]` acts on all of them.
+#[derive(Debug, Clone, Deserialize, Serialize, Default)]
+#[serde(deny_unknown_fields)]
+pub struct DamperFile {
+    /// The floor that carries it, 1 at the bottom (default the top floor; 1 on a `[frame]`).
+    pub floor: Option<u32>,
+    /// Its container.
+    pub container: Option<ContainerFile>,
+    /// Its balls on a line, as `[balls]`.
+    pub balls: Option<BallsFile>,
+    /// Its generated bed, as `[bed]`.
+    pub bed: Option<BedFile>,
+    /// Its balls placed by hand, as `[[ball]]`.
+    #[serde(rename = "ball")]
+    pub explicit_balls: Option<Vec<ExplicitBallFile>>,
 }
 
 /// `[container]`: the container's inner size. Its axis (y = z = 0) runs along the frame's

@@ -2,6 +2,7 @@
 //! Every model receives a [`Scene`] that is already known to be valid (docs/MODEL.md §1-2, §8).
 
 mod chamber;
+mod dampers;
 mod excitation;
 pub mod format;
 mod geometry;
@@ -19,6 +20,7 @@ mod validator;
 use std::path::{Path, PathBuf};
 
 pub use chamber::{Chamber, Wall};
+pub use dampers::Damper;
 pub use excitation::Forcing;
 pub use format::{Arrangement, Distribution, ForcingKind, Length, SceneFile, Stepping};
 pub use geometry::{ball_radius, pair_bodies, pair_gap, pair_range, Ball, BallKind, Body, Container, Pairs};
@@ -113,6 +115,10 @@ pub struct Scene {
     /// A structure of several storeys or a ground-motion record, which `frame` alone cannot
     /// describe; `None` for a frame in free vibration or under a sine.
     pub structure: Option<std::sync::Arc<Structure>>,
+    /// Every damper, each with its container, balls and floor, when the scene carries more
+    /// than one; empty for one damper, which `container`, `space` and the structure's `floor`
+    /// describe (and which they describe as the first of several).
+    pub dampers: Vec<Damper>,
 }
 
 impl Scene {
@@ -149,9 +155,9 @@ impl Scene {
     /// has none, so a bed at rest has only its pile's height (docs/MODEL.md §6).
     pub fn height_energy(&self, i: usize, p: [f64; 3]) -> f64 {
         let g = self.space.gravity;
-        let (radius, start) = (self.balls[i].radius, self.space.lateral_of(i));
+        let (radius, start, section) = (self.balls[i].radius, self.space.lateral_of(i), self.section_of(i));
         let across = |a: usize| {
-            let half = 0.5 * self.space.section[a - 1];
+            let half = 0.5 * section[a - 1];
             // A scene on one line has no walls across: its balls stay where they start.
             let lowest = if half <= 0.0 {
                 start[a - 1]
@@ -242,13 +248,14 @@ impl Scene {
     /// initial displacement or the largest ball's radius, whichever is largest, and at least a
     /// nanometre. Models scale their length tolerances by it.
     pub fn length_scale(&self) -> f64 {
-        let extent = match (self.container, self.initial_positions.first(), self.initial_positions.last()) {
-            (Some(c), _, _) => c.length,
+        let extent = match (self.longest_container(), self.initial_positions.first(), self.initial_positions.last()) {
+            (Some(length), _, _) => length,
             (None, Some(a), Some(b)) => b - a,
             _ => 0.0,
         };
         let largest = self.balls.iter().map(|b| b.radius).fold(0.0, f64::max);
-        let across = self.space.section[0].max(self.space.section[1]);
+        let across =
+            self.dampers.iter().map(|d| d.section).fold(self.space.section[0].max(self.space.section[1]), |m, [w, h]| m.max(w).max(h));
         extent.max(self.initial_displacement.abs()).max(largest).max(across).max(1e-9)
     }
 
@@ -272,7 +279,7 @@ impl Scene {
         if self.space.gravity == [0.0; 3] {
             return 0.0;
         }
-        let along = self.space.gravity[0].abs() * self.container.map_or(0.0, |c| c.length);
+        let along = self.space.gravity[0].abs() * self.longest_container().unwrap_or(0.0);
         (0..self.balls.len())
             .map(|i| {
                 let [y, z] = self.space.lateral_of(i);
@@ -388,6 +395,7 @@ impl Scene {
             initial_positions: vec![],
             initial_velocities: vec![],
             space: Space::line(0),
+            dampers: vec![],
             ..self.clone()
         }
     }

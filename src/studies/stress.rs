@@ -401,11 +401,19 @@ pub fn judge(model: Model, scene: &Scene, run: &Run) -> Result<(), Failure> {
     }
     // Balls on lines can be checked pair by pair along x; a bed's balls only against the walls.
     let on_lines = scene.space.beyond_lines(&scene.initial_positions).is_none();
-    if let Some(c) = scene.container {
+    let dampers = scene.damper_list();
+    if !dampers.is_empty() {
         let tol = checks.wall_overlap;
+        // Each damper's container moves with its floor (the series' carrying floor for one).
+        let floor_at = |i: usize, k: usize| {
+            let floor = dampers[scene.damper_of(i)].floor;
+            let own = scene.has_several_dampers().then(|| s.floor(floor, k)).flatten();
+            own.map_or(s.xs()[k], |f| f.0)
+        };
         for k in 0..s.len() {
             for (i, b) in scene.balls.iter().enumerate() {
-                let (lo, hi) = (s.x(i)[k] - b.radius - s.xs()[k], s.xs()[k] + c.length - s.x(i)[k] - b.radius);
+                let (xs, c) = (floor_at(i, k), dampers[scene.damper_of(i)].container);
+                let (lo, hi) = (s.x(i)[k] - b.radius - xs, xs + c.length - s.x(i)[k] - b.radius);
                 if lo < -tol || hi < -tol {
                     return fail("outside", format!("ball{} outside the container by {:e} m at t = {}", i + 1, -lo.min(hi), s.t()[k]));
                 }

@@ -73,6 +73,7 @@ fn ball_in_frame(frame: Frame, xs0: f64, m: f64, v: f64, clearance: f64, e: f64,
         compliant: CompliantSettings::default(),
         forcing: None,
         structure: None,
+        dampers: vec![],
     }
 }
 

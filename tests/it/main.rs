@@ -28,6 +28,7 @@ mod rapier_model;
 mod rapier_space;
 mod render;
 mod settled_beds;
+mod several_dampers;
 mod spatial_reference;
 mod stability_map;
 mod sticking;

@@ -15,13 +15,17 @@ impl Solver<'_> {
             self.open[i].iter_mut().for_each(|c| c.seen = false);
         }
         // On a structure the floors' own forces act in their step; here the walls' alone.
-        self.frame_force = if self.floors.is_some() { 0.0 } else { self.scene.frame_force(self.t, self.xs, self.vs) };
+        self.wall_forces.fill(0.0);
+        if self.floors.is_none() {
+            self.wall_forces[0] = self.scene.frame_force(self.t, self.xs, self.vs);
+        }
         self.stiffness_rate = 0.0;
         self.damping_rate = 0.0;
-        let xs = self.xs;
         let moved = (0..n).any(|i| {
             let d: [f64; 3] = std::array::from_fn(|k| self.x[i][k] - self.listed_at[i][k]);
-            (d[0] - (xs - self.listed_xs)).powi(2) + d[1] * d[1] + d[2] * d[2] > 0.25 * self.skin * self.skin
+            let damper = self.damper[i] as usize;
+            let floor_moved = self.carried[damper].0 - self.listed_carried[damper];
+            (d[0] - floor_moved).powi(2) + d[1] * d[1] + d[2] * d[2] > 0.25 * self.skin * self.skin
         });
         if moved || self.steps == 0 {
             self.list_candidates();
@@ -38,8 +42,9 @@ impl Solver<'_> {
         for k in 0..self.wall_candidates.len() {
             let (i, wall) = self.wall_candidates[k];
             let i = i as usize;
-            let local = [self.x[i][0] - xs, self.x[i][1], self.x[i][2]];
-            let (gap, normal) = self.chamber.gap(wall, local, self.radius[i]);
+            let damper = self.damper[i] as usize;
+            let local = [self.x[i][0] - self.carried[damper].0, self.x[i][1], self.x[i][2]];
+            let (gap, normal) = self.chambers[damper].gap(wall, local, self.radius[i]);
             if gap < 0.0 {
                 self.wall_contact(i, wall, -gap, normal, h);
             }
@@ -60,30 +65,37 @@ impl Solver<'_> {
     /// Lists the pairs and walls that may touch before some ball moves half the skin from
     /// where it is now (relative to the container): those closer than the skin now.
     pub(super) fn list_candidates(&mut self) {
-        let (xs, skin) = (self.xs, self.skin);
-        let x = &self.x;
-        self.cells.rebuild(|i| [x[i][0] - xs, x[i][1], x[i][2]]);
+        let skin = self.skin;
+        let (x, damper, carried, offsets) = (&self.x, &self.damper, &self.carried, &self.offsets);
+        self.cells.rebuild(|i| {
+            let d = damper[i] as usize;
+            [x[i][0] - carried[d].0 + offsets[d], x[i][1], x[i][2]]
+        });
         self.ball_candidates.clear();
         self.wall_candidates.clear();
         for i in 0..self.n {
-            let (xi, ri) = (self.x[i], self.radius[i]);
+            let (xi, ri, di) = (self.x[i], self.radius[i], self.damper[i]);
             let (x, radius, list) = (&self.x, &self.radius, &mut self.ball_candidates);
             self.cells.neighbours(i, |j| {
                 let d: [f64; 3] = std::array::from_fn(|k| x[j][k] - xi[k]);
                 let reach = ri + radius[j] + skin;
-                if dot(d, d) < reach * reach {
+                // Balls of two dampers are in two containers, on floors that move apart.
+                if dot(d, d) < reach * reach && damper[j] == di {
                     list.push((i as u32, j as u32));
                 }
             });
-            let local = [xi[0] - xs, xi[1], xi[2]];
-            for wall in self.chamber.walls_near(local) {
-                if self.chamber.gap(wall, local, ri).0 < skin {
+            let chamber = &self.chambers[di as usize];
+            let local = [xi[0] - self.carried[di as usize].0, xi[1], xi[2]];
+            for wall in chamber.walls_near(local) {
+                if chamber.gap(wall, local, ri).0 < skin {
                     self.wall_candidates.push((i as u32, wall));
                 }
             }
         }
         self.listed_at.copy_from_slice(&self.x);
-        self.listed_xs = xs;
+        for (listed, (x, _)) in self.listed_carried.iter_mut().zip(&self.carried) {
+            *listed = *x;
+        }
     }
 
     /// The contact of balls `i < j` whose centres are closer than their radii's sum.
@@ -121,20 +133,21 @@ impl Solver<'_> {
     /// The contact of ball `i` with `wall`, overlapping it by `overlap` along `normal` (from
     /// the ball towards the wall).
     pub(super) fn wall_contact(&mut self, i: usize, wall: Wall, overlap: f64, normal: [f64; 3], h: f64) {
-        let ri = self.radius[i];
-        let u = self.wall_velocity();
+        let (ri, damper) = (self.radius[i], self.damper[i] as usize);
+        let u = self.wall_velocity(damper);
         let dv: [f64; 3] = std::array::from_fn(|k| self.v[i][k] - u[k]);
         let s = cross(std::array::from_fn(|k| ri * self.w[i][k]), normal);
         let slip_all: [f64; 3] = std::array::from_fn(|k| dv[k] + s[k]);
         let m = self.mass[i];
-        let m_star = if self.frame_mass.is_finite() { m * self.frame_mass / (m + self.frame_mass) } else { m };
+        let floor_mass = self.floor_mass[damper];
+        let m_star = if floor_mass.is_finite() { m * floor_mass / (m + floor_mass) } else { m };
         let r_star = contact::effective_radius(ri, None);
         let other = wall_index(self.n, wall);
         let (f_n, f_t) = self.contact_force(i, other, Some(wall), r_star, m_star, overlap, dot(dv, normal), slip_all, normal, h);
         for k in 0..3 {
             self.force[i][k] += -f_n * normal[k] + f_t[k];
         }
-        self.frame_force -= -f_n * normal[0] + f_t[0];
+        self.wall_forces[self.carrier_floor[damper]] -= -f_n * normal[0] + f_t[0];
         let ti = cross(std::array::from_fn(|k| ri * normal[k]), f_t);
         for k in 0..3 {
             self.torque[i][k] += ti[k];

@@ -31,19 +31,24 @@ impl<'a> Floors<'a> {
 
     /// The carrying floor's absolute displacement and velocity at `t`.
     pub(super) fn carrying(&self, scene: &Scene, t: f64) -> (f64, f64) {
+        self.at(scene, t, self.structure.floor)
+    }
+
+    /// Floor `j`'s absolute displacement and velocity at `t`.
+    pub(super) fn at(&self, scene: &Scene, t: f64, j: usize) -> (f64, f64) {
         let (xg, vg, _) = scene.ground_motion(t);
-        let d = self.structure.floor;
-        (xg + self.u[d], vg + self.v[d])
+        (xg + self.u[j], vg + self.v[j])
     }
 
     /// Each floor's acceleration relative to the ground at `t`: the storeys' springs and
-    /// dampers, a sine force and the balls' contact force `contact` on the carrying floor, a
-    /// recorded force on its floor, less the ground's acceleration.
-    fn accelerations(&self, scene: &Scene, t: f64, contact: f64) -> Vec<f64> {
+    /// dampers, a sine force on the carrying floor, the balls' contact forces `contact` on
+    /// each floor, a recorded force on its floor, less the ground's acceleration.
+    fn accelerations(&self, scene: &Scene, t: f64, contact: &[f64]) -> Vec<f64> {
         let (_, _, ag) = scene.ground_motion(t);
-        let d = self.structure.floor;
         let mut a = scene.floor_accelerations(t, &self.u, &self.v);
-        a[d] += contact / self.structure.building.masses[d];
+        for (j, f) in contact.iter().enumerate() {
+            a[j] += f / self.structure.building.masses[j];
+        }
         a.iter_mut().for_each(|a| *a -= ag);
         a
     }
@@ -61,7 +66,7 @@ impl<'a> Floors<'a> {
 
     /// The first half of a step of `h` from `t0`: the half kick and the drift, and the
     /// velocities predicted at the step's end (for the dampers' forces there).
-    pub(super) fn kick_and_drift(&mut self, scene: &Scene, t0: f64, h: f64, contact: f64) {
+    pub(super) fn kick_and_drift(&mut self, scene: &Scene, t0: f64, h: f64, contact: &[f64]) {
         let a = self.accelerations(scene, t0, contact);
         for j in 0..self.u.len() {
             self.v_half[j] = self.v[j] + 0.5 * h * a[j];
@@ -72,7 +77,7 @@ impl<'a> Floors<'a> {
 
     /// The second half kick of a step of `h` ending at `t1`, with the contact force there, and
     /// the powers at its end.
-    pub(super) fn kick(&mut self, scene: &Scene, t1: f64, h: f64, contact: f64) {
+    pub(super) fn kick(&mut self, scene: &Scene, t1: f64, h: f64, contact: &[f64]) {
         let a = self.accelerations(scene, t1, contact);
         for j in 0..self.u.len() {
             self.v[j] = self.v_half[j] + 0.5 * h * a[j];

@@ -44,10 +44,15 @@ const BUDGET_STEPS: u64 = 1024;
 
 /// Why the spatial compliant model cannot run `scene`, or `None` when it can.
 pub(super) fn refusal(scene: &Scene) -> Option<String> {
-    if scene.container.is_none() {
+    let dampers = scene.damper_list();
+    if dampers.is_empty() {
         return Some("the scene's balls leave their lines but it has no container".into());
     }
-    Chamber::new(scene).err()
+    let several = dampers.len() > 1;
+    dampers
+        .iter()
+        .enumerate()
+        .find_map(|(k, d)| Chamber::of_damper(scene, d).err().map(|why| if several { format!("damper[{k}]: {why}") } else { why }))
 }
 
 /// The longest step at which an impact at closing speed `speed` takes [`STEPS_PER_CONTACT`]
@@ -101,7 +106,18 @@ struct Open {
 /// The spatial compliant model's run of one scene.
 struct Solver<'a> {
     scene: &'a Scene,
-    chamber: Chamber,
+    /// Each damper's container.
+    chambers: Vec<Chamber>,
+    /// The damper each ball is in.
+    damper: Vec<u32>,
+    /// Where each damper's container starts along x in the cells' frame: the containers lie
+    /// end to end there, far enough apart that balls of two dampers are never neighbours.
+    offsets: Vec<f64>,
+    /// The floor that carries each damper (0 on a frame), and its mass, kg.
+    carrier_floor: Vec<usize>,
+    floor_mass: Vec<f64>,
+    /// Each damper's floor: its displacement and velocity, m and m/s.
+    carried: Vec<(f64, f64)>,
     cells: Cells,
     n: usize,
     x: Vec<[f64; 3]>,
@@ -119,18 +135,19 @@ struct Solver<'a> {
     /// Pairs of balls and balls and walls closer than the skin when last listed.
     ball_candidates: Vec<(u32, u32)>,
     wall_candidates: Vec<(u32, Wall)>,
-    /// Where the balls and the frame were when the candidates were listed.
+    /// Where the balls and each damper's floor were when the candidates were listed.
     listed_at: Vec<[f64; 3]>,
-    listed_xs: f64,
+    listed_carried: Vec<f64>,
     /// How much closer than touching a pair must be to be listed, m.
     skin: f64,
     /// Open contacts, listed with the ball of lower index.
     open: Vec<Vec<Open>>,
+    /// The frame's (or the first damper's floor's) displacement and velocity.
     xs: f64,
     vs: f64,
-    /// Force on the frame: its spring, damper and excitation, and the walls' contacts, N (on a
-    /// structure's floor, the walls' contacts alone).
-    frame_force: f64,
+    /// Force on each floor beyond the structure's own: the walls' contacts of the dampers it
+    /// carries, N; on a frame (one floor) also its spring, damper and excitation.
+    wall_forces: Vec<f64>,
     /// A structure's floors, when the container rides one.
     floors: Option<Floors<'a>>,
     frame_mass: f64,
@@ -262,14 +279,25 @@ fn gravity_exchange(scene: &Scene, run: &Run) -> f64 {
 
 impl<'a> Solver<'a> {
     fn new(scene: &'a Scene) -> Result<Self, String> {
-        let chamber = Chamber::new(scene)?;
+        let dampers = scene.damper_list();
+        let chambers = dampers.iter().map(|d| Chamber::of_damper(scene, d)).collect::<Result<Vec<_>, _>>()?;
         let n = scene.balls.len();
-        let [width, height] = scene.space.section;
+        let mut damper = vec![0u32; n];
+        for (k, d) in dampers.iter().enumerate() {
+            damper[d.balls.clone()].fill(k as u32);
+        }
         let largest = scene.balls.iter().map(|b| b.radius).fold(0.0, f64::max);
         let smallest = scene.balls.iter().map(|b| b.radius).fold(f64::INFINITY, f64::min).min(largest);
         let skin = SKIN_RADII * smallest;
         // Listed pairs may be a skin apart: the cells are as wide as that reach.
-        let cells = Cells::new([chamber.length, width, height], 2.0 * largest + skin, n);
+        let reach = 2.0 * largest + skin;
+        let mut offsets = Vec::with_capacity(chambers.len());
+        let mut inside = [0.0f64; 3];
+        for c in &chambers {
+            offsets.push(if inside[0] > 0.0 { inside[0] + 2.0 * reach } else { 0.0 });
+            inside = [offsets[offsets.len() - 1] + c.length, inside[1].max(c.width), inside[2].max(c.height)];
+        }
+        let cells = Cells::new(inside, reach, n);
         let mass: Vec<f64> = scene.balls.iter().map(|b| b.mass).collect();
         let radius: Vec<f64> = scene.balls.iter().map(|b| b.radius).collect();
         let e_star = contact::effective_modulus(&scene.compliant);
@@ -288,7 +316,7 @@ impl<'a> Solver<'a> {
         let stiffest = (0..n).map(|i| 0.5 * mass[i] / contact::stiffness(e_star, radius[i])).fold(f64::INFINITY, f64::min);
         let g = dot(scene.space.gravity, scene.space.gravity).sqrt();
         // The fastest closing the scene sets going, or gravity across the container's diagonal.
-        let diagonal = chamber.diagonal();
+        let diagonal = chambers.iter().map(Chamber::diagonal).fold(0.0, f64::max);
         let design_speed = (2.0 * scene.speed_scale()).max((2.0 * g * diagonal).sqrt()).max(f64::MIN_POSITIVE);
         let mut h_max = scene.horizon;
         if let Some(f) = scene.frame.filter(|f| f.stiffness > 0.0) {
@@ -303,10 +331,27 @@ impl<'a> Solver<'a> {
             h_max = h_max.min(FRAME_PERIOD_FRACTION * 2.0 * std::f64::consts::PI / fastest);
         }
         let (xs, vs) = floors.as_ref().map_or((scene.initial_displacement, 0.0), |f| f.carrying(scene, 0.0));
+        let carrier_floor: Vec<usize> = dampers.iter().map(|d| d.floor).collect();
+        let frame_mass = scene.frame.map_or(f64::INFINITY, |f| f.mass);
+        let floor_mass = match &floors {
+            Some(f) => carrier_floor.iter().map(|&j| f.structure.building.masses[j]).collect(),
+            None => vec![frame_mass; dampers.len()],
+        };
+        let carried = match &floors {
+            Some(f) => carrier_floor.iter().map(|&j| f.at(scene, 0.0, j)).collect(),
+            None => vec![(xs, vs); dampers.len()],
+        };
+        let floor_count = floors.as_ref().map_or(1, |f| f.u.len());
         let inertia = (0..n).map(|i| 0.4 * mass[i] * radius[i] * radius[i]).collect();
         let mut solver = Solver {
             scene,
-            chamber,
+            chambers,
+            damper,
+            offsets,
+            listed_carried: vec![0.0; carried.len()],
+            carrier_floor,
+            floor_mass,
+            carried,
             cells,
             n,
             start: x.clone(),
@@ -323,14 +368,13 @@ impl<'a> Solver<'a> {
             ball_candidates: Vec::new(),
             wall_candidates: Vec::new(),
             listed_at: vec![[0.0; 3]; n],
-            listed_xs: 0.0,
             skin,
             open: vec![Vec::new(); n],
             xs,
             vs,
-            frame_force: 0.0,
+            wall_forces: vec![0.0; floor_count],
             floors,
-            frame_mass: scene.frame.map_or(f64::INFINITY, |f| f.mass),
+            frame_mass,
             gravity: scene.space.gravity,
             e_star,
             friction: scene.space.friction,
@@ -361,7 +405,8 @@ impl<'a> Solver<'a> {
     /// of its linearised stiffness and half the inverse of its damping rate, which a pile's
     /// loaded contacts can exceed); within the frame's and the forcing's periods.
     fn step(&self) -> f64 {
-        let speed = self.design_speed.max(2.0 * (self.fastest + self.vs.abs()));
+        let floor_speed = self.carried.iter().fold(0.0, |m: f64, (_, v)| m.max(v.abs()));
+        let speed = self.design_speed.max(2.0 * (self.fastest + floor_speed));
         let mut h = self.h_max;
         if self.stiffest.is_finite() {
             h = h.min(step_for(self.stiffest, speed));
@@ -375,8 +420,21 @@ impl<'a> Solver<'a> {
         h
     }
 
-    fn wall_velocity(&self) -> [f64; 3] {
-        [if self.frame_mass.is_finite() { self.vs } else { 0.0 }, 0.0, 0.0]
+    /// The velocity of damper `d`'s walls.
+    fn wall_velocity(&self, d: usize) -> [f64; 3] {
+        [if self.frame_mass.is_finite() { self.carried[d].1 } else { 0.0 }, 0.0, 0.0]
+    }
+
+    /// Each damper's floor now, from the frame's state or the floors'.
+    fn carry(&mut self) {
+        match &self.floors {
+            Some(f) => {
+                for (d, &j) in self.carrier_floor.iter().enumerate() {
+                    self.carried[d] = f.at(self.scene, self.t, j);
+                }
+            }
+            None => self.carried.fill((self.xs, self.vs)),
+        }
     }
 
     /// One velocity Verlet step of length `h`: a half kick, a drift, the forces at the new
@@ -386,7 +444,7 @@ impl<'a> Solver<'a> {
         let (t0, xs0, vs0) = (self.t, self.xs, self.vs);
         let scene = self.scene;
         let half = 0.5 * h;
-        let frame_a = if self.frame_mass.is_finite() { self.frame_force / self.frame_mass } else { 0.0 };
+        let frame_a = if self.frame_mass.is_finite() && self.floors.is_none() { self.wall_forces[0] / self.frame_mass } else { 0.0 };
         for i in 0..self.n {
             let (im, ii) = (1.0 / self.mass[i], 1.0 / self.inertia[i]);
             for k in 0..3 {
@@ -398,15 +456,15 @@ impl<'a> Solver<'a> {
             }
         }
         let vs_half = self.vs + half * frame_a;
-        let contact = self.frame_force;
         if let Some(f) = &mut self.floors {
-            f.kick_and_drift(scene, t0, h, contact);
+            f.kick_and_drift(scene, t0, h, &self.wall_forces);
             (self.xs, self.vs) = f.carrying(scene, t0 + h);
         } else {
             self.xs += h * vs_half;
             self.vs = vs_half + half * frame_a;
         }
         self.t = t0 + h;
+        self.carry();
         self.forces(h);
         let mut fastest_squared = 0.0f64;
         for i in 0..self.n {
@@ -418,21 +476,21 @@ impl<'a> Solver<'a> {
             fastest_squared = fastest_squared.max(dot(self.v[i], self.v[i]));
         }
         self.fastest = fastest_squared.sqrt();
-        let contact = self.frame_force;
         if let Some(f) = &mut self.floors {
             let (d0, w0) = f.powers_now;
-            f.kick(scene, self.t, h, contact);
+            f.kick(scene, self.t, h, &self.wall_forces);
             (self.xs, self.vs) = f.carrying(scene, self.t);
             let (d1, w1) = f.powers_now;
             self.damping_loss += half * (d0 + d1);
             self.forcing_work += half * (w0 + w1);
         } else {
             if self.frame_mass.is_finite() {
-                self.vs = vs_half + half * self.frame_force / self.frame_mass;
+                self.vs = vs_half + half * self.wall_forces[0] / self.frame_mass;
             }
             self.damping_loss += half * (scene.damping_power(t0, vs0) + scene.damping_power(self.t, self.vs));
             self.forcing_work += half * (scene.forcing_power(t0, xs0, vs0) + scene.forcing_power(self.t, self.xs, self.vs));
         }
+        self.carry();
         self.steps += 1;
     }
 
@@ -525,7 +583,8 @@ impl<'a> Solver<'a> {
     /// Energy gravity can give the balls falling across the container, J.
     fn gravity_allowance(&self) -> f64 {
         let g = dot(self.gravity, self.gravity).sqrt();
-        self.mass.iter().sum::<f64>() * g * self.chamber.diagonal()
+        let diagonal = self.chambers.iter().map(Chamber::diagonal).fold(0.0, f64::max);
+        self.mass.iter().sum::<f64>() * g * diagonal
     }
 
     /// The run so far, ended at the current time; open contacts stay out of the impacts.

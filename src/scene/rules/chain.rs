@@ -76,6 +76,7 @@ pub(in crate::scene) fn build_chain(
                     reference_radius: rr,
                     space: Space::line(balls_len),
                     structure: None,
+                    dampers: vec![],
                 },
             });
         }

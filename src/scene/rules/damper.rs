@@ -67,6 +67,7 @@ pub(in crate::scene) fn build_frame_damper(f: &SceneFile, name: &str, v: &Valida
             reference_radius: 0.0,
             space: Space::line(0),
             structure: None,
+            dampers: vec![],
         });
     };
     if world.restitution.is_some() {
@@ -136,6 +137,7 @@ pub(in crate::scene) fn build_frame_damper(f: &SceneFile, name: &str, v: &Valida
         forcing,
         reference_radius: rr,
         structure: None,
+        dampers: vec![],
     })
 }
 
@@ -316,6 +318,7 @@ fn placed_damper(f: &SceneFile, name: &str, v: &Validator, frame: Frame, world: 
         reference_radius: largest,
         space,
         structure: None,
+        dampers: vec![],
     })
 }
 

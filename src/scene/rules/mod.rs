@@ -22,6 +22,7 @@ use tolerances::tolerances;
 mod carrier;
 mod chain;
 mod damper;
+mod dampers;
 mod excitation;
 mod settings;
 mod tolerances;
@@ -35,6 +36,9 @@ pub fn from_file(parsed: SceneFile, file: &str, default_name: &str) -> Result<Lo
     let name = parsed.name.clone().unwrap_or_else(|| default_name.to_string());
     if parsed.chain.is_some() && (parsed.frame.is_some() || parsed.balls.is_some()) {
         return Err(v.err("chain", "cannot be combined with [frame] or [balls]: a chain file describes only the KER experiment"));
+    }
+    if parsed.chain.is_some() && parsed.dampers.is_some() {
+        return Err(v.err("chain", "cannot be combined with [[damper]]: a chain file describes only the KER experiment"));
     }
     if parsed.chain.is_some() && parsed.structure.is_some() {
         return Err(v.err("chain", "cannot be combined with [structure]: a chain file describes only the KER experiment"));
@@ -86,6 +90,9 @@ pub fn from_file(parsed: SceneFile, file: &str, default_name: &str) -> Result<Lo
 }
 
 pub(super) fn build_damper(f: &SceneFile, name: &str, v: &Validator) -> Result<Scene, SceneError> {
+    if let Some(list) = &f.dampers {
+        return dampers::build_dampers(f, list, name, v);
+    }
     let record = match &f.forcing {
         Some(g) if g.kind == ExcitationKind::Record => Some(Arc::new(ground_record(g, "record", &["file", "scale"], v)?)),
         Some(g) if g.kind == ExcitationKind::Random => {

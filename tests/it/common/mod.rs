@@ -116,6 +116,7 @@ pub fn damper(frame: Frame, xs0: f64, masses: &[f64], e: f64, gap: f64, clearanc
         compliant: Default::default(),
         forcing: None,
         structure: None,
+        dampers: vec![],
     }
 }
 
@@ -144,6 +145,7 @@ pub fn free_chain(balls: Vec<Ball>, gaps: &[f64], speeds: &[f64], e: f64, horizo
         compliant: Default::default(),
         forcing: None,
         structure: None,
+        dampers: vec![],
     }
 }
 

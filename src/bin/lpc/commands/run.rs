@@ -87,6 +87,7 @@ pub fn run(a: Args) -> Result<ExitStatus> {
         Err(e) => return Err(stopped(&a, e)),
     };
     let mut summary = RunSummary::of(&run);
+    summary.dampers = lpc_damper::metrics::DamperSummary::of(&scene, &run);
     if scene.structure.is_some() && !scene.balls.is_empty() {
         // The structure alone, for the floors' response without the damper.
         let bare = a.model.simulate(&scene.without_damper(), &RunOptions::limited(limits))?;

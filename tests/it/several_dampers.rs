@@ -1,0 +1,175 @@
+//! Several dampers on one structure (docs/MODEL.md §18): each container's balls push their own
+//! floor, a damper that touches nothing leaves the others' run as it was, one `[[damper]]` is
+//! the scene of today's format, and what a model or a picture cannot carry is refused with
+//! the reason.
+
+use lpc_damper::metrics::DamperSummary;
+use lpc_damper::model::{Model, RunOptions};
+use lpc_damper::run::Run;
+use lpc_damper::scene::{parse, Scene, SceneError};
+use lpc_damper::studies::stress::judge;
+
+use crate::common::lpc;
+
+/// The three-storey building of scenes/mdof-3storey-record.toml swinging freely from a
+/// displaced start, with `more` after it (the damper tables, or a damper floor). Friction has
+/// nothing to act on between balls on one axis; it sends one damper down the spatial path that
+/// carries several, so that the two are the same arithmetic.
+fn building(more: &str) -> String {
+    format!(
+        "[structure]\nmasses = [1.35, 1.35, 1.35]\nstiffnesses = [4364.0, 4364.0, 4364.0]\n\
+         damping_ratios = [0.016, 0.016, 0.016]\ninitial_displacements = [0.005, 0.01, 0.015]\n{more}\
+         [world]\nrestitution = 0.6\nfriction = 0.1\n\
+         [compliant]\nyoungs_modulus = 2e9\n\
+         [run]\nhorizon = 0.5\nsample_dt = 0.001\n"
+    )
+}
+
+/// Three 4 g balls of 5 mm in a 6 cm box, on its axis, the middle one moving: the box's walls
+/// and the balls strike each other as the floor swings. `prefix` is `""` for the scene's one
+/// damper and `"damper."` inside a `[[damper]]`.
+fn three_balls(prefix: &str) -> String {
+    let ball = |x: f64, vx: f64| {
+        format!("[[{prefix}ball]]\nposition = [{x}, 0.0, 0.0]\nmass = 0.004\nradius = 0.005\nvelocity = [{vx}, 0.0, 0.0]\n")
+    };
+    format!("[{prefix}container]\nlength = 0.06\nwidth = 0.04\nheight = 0.04\n{}{}{}", ball(0.01, 0.0), ball(0.03, 0.3), ball(0.05, 0.0))
+}
+
+/// One ball at rest in the middle of a half-metre box: the floor's swing of centimetres never
+/// brings a wall to it, and nothing else acts on it.
+const IDLE_DAMPER: &str = "[damper.container]\nlength = 0.5\nwidth = 0.04\nheight = 0.04\n\
+                           [[damper.ball]]\nposition = [0.25, 0.0, 0.0]\nmass = 0.004\nradius = 0.005\n";
+
+fn scene(text: &str) -> Scene {
+    parse(text, "dampers.toml", "dampers").unwrap_or_else(|e| panic!("{e}")).scene.unwrap()
+}
+
+fn invalid(text: &str) -> (String, String) {
+    match parse(text, "dampers.toml", "dampers") {
+        Err(SceneError::Invalid { field, rule, .. }) => (field, rule),
+        other => panic!("expected an invalid field, got {:?}", other.map(|l| l.scene.map(|s| s.name))),
+    }
+}
+
+fn compliant(scene: &Scene) -> Run {
+    let run = Model::Compliant.simulate(scene, &RunOptions::default()).unwrap_or_else(|e| panic!("{e}"));
+    judge(Model::Compliant, scene, &run).unwrap_or_else(|f| panic!("{} {}", f.check, f.detail));
+    run
+}
+
+/// A damper whose balls touch nothing exchanges nothing with its floor: the other damper's run
+/// on floor 2 is the run of that damper alone on floor 2, every floor and ball to round-off,
+/// with the idle damper listed first. (On another floor the idle damper's floor would set the
+/// step too: the step is fit for every wall's speed.)
+#[test]
+fn an_idle_damper_leaves_the_other_dampers_run_as_it_was() {
+    let alone = scene(&building(&format!("damper_floor = 2\n{}", three_balls(""))));
+    let with_idle = scene(&building(&format!("[[damper]]\nfloor = 2\n{IDLE_DAMPER}[[damper]]\nfloor = 2\n{}", three_balls("damper."))));
+    assert!(with_idle.has_several_dampers() && with_idle.balls.len() == 4);
+    let (a, b) = (compliant(&alone), compliant(&with_idle));
+    assert_eq!(a.series.len(), b.series.len());
+    // The floors' sums take the same forces in the same order; only the cells' grid differs.
+    let mut worst = 0.0f64;
+    for k in 0..a.series.len() {
+        for j in 0..3 {
+            let (fa, fb) = (a.series.floor(j, k).unwrap(), b.series.floor(j, k).unwrap());
+            worst = worst.max((fa.0 - fb.0).abs());
+        }
+        for i in 0..3 {
+            worst = worst.max((a.series.x(i)[k] - b.series.x(i + 1)[k]).abs());
+        }
+        assert_eq!(b.series.x(0)[k], 0.25 + 0.01, "the idle ball never moves (sample {k})");
+    }
+    assert!(worst <= 1e-12, "the floors and balls differ by {worst:e} m");
+    let dampers = DamperSummary::of(&with_idle, &b);
+    assert_eq!((dampers[0].floor, dampers[0].impacts, dampers[1].floor), (2, 0, 2));
+    assert_eq!(dampers[1].impacts, b.impact_count(), "every impact is the active damper's");
+    assert!(dampers[1].wall_impacts > 0 && dampers[1].impact_loss > 0.0);
+}
+
+/// Two dampers on two floors each push their own: the same box on floor 2 and on floor 3 of the
+/// building swinging in its first mode moves the floors as neither box alone does, and the
+/// run passes the checks the stress study applies (energy balance, balls inside their boxes).
+#[test]
+fn two_dampers_on_two_floors_each_push_their_own() {
+    let two = scene(&building(&format!("[[damper]]\nfloor = 2\n{0}[[damper]]\nfloor = 3\n{0}", three_balls("damper."))));
+    let run = compliant(&two);
+    let dampers = DamperSummary::of(&two, &run);
+    assert_eq!(dampers.iter().map(|d| d.floor).collect::<Vec<_>>(), [2, 3]);
+    assert!(dampers.iter().all(|d| d.wall_impacts > 0), "{dampers:?}");
+    assert_eq!(dampers.iter().map(|d| d.impacts).sum::<usize>(), run.impact_count());
+    for floor in [2, 3] {
+        let alone = compliant(&scene(&building(&format!("damper_floor = {floor}\n{}", three_balls("")))));
+        let gap = (0..run.series.len()).map(|k| (run.series.floor(1, k).unwrap().0 - alone.series.floor(1, k).unwrap().0).abs());
+        assert!(gap.fold(0.0, f64::max) > 1e-6, "the other box moves floor 2 too");
+    }
+}
+
+/// One `[[damper]]` is the scene the one damper of today's format describes.
+#[test]
+fn one_damper_table_is_todays_scene() {
+    let today = scene(&building(&format!("damper_floor = 2\n{}", three_balls(""))));
+    let listed = scene(&building(&format!("[[damper]]\nfloor = 2\n{}", three_balls("damper."))));
+    assert_eq!(today, listed);
+    assert!(!listed.has_several_dampers());
+}
+
+/// The models that carry one damper, and pictures, refuse several with the reason.
+#[test]
+fn one_damper_models_refuse_several_with_the_reason() {
+    let two = scene(&building(&format!("[[damper]]\nfloor = 2\n{0}[[damper]]\nfloor = 3\n{0}", three_balls("damper."))));
+    for model in [Model::Reference, Model::Rapier] {
+        let why = model.supports(&two).unwrap_err();
+        assert!(why.contains("2 dampers") && why.contains("compliant"), "{model}: {why}");
+    }
+    assert!(Model::Compliant.supports(&two).is_ok());
+}
+
+#[test]
+fn bad_damper_tables_name_the_field() {
+    let table = |floor: u32| format!("[[damper]]\nfloor = {floor}\n{}", three_balls("damper."));
+    let cases = [
+        (building(&format!("{}{}", table(2), table(4))), "damper[1].floor", "floors 1 to 3"),
+        (building(&format!("{}[[damper]]\nfloor = 1\n", table(2))), "damper[1]", "has no balls"),
+        (building(&format!("{}{}", three_balls(""), table(2))), "container", "cannot be combined with [[damper]]"),
+        (building(&format!("damper_floor = 2\n{}", table(2))), "structure.damper_floor", "each damper its `floor`"),
+        (
+            building(&format!("{}{}", table(2), table(3).replace("radius = 0.005", "radius = -0.005"))),
+            "damper[1].ball[0].radius",
+            "positive",
+        ),
+    ];
+    for (text, field, rule) in cases {
+        let (got_field, got_rule) = invalid(&text);
+        assert_eq!(got_field, field, "{got_rule}");
+        assert!(got_rule.contains(rule), "{field}: {got_rule}");
+    }
+}
+
+/// On the command line a damper on a floor that does not exist exits 2 naming the file and
+/// field, and writes nothing.
+#[test]
+fn a_damper_on_a_missing_floor_exits_2_and_writes_nothing() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("two.toml");
+    std::fs::write(&path, building(&format!("[[damper]]\nfloor = 7\n{}", three_balls("damper.")))).unwrap();
+    let out = dir.path().join("out");
+    let o = lpc(["run".as_ref(), path.as_os_str(), "--model".as_ref(), "compliant".as_ref(), "--out".as_ref(), out.as_os_str()]);
+    let stderr = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(2), "{stderr}");
+    assert!(stderr.contains("two.toml") && stderr.contains("damper[0].floor"), "{stderr}");
+    assert!(!out.exists());
+}
+
+/// The shipped two-damper scene loads as two boxes of 40 balls on floors 2 and 3, and its first
+/// 20 ms in the compliant model pass the stress checks.
+#[test]
+fn the_shipped_two_dampers_load_and_run() {
+    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/scenes/dampers-two-floors.toml");
+    let mut s = lpc_damper::scene::load_scene(&path).unwrap();
+    let floors: Vec<(usize, usize)> = s.damper_list().iter().map(|d| (d.floor + 1, d.balls.len())).collect();
+    assert_eq!(floors, [(2, 40), (3, 40)]);
+    s.horizon = 0.02;
+    let run = compliant(&s);
+    assert_eq!(run.series.floor_count(), 3);
+}
