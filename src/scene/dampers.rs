@@ -44,6 +44,15 @@ impl Scene {
         }]
     }
 
+    /// Where damper `d`'s container starts along the motion: its floor's initial displacement
+    /// (the frame's on a frame), m.
+    pub fn damper_start(&self, d: &Damper) -> f64 {
+        match &self.structure {
+            Some(s) if self.has_several_dampers() => s.initial_displacements[d.floor],
+            _ => self.initial_displacement,
+        }
+    }
+
     /// The length of the longest container, m (`None` without one).
     pub fn longest_container(&self) -> Option<f64> {
         let first = self.container?.length;

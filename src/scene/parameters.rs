@@ -2,7 +2,7 @@
 //! design space): each names itself once, says whether it is a length, sets itself in a scene
 //! file, and reads its value from a scene built from that file.
 
-use super::format::{Distribution, Length, SceneFile};
+use super::format::{BallsFile, BedFile, Distribution, Length, SceneFile};
 use super::Scene;
 
 /// Declares the parameters, each with its name (in files, on the command line and in outputs),
@@ -81,6 +81,42 @@ parameters! {
     BallCount = "ball_count", "bed.count", false;
     /// A bed's largest ball radius, m: every size scaled alike.
     BallRadius = "ball_radius", "bed.radii", false;
+    /// Number of dampers: the first so many of the file's `[[damper]]` tables (a whole number).
+    Dampers = "dampers", "damper", false;
+}
+
+/// Every bed of a file: its `[bed]`, or each `[[damper]]`'s; a parameter of a bed sets them all.
+fn beds(f: &mut SceneFile) -> Result<Vec<&mut BedFile>, String> {
+    let mut beds: Vec<&mut BedFile> = f.bed.iter_mut().collect();
+    beds.extend(f.dampers.iter_mut().flatten().filter_map(|d| d.bed.as_mut()));
+    if beds.is_empty() {
+        return Err("needs a [bed] table (or [[damper]] tables with beds)".into());
+    }
+    Ok(beds)
+}
+
+/// Every line of balls of a file: its `[balls]`, or each `[[damper]]`'s.
+fn lines(f: &mut SceneFile) -> Result<Vec<&mut BallsFile>, String> {
+    let mut lines: Vec<&mut BallsFile> = f.balls.iter_mut().collect();
+    lines.extend(f.dampers.iter_mut().flatten().filter_map(|d| d.balls.as_mut()));
+    if lines.is_empty() {
+        return Err("needs a [balls] table (or [[damper]] tables with balls)".into());
+    }
+    Ok(lines)
+}
+
+/// The first bed of a file and the index of its damper (0 for the scene's one).
+fn first_bed(f: &SceneFile) -> Option<(usize, &BedFile)> {
+    match (&f.bed, &f.dampers) {
+        (Some(bed), _) => Some((0, bed)),
+        (None, Some(list)) => list.iter().enumerate().find_map(|(k, d)| d.bed.as_ref().map(|b| (k, b))),
+        (None, None) => None,
+    }
+}
+
+/// The first line of balls of a file.
+fn first_line(f: &SceneFile) -> Option<&BallsFile> {
+    f.balls.as_ref().or_else(|| f.dampers.iter().flatten().find_map(|d| d.balls.as_ref()))
 }
 
 impl std::fmt::Display for Parameter {
@@ -102,7 +138,7 @@ impl Parameter {
     /// Whether its values are whole numbers (a count, as the number of chains): a study
     /// refines it over the whole numbers, never between them.
     pub fn is_count(self) -> bool {
-        matches!(self, Parameter::Chains | Parameter::DamperFloor | Parameter::BallCount)
+        matches!(self, Parameter::Chains | Parameter::DamperFloor | Parameter::BallCount | Parameter::Dampers)
     }
 
     /// The parameter whose value a scene file's field holds (`balls.container_length` holds
@@ -130,32 +166,38 @@ impl Parameter {
                 if !((1.0..=10_000.0).contains(&x) && x.fract() == 0.0) {
                     return Err(format!("`chains` must be a whole number in 1..=10000 (got {})", super::human(x)));
                 }
-                f.balls.as_mut().ok_or("needs a [balls] table")?.chains = Some(x as u32);
+                lines(&mut f)?.into_iter().for_each(|b| b.chains = Some(x as u32));
             }
             Parameter::Friction => f.world.get_or_insert_with(Default::default).friction = Some(number()?),
             Parameter::FillFraction => {
-                let bed = f.bed.as_mut().ok_or("needs a [bed] table")?;
-                bed.fill_fraction = Some(number()?);
-                bed.count = None;
+                let x = number()?;
+                for bed in beds(&mut f)? {
+                    bed.fill_fraction = Some(x);
+                    bed.count = None;
+                }
             }
             Parameter::BallCount => {
                 let x = number()?;
                 if !(x >= 1.0 && x <= u32::MAX as f64 && x.fract() == 0.0) {
                     return Err(format!("`ball_count` must be a whole number from 1 (got {})", super::human(x)));
                 }
-                let bed = f.bed.as_mut().ok_or("needs a [bed] table")?;
-                bed.count = Some(x as u32);
-                bed.fill_fraction = None;
+                for bed in beds(&mut f)? {
+                    bed.count = Some(x as u32);
+                    bed.fill_fraction = None;
+                }
             }
             Parameter::BallRadius => {
                 let x = number()?;
-                let bed = f.bed.as_mut().ok_or("needs a [bed] table")?;
-                let largest = bed.radii.iter().copied().fold(0.0, f64::max);
-                if !(x > 0.0 && x.is_finite() && largest > 0.0) {
+                if !(x > 0.0 && x.is_finite()) {
                     return Err(format!("`ball_radius` must be a positive length (got {})", super::human(x)));
                 }
-                // Every size keeps its ratio to the largest.
-                bed.radii.iter_mut().for_each(|r| *r *= x / largest);
+                for bed in beds(&mut f)? {
+                    let largest = bed.radii.iter().copied().fold(0.0, f64::max);
+                    if largest > 0.0 {
+                        // Every size keeps its ratio to the largest.
+                        bed.radii.iter_mut().for_each(|r| *r *= x / largest);
+                    }
+                }
             }
             Parameter::FrameMass => f.frame.as_mut().ok_or(no_frame)?.mass = number()?,
             Parameter::Stiffness => f.frame.as_mut().ok_or(no_frame)?.stiffness = number()?,
@@ -167,6 +209,18 @@ impl Parameter {
                     return Err(format!("`damper_floor` must be a whole number from 1 (got {})", super::human(x)));
                 }
                 f.structure.as_mut().ok_or("needs a [structure] table")?.damper_floor = Some(x as u32);
+            }
+            Parameter::Dampers => {
+                let x = number()?;
+                let list = f.dampers.as_mut().ok_or("needs [[damper]] tables")?;
+                if !(x >= 1.0 && x <= list.len() as f64 && x.fract() == 0.0) {
+                    return Err(format!(
+                        "`dampers` must be a whole number from 1 to the {} the file lists (got {})",
+                        list.len(),
+                        super::human(x)
+                    ));
+                }
+                list.truncate(x as usize);
             }
             Parameter::ForcingAmplitude | Parameter::ForcingFrequency => {
                 let x = number()?;
@@ -183,17 +237,18 @@ impl Parameter {
             | Parameter::Restitution
             | Parameter::LargeMass
             | Parameter::Density => {
-                let balls = f.balls.as_mut().ok_or("needs a [balls] table")?;
-                match self {
-                    Parameter::Clearance => {
-                        balls.clearance = Some(value);
-                        balls.container_length = None;
+                for balls in lines(&mut f)? {
+                    match self {
+                        Parameter::Clearance => {
+                            balls.clearance = Some(value);
+                            balls.container_length = None;
+                        }
+                        Parameter::Gap => balls.gap = value,
+                        Parameter::MassRatio => balls.mass_ratio = number()?,
+                        Parameter::Restitution => balls.restitution = number()?,
+                        Parameter::LargeMass => balls.large_mass = number()?,
+                        _ => balls.density = number()?,
                     }
-                    Parameter::Gap => balls.gap = value,
-                    Parameter::MassRatio => balls.mass_ratio = number()?,
-                    Parameter::Restitution => balls.restitution = number()?,
-                    Parameter::LargeMass => balls.large_mass = number()?,
-                    _ => balls.density = number()?,
                 }
             }
         }
@@ -203,7 +258,7 @@ impl Parameter {
     /// Its value in `scene`, built from `file`: in the file's unit, lengths in metres; `None`
     /// when the scene has no such part (no forcing).
     pub fn value(self, file: &SceneFile, scene: &Scene) -> Option<f64> {
-        let balls = file.balls.as_ref();
+        let balls = first_line(file);
         match self {
             Parameter::Clearance => scene.container.map(|c| c.clearance),
             Parameter::Gap => scene.container.map(|c| c.gap),
@@ -219,10 +274,11 @@ impl Parameter {
             Parameter::ForcingFrequency => scene.forcing.map(|g| g.frequency),
             Parameter::Chains => Some(scene.space.chains() as f64),
             Parameter::Friction => Some(scene.space.friction),
-            Parameter::FillFraction => file.bed.as_ref().and_then(|b| b.fill_fraction),
+            Parameter::FillFraction => first_bed(file).and_then(|(_, b)| b.fill_fraction),
             Parameter::DamperFloor => scene.structure.as_ref().map(|s| (s.floor + 1) as f64),
-            Parameter::BallCount => file.bed.as_ref().map(|_| scene.balls.len() as f64),
-            Parameter::BallRadius => file.bed.as_ref().map(|b| b.radii.iter().copied().fold(0.0, f64::max)),
+            Parameter::BallCount => first_bed(file).map(|(k, _)| scene.damper_list().get(k).map_or(0, |d| d.balls.len()) as f64),
+            Parameter::BallRadius => first_bed(file).map(|(_, b)| b.radii.iter().copied().fold(0.0, f64::max)),
+            Parameter::Dampers => file.dampers.as_ref().map(|_| scene.damper_list().len() as f64),
         }
     }
 }

@@ -80,26 +80,34 @@ pub(super) fn first_overlap(balls: &[Ball], centres: &[[f64; 3]], size: [f64; 3]
 /// container's frame): the rule broken, with nothing moved, when a ball would leave the box or
 /// overlap another.
 pub fn move_placed_balls(scene: &mut Scene, by: &[[f64; 3]]) -> Result<(), String> {
-    let length = scene.container.map_or(0.0, |c| c.length);
-    let size = [length, scene.space.section[0], scene.space.section[1]];
-    let xs0 = scene.initial_displacement;
     let x: Vec<f64> = scene.initial_positions.iter().zip(by).map(|(x, d)| x + d[0]).collect();
-    let centres: Vec<[f64; 3]> = (0..scene.balls.len())
-        .map(|i| {
-            let [y, z] = scene.space.lateral_of(i);
-            [x[i] - xs0, y + by[i][1], z + by[i][2]]
-        })
-        .collect();
-    for (i, (c, b)) in centres.iter().zip(&scene.balls).enumerate() {
-        if let Some(a) = outside(*c, b.radius, size) {
-            return Err(format!("moves {} outside the container along {}", Body::Ball(i).name(), ["x", "y", "z"][a]));
+    let mut lateral = Vec::with_capacity(scene.balls.len());
+    // Each damper's balls in its own box, from its floor's start.
+    for d in scene.damper_list() {
+        let size = [d.container.length, d.section[0], d.section[1]];
+        let xs0 = scene.damper_start(&d);
+        let centres: Vec<[f64; 3]> = d
+            .balls
+            .clone()
+            .map(|i| {
+                let [y, z] = scene.space.lateral_of(i);
+                [x[i] - xs0, y + by[i][1], z + by[i][2]]
+            })
+            .collect();
+        let balls = &scene.balls[d.balls.clone()];
+        for (k, (c, b)) in centres.iter().zip(balls).enumerate() {
+            if let Some(a) = outside(*c, b.radius, size) {
+                return Err(format!("moves {} outside the container along {}", Body::Ball(d.balls.start + k).name(), ["x", "y", "z"][a]));
+            }
         }
-    }
-    if let Some((i, j)) = first_overlap(&scene.balls, &centres, size) {
-        return Err(format!("makes {} overlap {}", Body::Ball(j).name(), Body::Ball(i).name()));
+        if let Some((i, j)) = first_overlap(balls, &centres, size) {
+            let (i, j) = (d.balls.start + i, d.balls.start + j);
+            return Err(format!("makes {} overlap {}", Body::Ball(j).name(), Body::Ball(i).name()));
+        }
+        lateral.extend(centres.iter().map(|c| [c[1], c[2]]));
     }
     scene.initial_positions = x;
-    scene.space.lateral = centres.iter().map(|c| [c[1], c[2]]).collect();
+    scene.space.lateral = lateral;
     Ok(())
 }
 

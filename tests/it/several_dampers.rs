@@ -173,3 +173,47 @@ fn the_shipped_two_dampers_load_and_run() {
     let run = compliant(&s);
     assert_eq!(run.series.floor_count(), 3);
 }
+
+/// Two beds of `count` balls in boxes of different lengths on floors 2 and 3.
+fn two_beds(count: u32) -> String {
+    let bed = |floor: u32, length: f64| {
+        format!(
+            "[[damper]]\nfloor = {floor}\n[damper.container]\nlength = {length}\nwidth = 0.04\nheight = 0.04\n\
+             [damper.bed]\ncount = {count}\nradii = [0.005]\ndensity = 7800.0\n"
+        )
+    };
+    building(&format!("{}{}", bed(2, 0.1), bed(3, 0.04)))
+}
+
+/// A study's bed parameters set every damper's bed, and `dampers` keeps the first so many.
+#[test]
+fn study_parameters_reach_every_damper() {
+    use lpc_damper::scene::{Length, Parameter};
+    let file: lpc_damper::scene::SceneFile = toml::from_str(&two_beds(4)).unwrap();
+    let build = |f: &lpc_damper::scene::SceneFile| lpc_damper::scene::from_file(f.clone(), "t.toml", "t").unwrap().scene.unwrap();
+    let counted = build(&Parameter::BallCount.apply(&file, Length::Metres(6.0)).unwrap());
+    assert_eq!(counted.damper_list().iter().map(|d| d.balls.len()).collect::<Vec<_>>(), [6, 6]);
+    assert_eq!(Parameter::BallCount.value(&file, &build(&file)), Some(4.0));
+    let first = build(&Parameter::Dampers.apply(&file, Length::Metres(1.0)).unwrap());
+    let mut alone = file.clone();
+    alone.dampers.as_mut().unwrap().truncate(1);
+    assert_eq!(first, build(&alone));
+    assert!(!first.has_several_dampers() && first.structure.as_ref().unwrap().floor == 1);
+    assert_eq!(Parameter::Dampers.value(&file, &build(&file)), Some(2.0));
+    assert!(Parameter::Dampers.apply(&file, Length::Metres(3.0)).unwrap_err().contains("from 1 to the 2"));
+}
+
+/// An ensemble's moves keep each ball in its own box: a shift the first, longer box would hold
+/// takes a ball of the second out of its own.
+#[test]
+fn moved_balls_stay_in_their_own_box() {
+    let s = scene(&two_beds(1));
+    let mut by = vec![[0.0; 3]; 2];
+    by[0][0] = 0.05;
+    let mut moved = s.clone();
+    lpc_damper::scene::move_placed_balls(&mut moved, &by).unwrap();
+    assert_eq!(moved.initial_positions[0], s.initial_positions[0] + 0.05);
+    by = vec![[0.0, 0.0, 0.0], [0.05, 0.0, 0.0]];
+    let why = lpc_damper::scene::move_placed_balls(&mut s.clone(), &by).unwrap_err();
+    assert!(why.contains("ball2") && why.contains("outside the container along x"), "{why}");
+}

@@ -44,7 +44,7 @@ pub(in crate::scene) fn tolerances(
     }
     let position = match t.position {
         None => None,
-        Some(_) if parsed.bed.is_none() && parsed.explicit_balls.is_none() => {
+        Some(_) if !places_balls_in_a_box(parsed) => {
             return Err(v.err("tolerances.position", "needs balls placed in a box ([bed] or [[ball]]); a chain's balls take `gap`"))
         }
         Some(Length::Rr(_)) => {
@@ -53,4 +53,12 @@ pub(in crate::scene) fn tolerances(
         Some(Length::Metres(x)) => Some(v.non_negative("tolerances.position", x)?),
     };
     Ok(Tolerances { spreads, position, distribution: t.distribution, seed: t.seed.unwrap_or(1) })
+}
+
+/// Whether the file's balls are placed in a box (`[bed]` or `[[ball]]`, or in every damper).
+fn places_balls_in_a_box(f: &SceneFile) -> bool {
+    match &f.dampers {
+        Some(list) => list.iter().all(|d| d.bed.is_some() || d.explicit_balls.is_some()),
+        None => f.bed.is_some() || f.explicit_balls.is_some(),
+    }
 }

@@ -68,7 +68,8 @@ pub fn member_rng(seed: u64, k: usize) -> Pcg64 {
 /// Whether `file` places a bed at random (or settles one from random nudges): its members
 /// then each place their own.
 pub fn places_bed_at_random(file: &SceneFile) -> bool {
-    file.bed.as_ref().is_some_and(|b| matches!(b.placement, scene::format::Placement::Random | scene::format::Placement::Settled))
+    let random = |b: &scene::format::BedFile| matches!(b.placement, scene::format::Placement::Random | scene::format::Placement::Settled);
+    file.bed.as_ref().is_some_and(random) || file.dampers.iter().flatten().filter_map(|d| d.bed.as_ref()).any(random)
 }
 
 /// Whether `file` shakes its ground at random: its members then each draw their own motion.
@@ -311,6 +312,12 @@ impl Drawer<'_> {
             let mut f = self.base.clone();
             if let (Some(bed), Some(seed)) = (f.bed.as_mut(), bed_seed) {
                 bed.seed = Some(seed);
+            }
+            // Several dampers' beds each from their own seed: the member's plus the bed's place among them.
+            for (d, bed) in f.dampers.iter_mut().flatten().filter_map(|d| d.bed.as_mut()).enumerate() {
+                if let Some(seed) = bed_seed {
+                    bed.seed = Some(seed + d as u64);
+                }
             }
             if let (Some(g), Some(seed)) = (f.forcing.as_mut(), ground_seed) {
                 g.seed = Some(seed);
