@@ -8,6 +8,7 @@ mod bed_energy_below_zero;
 mod box_loses_floor_velocity;
 mod check_bad_scene_exit_status;
 mod closed_pipe;
+mod compare_flag_that_cannot_help;
 mod driven_energy_remaining;
 mod driven_sweep_energy_left;
 mod end_wall_plastic_after_ring_down;

@@ -163,6 +163,12 @@ fn frictionless_copy(scene: &Scene, frictionless: bool) -> Result<Option<Scene>>
     }
     if scene.space.friction != 0.0 {
         if let Err(why) = Model::Reference.supports(scene) {
+            // The flag helps only where friction is all the reference refuses.
+            let mut smooth = scene.clone();
+            smooth.space.friction = 0.0;
+            if Model::Reference.supports(&smooth).is_err() {
+                return Err(ModelError::Refused(why).into());
+            }
             return Err(ModelError::Refused(format!(
                 "{why}; `lpc compare --frictionless-reference` compares the others with the reference on the frictionless copy"
             ))
