@@ -168,6 +168,9 @@ impl Series {
     /// the series has no floors.
     pub fn floor(&self, i: usize, k: usize) -> Option<(f64, f64, f64)> {
         let n = self.floor_count;
+        if i >= n {
+            return None;
+        }
         let at = 3 * n * k;
         self.floors.get(at..at + 3 * n).map(|z| (z[i], z[n + i], z[2 * n + i]))
     }

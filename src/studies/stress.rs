@@ -11,7 +11,9 @@ use serde::Serialize;
 
 use crate::model::{Limits, Model, ModelError, RunOptions};
 use crate::run::Run;
-use crate::scene::format::{BallsFile, BedFile, ContainerFile, ForcingFile, FrameFile, Placement, RunFile, StructureFile, WorldFile};
+use crate::scene::format::{
+    BallsFile, BedFile, ContainerFile, DamperFile, ForcingFile, FrameFile, Placement, RunFile, StructureFile, WorldFile,
+};
 use crate::scene::{self, Arrangement, ForcingKind, Length, Scene, SceneFile};
 
 /// How a run failed.
@@ -65,6 +67,8 @@ pub struct Draws {
     pub beds: bool,
     /// Each scene's frame as a floor of a building of 1 to 5 storeys ([`with_structure`]).
     pub structures: bool,
+    /// Each scene's bed as two dampers, each on a floor of its own draw ([`with_dampers`]).
+    pub dampers: bool,
 }
 
 /// `file` with its balls as a bed, drawn from a stream of its own (seeded from `seed` alone):
@@ -154,6 +158,27 @@ pub fn with_structure(mut file: SceneFile, seed: u64) -> SceneFile {
         initial_velocities: None,
         damper_floor: Some(floor as u32 + 1),
     });
+    file
+}
+
+/// `file` with its bed (`[container]` and `[bed]`) as two dampers, drawn from a stream of its
+/// own (seeded from `seed` alone): the drawn bed on the drawn floor, and a copy of its box
+/// holding 1 to as many balls, placed from another seed, on a floor drawn at random (maybe the
+/// same one). A file without a bed is returned as it is.
+pub fn with_dampers(mut file: SceneFile, seed: u64) -> SceneFile {
+    let mut rng = Pcg64::seed_from_u64(seed ^ 0xda3b_e500_0000_0000);
+    let (Some(container), Some(bed)) = (file.container.take(), file.bed.take()) else { return file };
+    let floors = file.structure.as_ref().map_or(1, |s| s.masses.len() as u32);
+    let floor = file.structure.as_mut().map_or(1, |s| s.damper_floor.take().unwrap_or(floors));
+    let count = bed.count.unwrap_or(1);
+    let second = BedFile { count: Some(rng.random_range(1..=count.max(1))), seed: Some(bed.seed.unwrap_or(1) + 1), ..bed.clone() };
+    let damper = |floor: u32, bed: BedFile| DamperFile {
+        floor: Some(floor),
+        container: Some(container.clone()),
+        bed: Some(bed),
+        ..DamperFile::default()
+    };
+    file.dampers = Some(vec![damper(floor, bed), damper(rng.random_range(1..=floors), second)]);
     file
 }
 
@@ -455,6 +480,21 @@ fn validate(file: &SceneFile) -> Result<Scene, String> {
 fn simplifications(f: &SceneFile) -> Vec<SceneFile> {
     let mut out = vec![];
     let horizon = f.run.horizon.unwrap_or(5.0);
+    if let Some(list) = &f.dampers {
+        // Dampers: one fewer, a shorter run.
+        if list.len() > 1 {
+            let mut g = f.clone();
+            g.dampers = Some(list[..list.len() - 1].to_vec());
+            out.push(g);
+        }
+        if horizon > 0.01 {
+            let mut g = f.clone();
+            g.run.horizon = Some(horizon / 2.0);
+            g.run.sample_dt = Some((horizon / 2.0 / 2000.0).max(1e-5));
+            out.push(g);
+        }
+        return out;
+    }
     if let Some(bed) = &f.bed {
         // A bed: fewer balls, a shorter run.
         if let Some(count) = bed.count.filter(|&c| c > 1) {
@@ -561,6 +601,7 @@ pub fn stress(model: Model, seed: u64, count: u64, draws: Draws, progress: &(dyn
             let file = if draws.chains { with_chains(file, s) } else { file };
             let file = if draws.beds { with_bed(file, s) } else { file };
             let file = if draws.structures { with_structure(file, s) } else { file };
+            let file = if draws.dampers { with_dampers(file, s) } else { file };
             let start = std::time::Instant::now();
             let outcome = |failure: Option<Failure>, minimal_scene, refused, refused_during_run, stopped, wall_s| Outcome {
                 seed: s,

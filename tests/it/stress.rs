@@ -26,7 +26,16 @@ fn three_hundred_random_scenes_pass_every_check() {
         Model::Reference,
         1,
         300,
-        Draws { max_horizon: 2.0, forced: false, extreme: false, max_wall_s: None, chains: false, beds: false, structures: false },
+        Draws {
+            max_horizon: 2.0,
+            forced: false,
+            extreme: false,
+            max_wall_s: None,
+            chains: false,
+            beds: false,
+            structures: false,
+            dampers: false,
+        },
         &|| {},
     ));
     // The same scenes as 1 to 4 chains side by side.
@@ -34,7 +43,16 @@ fn three_hundred_random_scenes_pass_every_check() {
         Model::Reference,
         1,
         100,
-        Draws { max_horizon: 2.0, forced: false, extreme: false, max_wall_s: None, chains: true, beds: false, structures: false },
+        Draws {
+            max_horizon: 2.0,
+            forced: false,
+            extreme: false,
+            max_wall_s: None,
+            chains: true,
+            beds: false,
+            structures: false,
+            dampers: false,
+        },
         &|| {},
     ));
 }
@@ -47,7 +65,16 @@ fn three_hundred_random_scenes_pass_every_check() {
 /// model, all pass) is a documented command.
 #[test]
 fn random_buildings_pass_every_check() {
-    let draws = Draws { max_horizon: 2.0, forced: false, extreme: false, max_wall_s: None, chains: false, beds: false, structures: true };
+    let draws = Draws {
+        max_horizon: 2.0,
+        forced: false,
+        extreme: false,
+        max_wall_s: None,
+        chains: false,
+        beds: false,
+        structures: true,
+        dampers: false,
+    };
     for (model, count) in [(Model::Reference, 40), (Model::Rapier, 20), (Model::Compliant, 10)] {
         assert_all_pass(&stress(model, 30, count, draws, &|| {}));
     }
@@ -59,8 +86,16 @@ fn random_buildings_pass_every_check() {
 /// of computing, which bounds the test's time.
 #[test]
 fn random_beds_on_buildings_pass_every_check() {
-    let draws =
-        Draws { max_horizon: 2.0, forced: false, extreme: false, max_wall_s: Some(2.0), chains: false, beds: true, structures: true };
+    let draws = Draws {
+        max_horizon: 2.0,
+        forced: false,
+        extreme: false,
+        max_wall_s: Some(2.0),
+        chains: false,
+        beds: true,
+        structures: true,
+        dampers: false,
+    };
     for (model, count) in [(Model::Rapier, 12), (Model::Compliant, 4)] {
         let outcomes = stress(model, 30, count, draws, &|| {});
         assert_all_pass(&outcomes);
@@ -73,6 +108,36 @@ fn random_beds_on_buildings_pass_every_check() {
     assert!(refused.len() < outcomes.len(), "some draws are frictionless and run");
 }
 
+/// Beds drawn as two dampers on floors of their own draws (`lpc stress --beds --structures
+/// --dampers`): the compliant model runs every one and passes every check on what it runs
+/// within its budget (each damper's balls in their own box, the energy balance with forces
+/// handed to each floor); the reference and the contact model refuse them, naming the dampers.
+#[test]
+fn random_dampers_on_buildings_pass_every_check() {
+    let draws = Draws {
+        max_horizon: 1.0,
+        forced: false,
+        extreme: false,
+        max_wall_s: Some(3.0),
+        chains: false,
+        beds: true,
+        structures: true,
+        dampers: true,
+    };
+    let outcomes = stress(Model::Compliant, 30, 4, draws, &|| {});
+    assert_all_pass(&outcomes);
+    assert!(outcomes.iter().all(|o| o.refused.is_none()), "{:?}", outcomes.iter().find_map(|o| o.refused.as_ref()));
+    for model in [Model::Reference, Model::Rapier] {
+        for o in stress(model, 30, 2, draws, &|| {}) {
+            assert!(
+                o.refused.as_ref().is_some_and(|why| why.contains("2 dampers") || why.contains("friction")),
+                "{model}: {:?}",
+                o.refused
+            );
+        }
+    }
+}
+
 /// The same under a random harmonic force or base motion (`lpc stress --forced`): besides the
 /// free checks, the energy balance against the forcing's work, and no ball inside a wall or
 /// another ball beyond the contact tolerance (issue 17). The full count (2000 scenes, horizons
@@ -83,7 +148,16 @@ fn forced_random_scenes_pass_every_check() {
         Model::Reference,
         1,
         100,
-        Draws { max_horizon: 2.0, forced: true, extreme: false, max_wall_s: None, chains: false, beds: false, structures: false },
+        Draws {
+            max_horizon: 2.0,
+            forced: true,
+            extreme: false,
+            max_wall_s: None,
+            chains: false,
+            beds: false,
+            structures: false,
+            dampers: false,
+        },
         &|| {},
     ));
 }
@@ -106,7 +180,16 @@ fn contact_model_passes_the_first_seeded_scenes() {
         Model::Rapier,
         1,
         25,
-        Draws { max_horizon: 1.0, forced: false, extreme: false, max_wall_s: None, chains: false, beds: false, structures: false },
+        Draws {
+            max_horizon: 1.0,
+            forced: false,
+            extreme: false,
+            max_wall_s: None,
+            chains: false,
+            beds: false,
+            structures: false,
+            dampers: false,
+        },
         &|| {},
     ));
 }
@@ -119,7 +202,16 @@ fn contact_model_passes_the_first_seeded_beds() {
         Model::Rapier,
         1,
         10,
-        Draws { max_horizon: 1.0, forced: false, extreme: false, max_wall_s: None, chains: false, beds: true, structures: false },
+        Draws {
+            max_horizon: 1.0,
+            forced: false,
+            extreme: false,
+            max_wall_s: None,
+            chains: false,
+            beds: true,
+            structures: false,
+            dampers: false,
+        },
         &|| {},
     ));
 }
@@ -135,7 +227,16 @@ fn reference_passes_the_first_seeded_beds() {
         Model::Reference,
         1,
         23,
-        Draws { max_horizon: 1.0, forced: false, extreme: false, max_wall_s: Some(3.0), chains: false, beds: true, structures: false },
+        Draws {
+            max_horizon: 1.0,
+            forced: false,
+            extreme: false,
+            max_wall_s: Some(3.0),
+            chains: false,
+            beds: true,
+            structures: false,
+            dampers: false,
+        },
         &|| {},
     ));
 }
@@ -149,7 +250,16 @@ fn compliant_model_passes_the_first_seeded_beds() {
         Model::Compliant,
         1,
         10,
-        Draws { max_horizon: 1.0, forced: false, extreme: false, max_wall_s: Some(3.0), chains: false, beds: true, structures: false },
+        Draws {
+            max_horizon: 1.0,
+            forced: false,
+            extreme: false,
+            max_wall_s: Some(3.0),
+            chains: false,
+            beds: true,
+            structures: false,
+            dampers: false,
+        },
         &|| {},
     ));
 }
@@ -169,6 +279,7 @@ fn extreme_scenes_pass_refuse_or_stop_never_panic() {
         chains: false,
         beds: false,
         structures: false,
+        dampers: false,
     };
     assert_all_pass(&stress(Model::Reference, 1, 24, draws(1.0), &|| {}));
     for model in [Model::Rapier, Model::Compliant] {

@@ -47,6 +47,11 @@ pub struct Args {
     /// frictionless).
     #[arg(long, conflicts_with = "extreme")]
     structures: bool,
+    /// With --beds, draw each bed as two dampers in copies of its box, the second holding 1 to as
+    /// many balls on a floor drawn at random (the compliant model runs them; the others refuse
+    /// several dampers).
+    #[arg(long, requires = "beds")]
+    dampers: bool,
     /// Seconds of computing each run may take; a run that takes longer stops (a typed stop,
     /// counted apart from passes and failures). Default: none, 10 s with --extreme.
     #[arg(long, value_name = "S")]
@@ -81,6 +86,7 @@ pub fn run(a: Args) -> Result<ExitStatus> {
         chains: a.chains,
         beds: a.beds,
         structures: a.structures,
+        dampers: a.dampers,
         max_wall_s: a.max_wall_time.or(a.extreme.then_some(10.0)),
     };
     let mut outcomes = Vec::new();
