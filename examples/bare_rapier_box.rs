@@ -31,8 +31,8 @@ fn main() -> anyhow::Result<()> {
     if !(dt > 0.0 && horizon > 0.0) {
         bail!("DT and HORIZON must be positive");
     }
-    if scene.is_driven() || scene.structure.is_some() {
-        bail!("{path}: the bare pipeline drives a frame in free vibration only");
+    if scene.is_driven() || scene.structure.is_some() || scene.has_several_dampers() {
+        bail!("{path}: the bare pipeline drives one damper on a frame in free vibration only");
     }
     let frame = scene.frame.context("the scene has no frame")?;
     let mut world = rapier_world(&scene).map_err(anyhow::Error::msg)?;
@@ -51,7 +51,7 @@ fn main() -> anyhow::Result<()> {
     let started = Instant::now();
     for _ in 0..steps {
         let (x1, v1) = oscillator.state(xs, vs, dt);
-        world.physics.bodies[world.frame].set_next_kinematic_translation(Vector::new(x1 as f32, 0.0, 0.0));
+        world.physics.bodies[world.frames[0]].set_next_kinematic_translation(Vector::new(x1 as f32, 0.0, 0.0));
         world.physics.step();
         let mut momentum = 0.0;
         for (i, h) in world.balls.iter().enumerate() {

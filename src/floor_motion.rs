@@ -312,6 +312,23 @@ impl FloorMotion {
         failure
     }
 
+    /// Starts a new segment at `t`, each floor `j` of `velocities` moving at its `v` (absolute),
+    /// no balls held: several floors struck at one instant.
+    pub fn restart_floors(&mut self, t: f64, velocities: &[(usize, f64)]) {
+        let (mut z, (_, vg)) = self.floors(t);
+        let n = self.n();
+        for &(j, v) in velocities {
+            z[n + j] = v - vg;
+        }
+        // The bare floors' modes are the first decomposed.
+        let (_, m, sine) = &self.cache[0];
+        self.modes = m.clone();
+        self.sine = sine.clone();
+        self.t0 = t;
+        self.z0 = z;
+        self.reset();
+    }
+
     /// The floors' mechanical energy at `t`: their kinetic energy in the ground's inertial
     /// frame and the storeys' springs (balls held on the carrying floor not included), J.
     pub fn energy(&self, t: f64) -> f64 {

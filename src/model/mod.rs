@@ -21,7 +21,7 @@ pub fn one_damper(scene: &Scene) -> Result<(), String> {
         return Ok(());
     }
     Err(format!(
-        "the scene has {} dampers; this model carries one damper (the compliant model runs several; give one [[damper]] to run here)",
+        "the scene has {} dampers; this model carries one damper (the contact and compliant models run several; give one [[damper]] to run here)",
         scene.dampers.len()
     ))
 }

@@ -59,8 +59,7 @@ impl Simulator for Rapier {
     }
 
     fn supports(&self, scene: &Scene) -> Result<(), String> {
-        crate::model::one_damper(scene)?;
-        // Several chains, or balls beyond lines, go to the spatial path (`spatial`).
+        // Several chains or dampers, or balls beyond lines, go to the spatial path (`spatial`).
         if spatial::needs_spatial(scene) {
             return spatial::refusal(scene).map_or(Ok(()), Err);
         }

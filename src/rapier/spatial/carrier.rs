@@ -12,15 +12,15 @@ use crate::scene::Scene;
 pub(super) enum Carrier<'a> {
     /// A frame: the closed-form oscillator from its state `(x0, v0)` at `t0`.
     Frame { scene: &'a Scene, motion: Driven, x0: f64, v0: f64, t0: f64 },
-    /// A structure's floors, the container on the carrying one.
-    Floors(Box<FloorMotion>),
+    /// A structure's floors, and those that carry dampers (the carrying one for one damper).
+    Floors(Box<FloorMotion>, Vec<usize>),
 }
 
 impl<'a> Carrier<'a> {
     /// The carrier of `scene` at its start.
     pub(super) fn new(scene: &'a Scene) -> Result<Self, String> {
         if let Some(s) = &scene.structure {
-            return Ok(Carrier::Floors(Box::new(FloorMotion::new(s.clone(), scene.forcing)?)));
+            return Ok(Carrier::Floors(Box::new(FloorMotion::new(s.clone(), scene.forcing)?), carrying_floors(scene)));
         }
         let f = scene.frame.ok_or("the scene has no frame")?;
         let motion = Driven::new(Oscillator::new(f.mass, f.damping, f.stiffness), scene.harmonic_load());
@@ -32,7 +32,20 @@ impl<'a> Carrier<'a> {
     pub(super) fn state(&self, t: f64) -> (f64, f64) {
         match self {
             Carrier::Frame { motion, x0, v0, t0, .. } => motion.state(*x0, *v0, *t0, t),
-            Carrier::Floors(m) => m.state(t),
+            Carrier::Floors(m, _) => m.state(t),
+        }
+    }
+
+    /// Each body that carries dampers ([`carrying_floors`]): its absolute displacement and
+    /// velocity at `t` (not before the last restart).
+    pub(super) fn states(&self, t: f64) -> Vec<(f64, f64)> {
+        match self {
+            Carrier::Floors(m, floors) if floors.len() > 1 => {
+                let (z, (xg, vg)) = m.floors(t);
+                let n = z.len() / 2;
+                floors.iter().map(|&j| (xg + z[j], vg + z[n + j])).collect()
+            }
+            _ => vec![self.state(t)],
         }
     }
 
@@ -52,16 +65,16 @@ impl<'a> Carrier<'a> {
                     (damping, work)
                 }
             }
-            Carrier::Floors(m) => m.energy_between(from, from + h),
+            Carrier::Floors(m, _) => m.energy_between(from, from + h),
         }
     }
 
-    /// The carrying body's displacement and velocity at the last restart (at the start, its
+    /// Each carrying body's displacement and velocity at the last restart (at the start, its
     /// initial state), exactly.
-    pub(super) fn start(&self) -> (f64, f64) {
+    pub(super) fn starts(&self) -> Vec<(f64, f64)> {
         match self {
-            Carrier::Frame { x0, v0, .. } => (*x0, *v0),
-            Carrier::Floors(m) => m.state(m.t0),
+            Carrier::Frame { x0, v0, .. } => vec![(*x0, *v0)],
+            Carrier::Floors(m, _) => self.states(m.t0),
         }
     }
 
@@ -74,8 +87,23 @@ impl<'a> Carrier<'a> {
                 (*x0, *v0, *t0) = (state.0, v, t);
                 Ok(())
             }
-            Carrier::Floors(m) if v != state.1 => m.restart(t, v, 0.0),
-            Carrier::Floors(_) => Ok(()),
+            Carrier::Floors(m, _) if v != state.1 => m.restart(t, v, 0.0),
+            Carrier::Floors(..) => Ok(()),
+        }
+    }
+
+    /// [`Carrier::restart`] for every carrying body: at `states` at `t`, going on at `v`.
+    pub(super) fn restart_bodies(&mut self, t: f64, states: &[(f64, f64)], v: &[f64]) -> Result<(), String> {
+        match self {
+            Carrier::Floors(m, floors) if floors.len() > 1 => {
+                let struck: Vec<(usize, f64)> =
+                    floors.iter().zip(states.iter().zip(v)).filter(|(_, (s, v))| **v != s.1).map(|(&j, (_, &v))| (j, v)).collect();
+                if !struck.is_empty() {
+                    m.restart_floors(t, &struck);
+                }
+                Ok(())
+            }
+            _ => self.restart(t, states[0], v[0]),
         }
     }
 
@@ -84,7 +112,7 @@ impl<'a> Carrier<'a> {
     pub(super) fn energy(&self, t: f64, x: f64, v: f64) -> f64 {
         match self {
             Carrier::Frame { scene, .. } => scene.frame_energy(t, x, v),
-            Carrier::Floors(m) => m.energy(t),
+            Carrier::Floors(m, _) => m.energy(t),
         }
     }
 
@@ -93,7 +121,19 @@ impl<'a> Carrier<'a> {
     pub(super) fn floors(&self, t: f64) -> Option<(Vec<f64>, (f64, f64))> {
         match self {
             Carrier::Frame { .. } => None,
-            Carrier::Floors(m) => Some(m.floors(t)),
+            Carrier::Floors(m, _) => Some(m.floors(t)),
         }
     }
+}
+
+/// The floors that carry the scene's dampers, in the order their dampers first name them: one
+/// body each, which the balls' wall impulses move (the carrying floor alone for one damper).
+pub(super) fn carrying_floors(scene: &Scene) -> Vec<usize> {
+    let mut floors: Vec<usize> = Vec::new();
+    for d in scene.damper_list() {
+        if !floors.contains(&d.floor) {
+            floors.push(d.floor);
+        }
+    }
+    floors
 }

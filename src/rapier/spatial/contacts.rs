@@ -42,6 +42,18 @@ pub struct Balls<'a> {
     pub mass: &'a [f64],
 }
 
+/// Where each ball's container is: ball `i` is in damper `damper[i]`, whose inside is
+/// `chambers[damper[i]]` with its left wall at `xs[damper[i]]`.
+#[derive(Clone, Copy)]
+pub struct Containers<'a> {
+    /// Each damper's inside.
+    pub chambers: &'a [Chamber],
+    /// Each ball's damper.
+    pub damper: &'a [u32],
+    /// Each damper's left wall along x, m.
+    pub xs: &'a [f64],
+}
+
 /// Finds the contacts of a step on a grid of cells over the container, kept between steps and
 /// made anew with wider cells when a step asks for a longer reach: every step costs what its
 /// balls do, whatever the bed's shape.
@@ -51,22 +63,27 @@ pub struct Finder {
 }
 
 impl Finder {
-    /// Finds every pair closer than `touching` (balls and walls), the frame at `xs`, into
-    /// `out`: each ball's walls, then the balls of larger index it touches.
-    pub fn find(&mut self, geometry: &Chamber, x: &[[f64; 3]], radius: &[f64], xs: f64, touching: f64, out: &mut Vec<Contact>) {
+    /// Finds every pair closer than `touching` (balls and walls) into `out`: each ball's walls,
+    /// then the balls of larger index it touches; only balls of one damper touch (the dampers'
+    /// insides overlay each other in the cells).
+    pub fn find(&mut self, containers: Containers, x: &[[f64; 3]], radius: &[f64], touching: f64, out: &mut Vec<Contact>) {
+        let Containers { chambers, damper, xs } = containers;
         out.clear();
         let n = x.len();
-        let reach = 2.0 * geometry.largest_radius + touching;
+        let largest = chambers.iter().map(|c| c.largest_radius).fold(0.0, f64::max);
+        let reach = 2.0 * largest + touching;
         if self.cells.as_ref().is_none_or(|(_, width)| *width < reach) {
             // Wider than asked, so that a slowly growing reach does not make the grid anew each step.
             let width = 1.25 * reach;
-            self.cells = Some((Cells::new([geometry.length, geometry.width, geometry.height], width, n), width));
+            let inside = chambers.iter().fold([0.0f64; 3], |m, c| [m[0].max(c.length), m[1].max(c.width), m[2].max(c.height)]);
+            self.cells = Some((Cells::new(inside, width, n), width));
         }
         let Some((cells, _)) = self.cells.as_mut() else { return };
-        let local = |i: usize| [x[i][0] - xs, x[i][1], x[i][2]];
+        let local = |i: usize| [x[i][0] - xs[damper[i] as usize], x[i][1], x[i][2]];
         cells.rebuild(local);
         for i in 0..n {
             let p = local(i);
+            let geometry = &chambers[damper[i] as usize];
             for wall in geometry.walls_near(p) {
                 let (gap, normal) = geometry.gap(wall, p, radius[i]);
                 if gap <= touching {
@@ -74,6 +91,9 @@ impl Finder {
                 }
             }
             cells.neighbours(i, |j| {
+                if damper[j] != damper[i] {
+                    return;
+                }
                 let d = [x[j][0] - x[i][0], x[j][1] - x[i][1], x[j][2] - x[i][2]];
                 let dist = (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt();
                 let gap = dist - radius[i] - radius[j];
@@ -109,12 +129,15 @@ fn dot(a: [f64; 3], b: [f64; 3]) -> f64 {
     a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
 }
 
-/// The frame as the walls' body: its velocity along x and its mass.
-pub struct FrameBody {
-    /// Velocity, m/s.
-    pub vs: f64,
-    /// Mass, kg.
-    pub mass: f64,
+/// The bodies that carry the walls (the frame, or the floors that carry dampers): each one's
+/// velocity along x and mass, and which of them carries each ball's walls.
+pub struct FrameBody<'a> {
+    /// Velocities, m/s.
+    pub vs: Vec<f64>,
+    /// Masses, kg.
+    pub mass: &'a [f64],
+    /// The body that carries each ball's walls.
+    pub of_ball: &'a [usize],
 }
 
 /// Relative normal velocity of contact `c` (the other body's less the ball's, along the
@@ -124,7 +147,10 @@ pub fn relative(c: &Contact, balls: &Balls, frame: &FrameBody) -> (f64, f64, f64
     let inv_a = 1.0 / balls.mass[c.ball];
     match c.other {
         Other::Ball(j) => (dot(balls.v[j], n) - dot(balls.v[c.ball], n), inv_a, 1.0 / balls.mass[j]),
-        Other::Wall(_) => (n[0] * frame.vs - dot(balls.v[c.ball], n), inv_a, n[0] * n[0] / frame.mass),
+        Other::Wall(_) => {
+            let body = frame.of_ball[c.ball];
+            (n[0] * frame.vs[body] - dot(balls.v[c.ball], n), inv_a, n[0] * n[0] / frame.mass[body])
+        }
     }
 }
 
@@ -142,7 +168,10 @@ pub fn push_apart(c: &Contact, j: f64, balls: &mut Balls, frame: &mut FrameBody)
                 balls.v[b][a] += j * nk / mb;
             }
         }
-        Other::Wall(_) => frame.vs += j * n[0] / frame.mass,
+        Other::Wall(_) => {
+            let body = frame.of_ball[c.ball];
+            frame.vs[body] += j * n[0] / frame.mass[body];
+        }
     }
 }
 
@@ -452,12 +481,13 @@ mod tests {
             let frame_mass = [1e-3, 1.0, 1e6][rng.random_range(0..3)];
 
             let (mut v_scan, mut kicked_scan) = (v.clone(), kicked.clone());
-            let mut frame_scan = FrameBody { vs: frame_vs, mass: frame_mass };
+            let on_frame = vec![0; n];
+            let mut frame_scan = FrameBody { vs: vec![frame_vs], mass: &[frame_mass], of_ball: &on_frame };
             let mut balls = Balls { v: &mut v_scan, mass: &mass };
             let expected = cascade_by_scan(&found, 0.0, &mut kicked_scan, resting, &mut balls, &mut frame_scan, e);
 
             let (mut v_cal, mut kicked_cal) = (v.clone(), kicked.clone());
-            let mut frame_cal = FrameBody { vs: frame_vs, mass: frame_mass };
+            let mut frame_cal = FrameBody { vs: vec![frame_vs], mass: &[frame_mass], of_ball: &on_frame };
             let mut balls = Balls { v: &mut v_cal, mass: &mass };
             let mut strikes = Vec::new();
             let mut cascade = Cascade::default();
@@ -469,7 +499,7 @@ mod tests {
             assert_eq!(strikes, expected, "{nx} x {ny} x {nz}");
             assert_eq!(v_cal, v_scan);
             assert_eq!(kicked_cal, kicked_scan);
-            assert_eq!(frame_cal.vs.to_bits(), frame_scan.vs.to_bits());
+            assert_eq!(frame_cal.vs[0].to_bits(), frame_scan.vs[0].to_bits());
         }
     }
 }

@@ -24,7 +24,7 @@ use crate::model::{Budget, Checks, Meter, Model, ModelError, OverBudget, RunOpti
 use crate::run::{EnergyAccount, Impact, Impacts, Recorder, Run, MAX_KEPT_IMPACTS};
 use crate::scene::{Body, Chamber, Scene, Wall};
 use carrier::Carrier;
-use contacts::{Balls, Contact, FrameBody, Other};
+use contacts::{Balls, Contact, Containers, FrameBody, Other};
 
 /// Default step of the spatial path, s: Rapier's steps are plastic and the bounces come from
 /// the impact law, so a millisecond resolves the flights between impacts of centimetre balls.
@@ -54,10 +54,10 @@ pub const STEP_TRAVEL: f64 = 0.2;
 /// bed can take a second (a look costs tens of nanoseconds, a step at least microseconds).
 const BUDGET_STEPS: u64 = 1;
 
-/// Whether `scene` goes to the spatial path: several chains, or anything a line cannot hold
-/// (balls off their chain's line, motion across, gravity, friction).
+/// Whether `scene` goes to the spatial path: several chains or dampers, or anything a line
+/// cannot hold (balls off their chain's line, motion across, gravity, friction).
 pub fn needs_spatial(scene: &Scene) -> bool {
-    scene.space.chains() > 1 || scene.space.beyond_lines(&scene.initial_positions).is_some()
+    scene.space.chains() > 1 || scene.has_several_dampers() || scene.space.beyond_lines(&scene.initial_positions).is_some()
 }
 
 /// Why the spatial path cannot run `scene`, or `None` when it can.
@@ -65,8 +65,15 @@ pub fn refusal(scene: &Scene) -> Option<String> {
     if scene.frame.is_none() {
         return Some("the scene has no frame; the spatial contact model needs a container on a frame".into());
     }
-    if let Err(reason) = Chamber::new(scene) {
-        return Some(reason);
+    let dampers = scene.damper_list();
+    if dampers.len() > world::MOST_DAMPERS {
+        return Some(format!("the scene has {} dampers; the contact model holds at most {}", dampers.len(), world::MOST_DAMPERS));
+    }
+    let several = dampers.len() > 1;
+    for (k, d) in dampers.iter().enumerate() {
+        if let Err(reason) = Chamber::of_damper(scene, d) {
+            return Some(if several { format!("damper[{k}]: {reason}") } else { reason });
+        }
     }
     if scene.balls.is_empty() {
         return Some("the scene has no balls".into());
@@ -90,8 +97,12 @@ pub fn rapier_world(scene: &Scene) -> Result<SpatialWorld, String> {
     if let Some(why) = refusal(scene) {
         return Err(why);
     }
-    let geometry = Chamber::new(scene)?;
-    Ok(world::build(scene, &geometry, solver_settings(scene)))
+    Ok(world::build(scene, &chambers(scene)?, solver_settings(scene)))
+}
+
+/// Each damper's container.
+fn chambers(scene: &Scene) -> Result<Vec<Chamber>, String> {
+    scene.damper_list().iter().map(|d| Chamber::of_damper(scene, d)).collect()
 }
 
 /// Rapier's settings for `scene` on the spatial path: the scene's `[rapier] dt` (default
@@ -217,12 +228,25 @@ pub fn simulate_spatial_with(scene: &Scene, solver: SolverSettings, options: &Ru
     if let Some(reason) = refusal(scene) {
         return Err(ModelError::Refused(reason));
     }
-    let geometry = Chamber::new(scene).map_err(ModelError::Refused)?;
+    let geometry = chambers(scene).map_err(ModelError::Refused)?;
     let speed = crate::rapier::resources::speed_scale(scene);
     let Some(f) = scene.frame else { return Err(ModelError::Refused("the scene has no frame".into())) };
     let meter = Meter::new(options, BUDGET_STEPS);
     let mut world = world::build(scene, &geometry, solver);
     let n = scene.balls.len();
+    // The bodies that carry the walls: the frame, or each floor that carries a damper. Each
+    // ball's walls are its damper's, on its damper's body.
+    let dampers = scene.damper_list();
+    let body_floors = carrier::carrying_floors(scene);
+    let body_of_damper: Vec<usize> = dampers.iter().map(|d| body_floors.iter().position(|&j| j == d.floor).unwrap_or(0)).collect();
+    let damper_of: Vec<u32> = (0..n).map(|i| scene.damper_of(i) as u32).collect();
+    let body_of: Vec<usize> = damper_of.iter().map(|&d| body_of_damper[d as usize]).collect();
+    let body_mass: Vec<f64> = match (&scene.structure, body_floors.len()) {
+        (Some(s), 2..) => body_floors.iter().map(|&j| s.building.masses[j]).collect(),
+        _ => vec![f.mass],
+    };
+    let bodies = body_mass.len();
+    let xs_of_damper = |xs: &[f64]| -> Vec<f64> { body_of_damper.iter().map(|&b| xs[b]).collect() };
     let mass: Vec<f64> = scene.balls.iter().map(|b| b.mass).collect();
     let radius: Vec<f64> = scene.balls.iter().map(|b| b.radius).collect();
     let inertia: Vec<f64> = scene.balls.iter().map(|b| 0.4 * b.mass * b.radius * b.radius).collect();
@@ -233,13 +257,13 @@ pub fn simulate_spatial_with(scene: &Scene, solver: SolverSettings, options: &Ru
     now.read(&world.physics.bodies, &world.balls);
     let start_positions = now.x.clone();
     let mut before = BallState { x: now.x.clone(), v: now.v.clone(), w: now.w.clone() };
-    let (mut xs, mut vs) = carrier.start();
+    let (mut xs, mut vs): (Vec<f64>, Vec<f64>) = carrier.starts().into_iter().unzip();
     let (mut damping_loss, mut forcing_work, mut impact_loss, mut contact_loss) = (0.0, 0.0, 0.0, 0.0);
     let mut report = SpatialReport::default();
     let mut impacts = Impacts::new(options.impacts);
     let mut recorder = Recorder::new(scene, options.record);
     let sample_count = scene.sample_count();
-    sample(&mut recorder, scene, &carrier, 0.0, (xs, vs), |i| {
+    sample(&mut recorder, scene, &carrier, 0.0, (xs[0], vs[0]), |i| {
         let ([y, z], [vy, vz]) = (scene.space.lateral_of(i), scene.space.lateral_velocity_of(i));
         ([scene.initial_positions[i], y, z], [scene.initial_velocities[i], vy, vz])
     });
@@ -253,10 +277,10 @@ pub fn simulate_spatial_with(scene: &Scene, solver: SolverSettings, options: &Ru
     let g_norm = contacts_dot(g, g).sqrt();
     let down = if g_norm > 0.0 { g.map(|c| c / g_norm) } else { [0.0; 3] };
     let mut in_pile = vec![false; n];
-    let resting_speed = |c: &Contact, in_pile: &[bool], walls_a: f64| {
+    let resting_speed = |c: &Contact, in_pile: &[bool], walls_a: &[f64]| {
         let piled = in_pile[c.ball] || matches!(c.other, Other::Ball(j) if in_pile[j]);
         let pressing = if piled { g_norm } else { contacts_dot(g, c.normal).abs() };
-        2.0 * (pressing + c.normal[0].abs() * walls_a) * solver.dt + speed_floor
+        2.0 * (pressing + c.normal[0].abs() * walls_a[body_of[c.ball]]) * solver.dt + speed_floor
     };
     let prediction = world.physics.integration_parameters.normalized_prediction_distance;
     let lu = world.physics.integration_parameters.length_unit;
@@ -273,8 +297,8 @@ pub fn simulate_spatial_with(scene: &Scene, solver: SolverSettings, options: &Ru
     let mut strikes = strikes::Strikes::default();
     let mut unsolved = Vec::new();
     let height_at_start = scene.height_energy_at_start();
-    let energy_of = |carrier: &Carrier, state: &BallState, t: f64, xs: f64, vs: f64| -> f64 {
-        let mut e = carrier.energy(t, xs, vs) + height_at_start;
+    let energy_of = |carrier: &Carrier, state: &BallState, t: f64, xs: &[f64], vs: &[f64]| -> f64 {
+        let mut e = carrier.energy(t, xs[0], vs[0]) + height_at_start;
         for i in 0..n {
             let (v, w, x, x0) = (state.v[i], state.w[i], state.x[i], start_positions[i]);
             e += 0.5 * mass[i] * contacts_dot(v, v) + 0.5 * inertia[i] * contacts_dot(w, w);
@@ -289,15 +313,16 @@ pub fn simulate_spatial_with(scene: &Scene, solver: SolverSettings, options: &Ru
     // to Rapier's plastic solve, a ball touching a row would move the whole row as one block.
     {
         // As far as the first step may close a pair, for its strikes.
-        finder.find(&geometry, &now.x, &radius, xs, touching + reach * solver.dt, &mut found);
+        let walls = Containers { chambers: &geometry, damper: &damper_of, xs: &xs_of_damper(&xs) };
+        finder.find(walls, &now.x, &radius, touching + reach * solver.dt, &mut found);
         contacts::mark_piles(&found, touching, down, &mut in_pile);
         kicked.iter_mut().for_each(|k| *k = true);
         let mut struck = vec![false; n];
         let mut balls = Balls { v: &mut now.v, mass: &mass };
-        let mut frame = FrameBody { vs, mass: f.mass };
+        let mut frame = FrameBody { vs: vs.clone(), mass: &body_mass, of_ball: &body_of };
         // The walls' mean acceleration over the first step.
-        let walls_a = ((carrier.state(solver.dt).1 - vs) / solver.dt).abs();
-        let resting = |c: &Contact| resting_speed(c, &in_pile, walls_a);
+        let walls_a: Vec<f64> = carrier.states(solver.dt).iter().zip(&vs).map(|((_, v1), v0)| ((v1 - v0) / solver.dt).abs()).collect();
+        let resting = |c: &Contact| resting_speed(c, &in_pile, &walls_a);
         cascade.run(&found, touching, &mut kicked, resting, (&mut balls, &mut frame), |c, approach, balls, frame| {
             let lost = contacts::strike(c, approach, e, balls, frame);
             impact_loss += lost;
@@ -308,7 +333,8 @@ pub fn simulate_spatial_with(scene: &Scene, solver: SolverSettings, options: &Ru
                 struck[j] = true;
             }
         });
-        carrier.restart(0.0, (xs, vs), frame.vs).map_err(ModelError::Refused)?;
+        let starts: Vec<(f64, f64)> = xs.iter().copied().zip(vs.iter().copied()).collect();
+        carrier.restart_bodies(0.0, &starts, &frame.vs).map_err(ModelError::Refused)?;
         vs = frame.vs;
         now.write_velocities(&mut world.physics.bodies, &world.balls, &struck);
     }
@@ -316,8 +342,8 @@ pub fn simulate_spatial_with(scene: &Scene, solver: SolverSettings, options: &Ru
     let mut steps: u64 = 0;
     let finish = |carrier: &Carrier,
                   t: f64,
-                  xs: f64,
-                  vs: f64,
+                  xs: &[f64],
+                  vs: &[f64],
                   state: &BallState,
                   recorder: Recorder,
                   impacts: Impacts,
@@ -357,7 +383,7 @@ pub fn simulate_spatial_with(scene: &Scene, solver: SolverSettings, options: &Ru
                 cost += "; a run that counts its impacts instead of keeping them (`--impacts count`) is not bounded by memory";
             }
             let mut partial =
-                finish(&carrier, t, xs, vs, &now, recorder, impacts, damping_loss, impact_loss, contact_loss, forcing_work, steps);
+                finish(&carrier, t, &xs, &vs, &now, recorder, impacts, damping_loss, impact_loss, contact_loss, forcing_work, steps);
             partial.wall_time_s = wall_s;
             return Err(ModelError::OverBudget(Box::new(OverBudget {
                 scene: scene.name.clone(),
@@ -380,24 +406,28 @@ pub fn simulate_spatial_with(scene: &Scene, solver: SolverSettings, options: &Ru
         // The frame to where its closed form is at the step's end; Rapier moves the walls
         // there in a straight line.
         let (t0, t1) = (t, t + h);
-        let (x1, v1) = carrier.state(t1);
+        let (x1, v1): (Vec<f64>, Vec<f64>) = carrier.states(t1).into_iter().unzip();
         let (damping, work) = carrier.energy_flows(t0, h);
         damping_loss += damping;
         forcing_work += work;
-        world.physics.bodies[world.frame].set_next_kinematic_translation(Vector::new(x1 as f32, 0.0, 0.0));
+        for (d, &frame) in world.frames.iter().enumerate() {
+            let x = x1[body_of_damper[d]];
+            world.physics.bodies[frame].set_next_kinematic_translation(Vector::new(x as f32, 0.0, 0.0));
+        }
         // The walls' mean velocity over the step: Rapier moves them there in a straight line.
-        let mean_vs = (x1 - xs) / h;
+        let mean_vs: Vec<f64> = (0..bodies).map(|b| (x1[b] - xs[b]) / h).collect();
         // Rapier stops a pair at contact only when it predicts it: as far ahead as the scene's
         // speed carries a body in a step, and further when a ball moves faster than that
         // relative to the walls (light balls struck by heavy ones), by what any pair can then
         // close in the step (twice the fastest ball's speed, and gravity's pull).
-        let fastest = now.v.iter().map(|v| ((v[0] - mean_vs).powi(2) + v[1] * v[1] + v[2] * v[2]).sqrt()).fold(0.0, f64::max);
+        let fastest =
+            now.v.iter().zip(&body_of).map(|(v, &b)| ((v[0] - mean_vs[b]).powi(2) + v[1] * v[1] + v[2] * v[2]).sqrt()).fold(0.0, f64::max);
         let closing = (2.0 * fastest * h + g_norm * h * h) as f32 / lu;
         world.physics.integration_parameters.normalized_prediction_distance = prediction.max(closing);
         // Strikes on touching groups are kept out of Rapier's solve of their pair (`strikes`).
         // The walls' mean acceleration over the step, as its closed form moves them.
-        let walls_a = ((v1 - vs) / h).abs();
-        strikes.predict(&found, &now.v, vs, touching, h, |c| resting_speed(c, &in_pile, walls_a));
+        let walls_a: Vec<f64> = (0..bodies).map(|b| ((v1[b] - vs[b]) / h).abs()).collect();
+        strikes.predict(&found, &now.v, |k| vs[body_of[k]], touching, h, |c| resting_speed(c, &in_pile, &walls_a));
         unsolved.clear();
         unsolved.extend(strikes.list.iter().map(|s| (world.colliders[s.striker], world.colliders[s.target])));
         for s in &strikes.list {
@@ -408,7 +438,7 @@ pub fn simulate_spatial_with(scene: &Scene, solver: SolverSettings, options: &Ru
         now.read(&world.physics.bodies, &world.balls);
         for s in &strikes.list {
             world.physics.colliders[world.colliders[s.striker]].set_active_hooks(ActiveHooks::empty());
-            if strikes::bring_back(*s, &mut now.x, &now.v, mean_vs, &radius, h) {
+            if strikes::bring_back(*s, &mut now.x, &now.v, mean_vs[body_of[s.striker]], &radius, h) {
                 let p = now.x[s.striker].map(|c| c as f32);
                 let body = &mut world.physics.bodies[world.balls[s.striker]];
                 body.set_translation(Vector::new(p[0], p[1], p[2]), true);
@@ -417,11 +447,15 @@ pub fn simulate_spatial_with(scene: &Scene, solver: SolverSettings, options: &Ru
         }
         // Rapier's walls are infinitely heavy: the frame takes the opposite of the x momentum
         // they gave the balls (ball-ball impulses cancel in the sum; gravity's is not theirs).
-        let dpx: f64 = (0..n).map(|i| mass[i] * (now.v[i][0] - before.v[i][0] - g[0] * h)).sum();
-        let mut frame = FrameBody { vs: v1 - dpx / f.mass, mass: f.mass };
+        let mut dpx = vec![-0.0; bodies];
+        for i in 0..n {
+            dpx[body_of[i]] += mass[i] * (now.v[i][0] - before.v[i][0] - g[0] * h);
+        }
+        let mut frame = FrameBody { vs: (0..bodies).map(|b| v1[b] - dpx[b] / body_mass[b]).collect(), mass: &body_mass, of_ball: &body_of };
         // Pairs Rapier may have stopped: its speculative contacts slow a pair a little before
         // it touches, within what it closes in a step or two.
-        finder.find(&geometry, &now.x, &radius, x1, touching + reach * h, &mut found);
+        let walls = Containers { chambers: &geometry, damper: &damper_of, xs: &xs_of_damper(&x1) };
+        finder.find(walls, &now.x, &radius, touching + reach * h, &mut found);
         contacts::mark_piles(&found, touching, down, &mut in_pile);
         // Contacts whose approach Rapier stopped, the fastest first.
         let mut new: Vec<Closing> = Vec::new();
@@ -430,7 +464,8 @@ pub fn simulate_spatial_with(scene: &Scene, solver: SolverSettings, options: &Ru
             _ => None,
         });
         if let Some((c, wall)) = sunk.min_by(|a, b| a.0.gap.total_cmp(&b.0.gap)) {
-            return Err(sunk_too_deep(scene, t1, (c.ball, -c.gap, wall), sink_limit, (v1 - vs) / h));
+            let b = body_of[c.ball];
+            return Err(sunk_too_deep(scene, t1, (c.ball, -c.gap, wall), sink_limit, (v1[b] - vs[b]) / h));
         }
         for (k, c) in found.iter().enumerate() {
             report.deepest_overlap = report.deepest_overlap.max(-c.gap);
@@ -457,8 +492,9 @@ pub fn simulate_spatial_with(scene: &Scene, solver: SolverSettings, options: &Ru
                 }
                 Other::Wall(wall) => {
                     let p = before.x[c.ball];
-                    let (gap0, _) = geometry.gap(wall, [p[0] - xs, p[1], p[2]], radius[c.ball]);
-                    let wall_n = c.normal[0] * mean_vs;
+                    let b = body_of[c.ball];
+                    let (gap0, _) = geometry[damper_of[c.ball] as usize].gap(wall, [p[0] - xs[b], p[1], p[2]], radius[c.ball]);
+                    let wall_n = c.normal[0] * mean_vs[b];
                     (
                         gap0,
                         wall_n - contacts_dot(before.v[c.ball], c.normal),
@@ -469,7 +505,7 @@ pub fn simulate_spatial_with(scene: &Scene, solver: SolverSettings, options: &Ru
             };
             // An impact is a contact Rapier's plastic solve stopped in this step: it was
             // approaching faster than a resting contact, and the step took its approach.
-            let resting = resting_speed(c, &in_pile, walls_a);
+            let resting = resting_speed(c, &in_pile, &walls_a);
             let approach = closing_speed(gap0, w0, g_n, h);
             let stopped = w_end - (w0 - g_n * h) > resting;
             if approach > resting && stopped && c.gap <= touching + 2.0 * (-w0).max(0.0) * h {
@@ -483,14 +519,15 @@ pub fn simulate_spatial_with(scene: &Scene, solver: SolverSettings, options: &Ru
             let mut balls = Balls { v: &mut now.v, mass: &mass };
             // The frame's velocity as the impacts leave it one after the other (§3): each
             // wall impact meets the frame as the impacts before it left it.
-            let mut frame_in_turn = mean_vs;
+            let mut frame_in_turn = mean_vs.clone();
             for closing in &new {
                 let c = found[closing.k];
                 let (approach, lost) = match c.other {
                     Other::Ball(_) => (closing.approach, contacts::strike(&c, closing.approach, e, &mut balls, &mut frame)),
                     Other::Wall(_) => {
                         let n = c.normal;
-                        let w0 = closing.w0 + n[0] * (frame_in_turn - mean_vs);
+                        let b = body_of[c.ball];
+                        let w0 = closing.w0 + n[0] * (frame_in_turn[b] - mean_vs[b]);
                         let approach = closing_speed(closing.gap0, w0, closing.g_n, h);
                         if approach <= 0.0 {
                             continue;
@@ -498,12 +535,12 @@ pub fn simulate_spatial_with(scene: &Scene, solver: SolverSettings, options: &Ru
                         // Eq. 9-10 with the frame as it is at this impact's turn: the ball
                         // leaves at the frame's normal velocity then, less `e` times the
                         // approach, less the frame's share of the recoil.
-                        let (m, inv_frame) = (mass[c.ball], n[0] * n[0] / f.mass);
+                        let (m, inv_frame) = (mass[c.ball], n[0] * n[0] / body_mass[b]);
                         let mu = 1.0 / (1.0 / m + inv_frame);
-                        let ball_after = n[0] * frame_in_turn + approach - (1.0 + e) * approach * mu / m;
+                        let ball_after = n[0] * frame_in_turn[b] + approach - (1.0 + e) * approach * mu / m;
                         let ball_now = contacts_dot(balls.v[c.ball], n);
                         contacts::push_apart(&c, m * (ball_now - ball_after), &mut balls, &mut frame);
-                        frame_in_turn += (1.0 + e) * approach * mu * n[0] / f.mass;
+                        frame_in_turn[b] += (1.0 + e) * approach * mu * n[0] / body_mass[b];
                         (approach, 0.5 * (1.0 - e * e) * mu * approach * approach)
                     }
                 };
@@ -517,7 +554,7 @@ pub fn simulate_spatial_with(scene: &Scene, solver: SolverSettings, options: &Ru
             }
             // Touching pairs the impacts set approaching strike in turn, the fastest first.
             if !new.is_empty() {
-                let resting = |c: &Contact| resting_speed(c, &in_pile, walls_a);
+                let resting = |c: &Contact| resting_speed(c, &in_pile, &walls_a);
                 cascade.run(&found, touching, &mut kicked, resting, (&mut balls, &mut frame), |c, approach, balls, frame| {
                     let lost = contacts::strike(c, approach, e, balls, frame);
                     step_impact_loss += lost;
@@ -535,7 +572,7 @@ pub fn simulate_spatial_with(scene: &Scene, solver: SolverSettings, options: &Ru
             (0..n).map(|i| 0.5 * mass[i] * contacts_dot(s.v[i], s.v[i]) + 0.5 * inertia[i] * contacts_dot(s.w[i], s.w[i])).sum()
         };
         let gravity_work: f64 = (0..n).map(|i| mass[i] * contacts_dot(g, std::array::from_fn(|a| now.x[i][a] - before.x[i][a]))).sum();
-        let frame_jump = 0.5 * f.mass * (frame.vs * frame.vs - v1 * v1);
+        let frame_jump: f64 = (0..bodies).map(|b| 0.5 * body_mass[b] * (frame.vs[b] * frame.vs[b] - v1[b] * v1[b])).sum();
         let step_loss = -(kinetic(&now) - kinetic(&before) - gravity_work + frame_jump) - step_impact_loss;
         contact_loss += step_loss;
         report.worst_step_gain = report.worst_step_gain.max(-step_loss);
@@ -550,22 +587,23 @@ pub fn simulate_spatial_with(scene: &Scene, solver: SolverSettings, options: &Ru
             let wgt = ((ts - t0) / h).clamp(0.0, 1.0);
             let b = &before;
             let a = &now;
-            sample(&mut recorder, scene, &carrier, ts, carrier.state(ts.max(t0)), |i| {
+            sample(&mut recorder, scene, &carrier, ts, carrier.states(ts.max(t0))[0], |i| {
                 (std::array::from_fn(|k| b.x[i][k] + wgt * (a.x[i][k] - b.x[i][k])), b.v[i])
             });
             next_sample += 1;
         }
-        carrier.restart(t1, (x1, v1), frame.vs).map_err(ModelError::Refused)?;
+        let ends: Vec<(f64, f64)> = x1.iter().copied().zip(v1.iter().copied()).collect();
+        carrier.restart_bodies(t1, &ends, &frame.vs).map_err(ModelError::Refused)?;
         while next_sample < sample_count && scene.sample_at_step_end(next_sample as f64 * scene.sample_dt, t1, h) {
             let a = &now;
-            sample(&mut recorder, scene, &carrier, next_sample as f64 * scene.sample_dt, (x1, frame.vs), |i| (a.x[i], a.v[i]));
+            sample(&mut recorder, scene, &carrier, next_sample as f64 * scene.sample_dt, (x1[0], frame.vs[0]), |i| (a.x[i], a.v[i]));
             next_sample += 1;
         }
         xs = x1;
         vs = frame.vs;
         t = t1;
         steps += 1;
-        let energy = energy_of(&carrier, &now, t, xs, vs);
+        let energy = energy_of(&carrier, &now, t, &xs, &vs);
         let energy_in = initial_energy + forcing_work;
         if energy > energy_in + energy_gain_allowance(scene, energy_in) {
             return Err(ModelError::Unstable {
@@ -581,7 +619,7 @@ pub fn simulate_spatial_with(scene: &Scene, solver: SolverSettings, options: &Ru
     meter.finish(scene.horizon, steps);
     report.steps = steps;
     report.contact_loss = contact_loss;
-    let mut run = finish(&carrier, t, xs, vs, &now, recorder, impacts, damping_loss, impact_loss, contact_loss, forcing_work, steps);
+    let mut run = finish(&carrier, t, &xs, &vs, &now, recorder, impacts, damping_loss, impact_loss, contact_loss, forcing_work, steps);
     // The steps' sum ends within a relative 1e-12 of the horizon; the run covered it.
     run.horizon = scene.horizon;
     run.wall_time_s = meter.elapsed();

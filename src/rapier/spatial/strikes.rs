@@ -41,12 +41,20 @@ fn dot(a: [f64; 3], b: [f64; 3]) -> f64 {
 impl Strikes {
     /// Lists the strikes of a step of length `h` from `found` (every pair closer than
     /// `touching` and those a step may close, at the step's start) and the balls' velocities
-    /// `v` (the walls moving along x at `walls_v`): pairs of balls apart by more than `touching` whose free flight closes them within
+    /// `v` (ball `k`'s walls moving along x at `walls_v(k)`): pairs of balls apart by more than `touching` whose free flight closes them within
     /// two steps, approaching faster than `resting(contact)`, of which one ball (the striker)
     /// touches no other ball and no end wall (one that the frame drives is not in flight),
     /// closes on nothing else and carries half the approach or more relative to the walls, and
     /// the other touches something. A ball is in one strike at most.
-    pub fn predict(&mut self, found: &[Contact], v: &[[f64; 3]], walls_v: f64, touching: f64, h: f64, resting: impl Fn(&Contact) -> f64) {
+    pub fn predict(
+        &mut self,
+        found: &[Contact],
+        v: &[[f64; 3]],
+        walls_v: impl Fn(usize) -> f64,
+        touching: f64,
+        h: f64,
+        resting: impl Fn(&Contact) -> f64,
+    ) {
         let n = v.len();
         self.list.clear();
         for flags in [&mut self.touches_ball, &mut self.touches_any, &mut self.touches_end_wall] {
@@ -92,7 +100,7 @@ impl Strikes {
             // among them than two steps.
             let approach = dot(v[c.ball], c.normal) - dot(v[j], c.normal);
             let free = |k: usize| {
-                let among_walls = dot(v[k], c.normal) - walls_v * c.normal[0];
+                let among_walls = dot(v[k], c.normal) - walls_v(k) * c.normal[0];
                 let own = if k == c.ball { among_walls } else { -among_walls };
                 !self.touches_ball[k] && !self.touches_end_wall[k] && self.closings[k] == 1 && own >= 0.5 * approach
             };

@@ -1,6 +1,7 @@
-//! The scene as a Rapier world: a kinematic frame carrying the container's six walls (and the
-//! dividers between chains), and a dynamic sphere per ball, free in 3D, under the scene's
-//! gravity and friction. Every contact Rapier solves is plastic: the stepper gives the bounces.
+//! The scene as a Rapier world: a kinematic body per damper carrying its container's six walls
+//! (and the dividers between chains), and a dynamic sphere per ball, free in 3D, under the
+//! scene's gravity and friction. Every contact Rapier solves is plastic: the stepper gives the
+//! bounces. Several dampers share the world's space; each collides only with itself.
 
 use bevy_rapier3d::rapier::prelude::*;
 
@@ -10,8 +11,8 @@ use crate::scene::{Chamber, Scene, Wall};
 pub struct SpatialWorld {
     /// Rapier's state.
     pub physics: PhysicsWorld,
-    /// The frame's kinematic body.
-    pub frame: RigidBodyHandle,
+    /// Each damper's kinematic body (the frame's, or its floor's), in the scene's order.
+    pub frames: Vec<RigidBodyHandle>,
     /// One dynamic body per ball, in the scene's order.
     pub balls: Vec<RigidBodyHandle>,
     /// Each ball's collider, in the same order.
@@ -36,8 +37,12 @@ pub struct SolverSettings {
 /// The walls are this many largest radii thick: no ball crosses one in a step.
 const WALL_THICKNESS_RADII: f64 = 4.0;
 
-/// Builds the world of `scene` (validated for the spatial path by `super::refusal`).
-pub fn build(scene: &Scene, geometry: &Chamber, solver: SolverSettings) -> SpatialWorld {
+/// Most dampers one world holds: each has a collision group of its own.
+pub const MOST_DAMPERS: usize = 32;
+
+/// Builds the world of `scene` (validated for the spatial path by `super::refusal`), each
+/// damper's container from `chambers`.
+pub fn build(scene: &Scene, chambers: &[Chamber], solver: SolverSettings) -> SpatialWorld {
     let mut physics = PhysicsWorld::new();
     let [gx, gy, gz] = scene.space.gravity;
     physics.gravity = Vector::new(gx as f32, gy as f32, gz as f32);
@@ -65,18 +70,31 @@ pub fn build(scene: &Scene, geometry: &Chamber, solver: SolverSettings) -> Spati
             .restitution(0.0)
             .restitution_combine_rule(CoefficientCombineRule::Min)
     };
-    let frame = physics.insert_body(
-        RigidBodyBuilder::kinematic_position_based().translation(Vector::new(scene.initial_displacement as f32, 0.0, 0.0)).can_sleep(false),
-    );
-    let thick = WALL_THICKNESS_RADII * geometry.largest_radius;
-    for wall in geometry.walls() {
-        let (centre, half) = wall_box(geometry, wall, thick);
-        let collider = plastic(ColliderBuilder::cuboid(half[0] as f32, half[1] as f32, half[2] as f32)).translation(Vector::new(
-            centre[0] as f32,
-            centre[1] as f32,
-            centre[2] as f32,
-        ));
-        physics.insert_collider(collider, Some(frame));
+    // Several dampers each collide only within themselves; one keeps Rapier's default groups.
+    let dampers = scene.damper_list();
+    let own = |d: usize, b: ColliderBuilder| {
+        if dampers.len() < 2 {
+            return b;
+        }
+        let group = Group::from_bits_truncate(1 << (d % MOST_DAMPERS));
+        b.collision_groups(InteractionGroups::new(group, group, InteractionTestMode::And))
+    };
+    let mut frames = Vec::with_capacity(dampers.len());
+    for (d, (damper, geometry)) in dampers.iter().zip(chambers).enumerate() {
+        let start = scene.damper_start(damper);
+        let frame = physics
+            .insert_body(RigidBodyBuilder::kinematic_position_based().translation(Vector::new(start as f32, 0.0, 0.0)).can_sleep(false));
+        let thick = WALL_THICKNESS_RADII * geometry.largest_radius;
+        for wall in geometry.walls() {
+            let (centre, half) = wall_box(geometry, wall, thick);
+            let collider = plastic(ColliderBuilder::cuboid(half[0] as f32, half[1] as f32, half[2] as f32)).translation(Vector::new(
+                centre[0] as f32,
+                centre[1] as f32,
+                centre[2] as f32,
+            ));
+            physics.insert_collider(own(d, collider), Some(frame));
+        }
+        frames.push(frame);
     }
     let mut balls = Vec::with_capacity(scene.balls.len());
     let mut colliders = Vec::with_capacity(scene.balls.len());
@@ -87,12 +105,12 @@ pub fn build(scene: &Scene, geometry: &Chamber, solver: SolverSettings) -> Spati
             .translation(Vector::new(scene.initial_positions[i] as f32, y as f32, z as f32))
             .linvel(Vector::new(scene.initial_velocities[i] as f32, vy as f32, vz as f32))
             .can_sleep(false);
-        let collider = plastic(ColliderBuilder::ball(ball.radius as f32)).mass(ball.mass as f32);
+        let collider = own(scene.damper_of(i), plastic(ColliderBuilder::ball(ball.radius as f32)).mass(ball.mass as f32));
         let (body, collider) = physics.insert(body, collider);
         balls.push(body);
         colliders.push(collider);
     }
-    SpatialWorld { physics, frame, balls, colliders }
+    SpatialWorld { physics, frames, balls, colliders }
 }
 
 /// The box of a wall in the frame's coordinates (origin at the left wall's inner face on the
