@@ -8,6 +8,7 @@ use anyhow::Context;
 
 use lpc_damper::model::{ModelError, RunOptions};
 use lpc_damper::run::ImpactRecord;
+use lpc_damper::scene::Scene;
 
 use lpc_damper::files::write_atomic;
 use lpc_damper::metrics::{Metric, RunSummary};
@@ -84,7 +85,7 @@ pub fn run(a: Args) -> Result<ExitStatus> {
     }
     let run = match crate::watch::watched_model(a.model, &scene, RunOptions { impacts: a.impacts, ..RunOptions::limited(limits) }) {
         Ok(run) => run,
-        Err(e) => return Err(stopped(&a, e)),
+        Err(e) => return Err(stopped(&a, &scene, e)),
     };
     let mut summary = RunSummary::of(&run);
     summary.dampers = lpc_damper::metrics::DamperSummary::of(&scene, &run);
@@ -111,9 +112,12 @@ pub fn run(a: Args) -> Result<ExitStatus> {
 
 /// A run that could not reach its horizon: the run so far, when the model kept it, written to
 /// `--out` and printed as JSON, both with the reason it stopped; then the error.
-fn stopped(a: &Args, e: ModelError) -> CommandError {
+fn stopped(a: &Args, scene: &Scene, e: ModelError) -> CommandError {
     let reason = e.to_string();
-    let summary = e.partial().map(|partial| (partial, RunSummary { stop: Some(reason.clone()), ..RunSummary::of(partial) }));
+    let summary = e.partial().map(|partial| {
+        let dampers = lpc_damper::metrics::DamperSummary::of(scene, partial);
+        (partial, RunSummary { stop: Some(reason.clone()), dampers, ..RunSummary::of(partial) })
+    });
     if let (Some((partial, summary)), Some(dir)) = (&summary, &a.out) {
         if let Err(w) = write_run_dir_with(partial, summary, dir) {
             return CommandError::failure(anyhow::Error::new(w).context(format!("writing outputs to {}", dir.display())));
