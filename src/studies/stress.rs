@@ -476,10 +476,20 @@ fn validate(file: &SceneFile) -> Result<Scene, String> {
     scene::from_file(file.clone(), "stress", "stress").map_err(|e| e.to_string())?.scene.ok_or_else(|| "no damper scene".to_string())
 }
 
+/// The scene run for half as long, unless it is 10 ms or shorter already.
+fn shorter(f: &SceneFile) -> Option<SceneFile> {
+    let horizon = f.run.horizon.unwrap_or(5.0);
+    (horizon > 0.01).then(|| {
+        let mut g = f.clone();
+        g.run.horizon = Some(horizon / 2.0);
+        g.run.sample_dt = Some((horizon / 2.0 / 2000.0).max(1e-5));
+        g
+    })
+}
+
 /// Smaller and simpler variants of a scene file, for shrinking.
 fn simplifications(f: &SceneFile) -> Vec<SceneFile> {
     let mut out = vec![];
-    let horizon = f.run.horizon.unwrap_or(5.0);
     if let Some(list) = &f.dampers {
         // Dampers: one fewer, a shorter run.
         if list.len() > 1 {
@@ -487,12 +497,7 @@ fn simplifications(f: &SceneFile) -> Vec<SceneFile> {
             g.dampers = Some(list[..list.len() - 1].to_vec());
             out.push(g);
         }
-        if horizon > 0.01 {
-            let mut g = f.clone();
-            g.run.horizon = Some(horizon / 2.0);
-            g.run.sample_dt = Some((horizon / 2.0 / 2000.0).max(1e-5));
-            out.push(g);
-        }
+        out.extend(shorter(f));
         return out;
     }
     if let Some(bed) = &f.bed {
@@ -502,12 +507,7 @@ fn simplifications(f: &SceneFile) -> Vec<SceneFile> {
             g.bed.as_mut().unwrap().count = Some(count / 2);
             out.push(g);
         }
-        if horizon > 0.01 {
-            let mut g = f.clone();
-            g.run.horizon = Some(horizon / 2.0);
-            g.run.sample_dt = Some((horizon / 2.0 / 2000.0).max(1e-5));
-            out.push(g);
-        }
+        out.extend(shorter(f));
         return out;
     }
     let balls = f.balls.as_ref().expect("damper");
@@ -522,13 +522,7 @@ fn simplifications(f: &SceneFile) -> Vec<SceneFile> {
             }
         }
     }
-    let horizon = f.run.horizon.unwrap_or(5.0);
-    if horizon > 0.01 {
-        let mut g = f.clone();
-        g.run.horizon = Some(horizon / 2.0);
-        g.run.sample_dt = Some((horizon / 2.0 / 2000.0).max(1e-5));
-        out.push(g);
-    }
+    out.extend(shorter(f));
     let mut tweak = |edit: &dyn Fn(&mut SceneFile)| {
         let mut g = f.clone();
         edit(&mut g);
