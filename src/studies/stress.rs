@@ -71,6 +71,23 @@ pub struct Draws {
     pub dampers: bool,
 }
 
+impl Draws {
+    /// Plausible scenes run up to `max_horizon`, free, without a time budget, drawn on lines as
+    /// [`random_scene_file`] draws them.
+    pub fn plausible(max_horizon: f64) -> Draws {
+        Draws {
+            max_horizon,
+            forced: false,
+            extreme: false,
+            max_wall_s: None,
+            chains: false,
+            beds: false,
+            structures: false,
+            dampers: false,
+        }
+    }
+}
+
 /// `file` with its balls as a bed, drawn from a stream of its own (seeded from `seed` alone):
 /// 2 to 200 balls of one or two sizes (radii 2 to 8 mm) filling 20 to 70 % of the cells of a
 /// lattice in a box sized to hold them (up to twice as long), on the lattice or (at most 40 %

@@ -22,39 +22,9 @@ fn assert_all_pass(outcomes: &[Outcome]) {
 
 #[test]
 fn three_hundred_random_scenes_pass_every_check() {
-    assert_all_pass(&stress(
-        Model::Reference,
-        1,
-        300,
-        Draws {
-            max_horizon: 2.0,
-            forced: false,
-            extreme: false,
-            max_wall_s: None,
-            chains: false,
-            beds: false,
-            structures: false,
-            dampers: false,
-        },
-        &|| {},
-    ));
+    assert_all_pass(&stress(Model::Reference, 1, 300, Draws::plausible(2.0), &|| {}));
     // The same scenes as 1 to 4 chains side by side.
-    assert_all_pass(&stress(
-        Model::Reference,
-        1,
-        100,
-        Draws {
-            max_horizon: 2.0,
-            forced: false,
-            extreme: false,
-            max_wall_s: None,
-            chains: true,
-            beds: false,
-            structures: false,
-            dampers: false,
-        },
-        &|| {},
-    ));
+    assert_all_pass(&stress(Model::Reference, 1, 100, Draws { chains: true, ..Draws::plausible(2.0) }, &|| {}));
 }
 
 /// The same scenes with their frames as floors of buildings of 1 to 5 storeys, a third of the
@@ -65,16 +35,7 @@ fn three_hundred_random_scenes_pass_every_check() {
 /// model, all pass) is a documented command.
 #[test]
 fn random_buildings_pass_every_check() {
-    let draws = Draws {
-        max_horizon: 2.0,
-        forced: false,
-        extreme: false,
-        max_wall_s: None,
-        chains: false,
-        beds: false,
-        structures: true,
-        dampers: false,
-    };
+    let draws = Draws { structures: true, ..Draws::plausible(2.0) };
     for (model, count) in [(Model::Reference, 40), (Model::Rapier, 20), (Model::Compliant, 10)] {
         assert_all_pass(&stress(model, 30, count, draws, &|| {}));
     }
@@ -86,16 +47,7 @@ fn random_buildings_pass_every_check() {
 /// of computing, which bounds the test's time.
 #[test]
 fn random_beds_on_buildings_pass_every_check() {
-    let draws = Draws {
-        max_horizon: 2.0,
-        forced: false,
-        extreme: false,
-        max_wall_s: Some(2.0),
-        chains: false,
-        beds: true,
-        structures: true,
-        dampers: false,
-    };
+    let draws = Draws { max_wall_s: Some(2.0), beds: true, structures: true, ..Draws::plausible(2.0) };
     run_and_pass(draws, &[(Model::Rapier, 12), (Model::Compliant, 4)]);
     let outcomes = stress(Model::Reference, 1, 40, draws, &|| {});
     assert_all_pass(&outcomes);
@@ -111,16 +63,7 @@ fn random_beds_on_buildings_pass_every_check() {
 /// them, naming the dampers.
 #[test]
 fn random_dampers_on_buildings_pass_every_check() {
-    let draws = Draws {
-        max_horizon: 1.0,
-        forced: false,
-        extreme: false,
-        max_wall_s: Some(3.0),
-        chains: false,
-        beds: true,
-        structures: true,
-        dampers: true,
-    };
+    let draws = Draws { max_wall_s: Some(3.0), beds: true, structures: true, dampers: true, ..Draws::plausible(1.0) };
     run_and_pass(draws, &[(Model::Rapier, 8), (Model::Compliant, 4)]);
     for o in stress(Model::Reference, 30, 2, draws, &|| {}) {
         assert!(o.refused.as_ref().is_some_and(|why| why.contains("2 dampers") || why.contains("friction")), "{:?}", o.refused);
@@ -133,22 +76,7 @@ fn random_dampers_on_buildings_pass_every_check() {
 /// up to 10 s, all pass) is a documented command.
 #[test]
 fn forced_random_scenes_pass_every_check() {
-    assert_all_pass(&stress(
-        Model::Reference,
-        1,
-        100,
-        Draws {
-            max_horizon: 2.0,
-            forced: true,
-            extreme: false,
-            max_wall_s: None,
-            chains: false,
-            beds: false,
-            structures: false,
-            dampers: false,
-        },
-        &|| {},
-    ));
+    assert_all_pass(&stress(Model::Reference, 1, 100, Draws { forced: true, ..Draws::plausible(2.0) }, &|| {}));
 }
 
 #[test]
@@ -165,44 +93,14 @@ fn generated_scenes_are_reproducible_from_their_seed() {
 /// --count 1000` passes all 1000, 235 of them refused; docs/BENCHMARKS.md "Stress").
 #[test]
 fn contact_model_passes_the_first_seeded_scenes() {
-    assert_all_pass(&stress(
-        Model::Rapier,
-        1,
-        25,
-        Draws {
-            max_horizon: 1.0,
-            forced: false,
-            extreme: false,
-            max_wall_s: None,
-            chains: false,
-            beds: false,
-            structures: false,
-            dampers: false,
-        },
-        &|| {},
-    ));
+    assert_all_pass(&stress(Model::Rapier, 1, 25, Draws::plausible(1.0), &|| {}));
 }
 
 #[test]
 fn contact_model_passes_the_first_seeded_beds() {
     // Beds in boxes, under gravity and friction, some shaken by frames swinging at hundreds of
     // metres per second (seeds 1-10 of `lpc stress --beds`).
-    assert_all_pass(&stress(
-        Model::Rapier,
-        1,
-        10,
-        Draws {
-            max_horizon: 1.0,
-            forced: false,
-            extreme: false,
-            max_wall_s: None,
-            chains: false,
-            beds: true,
-            structures: false,
-            dampers: false,
-        },
-        &|| {},
-    ));
+    assert_all_pass(&stress(Model::Rapier, 1, 10, Draws { beds: true, ..Draws::plausible(1.0) }, &|| {}));
 }
 
 #[test]
@@ -212,22 +110,7 @@ fn reference_passes_the_first_seeded_beds() {
     // round-off with gravity's work, no overlap, no stall); a run may stop at its 3 s budget, a
     // typed stop (a pile costs a million events per contact and simulated second, docs/MODEL.md
     // §14).
-    assert_all_pass(&stress(
-        Model::Reference,
-        1,
-        23,
-        Draws {
-            max_horizon: 1.0,
-            forced: false,
-            extreme: false,
-            max_wall_s: Some(3.0),
-            chains: false,
-            beds: true,
-            structures: false,
-            dampers: false,
-        },
-        &|| {},
-    ));
+    assert_all_pass(&stress(Model::Reference, 1, 23, Draws { max_wall_s: Some(3.0), beds: true, ..Draws::plausible(1.0) }, &|| {}));
 }
 
 #[test]
@@ -235,22 +118,7 @@ fn compliant_model_passes_the_first_seeded_beds() {
     // The same beds for the compliant model's spatial path: every run it finishes passes every
     // check (its energy balance to the integration error); a run may stop at its 3 s budget,
     // a typed stop (whether it does depends on the machine; what is asserted does not).
-    assert_all_pass(&stress(
-        Model::Compliant,
-        1,
-        10,
-        Draws {
-            max_horizon: 1.0,
-            forced: false,
-            extreme: false,
-            max_wall_s: Some(3.0),
-            chains: false,
-            beds: true,
-            structures: false,
-            dampers: false,
-        },
-        &|| {},
-    ));
+    assert_all_pass(&stress(Model::Compliant, 1, 10, Draws { max_wall_s: Some(3.0), beds: true, ..Draws::plausible(1.0) }, &|| {}));
 }
 
 /// Issue 19: scenes at the extremes a user can type (`lpc stress --extreme`: 1-10 000 balls,
@@ -260,16 +128,7 @@ fn compliant_model_passes_the_first_seeded_beds() {
 /// (Whether a run finishes within its budget depends on the machine; what is asserted does not.)
 #[test]
 fn extreme_scenes_pass_refuse_or_stop_never_panic() {
-    let draws = |max_wall_s| Draws {
-        max_horizon: 100.0,
-        forced: false,
-        extreme: true,
-        max_wall_s: Some(max_wall_s),
-        chains: false,
-        beds: false,
-        structures: false,
-        dampers: false,
-    };
+    let draws = |max_wall_s| Draws { extreme: true, max_wall_s: Some(max_wall_s), ..Draws::plausible(100.0) };
     assert_all_pass(&stress(Model::Reference, 1, 24, draws(1.0), &|| {}));
     for model in [Model::Rapier, Model::Compliant] {
         for o in stress(model, 1, 6, draws(0.5), &|| {}) {
