@@ -58,6 +58,7 @@ class Run:
     metrics: dict[str, float | None]
     energy: dict[str, float]
     noise: dict[str, Any]
+    dampers: list[dict[str, Any]]
     wall_time_s: float
 
 def load_scene(path: str | PathLike[str]) -> Scene: ...

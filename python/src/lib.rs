@@ -96,10 +96,10 @@ fn run(
     let impacts = impacts.parse().map_err(|e| SceneError::new_err(format!("impacts: {e}")))?;
     let options = RunOptions { impacts, ..RunOptions::limited(limits(max_steps, max_wall_time)?) };
     match py.detach(|| model.simulate(&s, &options)) {
-        Ok(run) => Ok(Run::of(run)),
+        Ok(run) => Ok(Run::of(&s, run)),
         Err(RustModelError::OverBudget(stop)) => {
             let err = ModelError::new_err(stop.to_string());
-            err.value(py).setattr("partial", Py::new(py, Run::of(stop.partial))?)?;
+            err.value(py).setattr("partial", Py::new(py, Run::of(&s, stop.partial))?)?;
             Err(err)
         }
         Err(e) => Err(model_error(e)),

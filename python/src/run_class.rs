@@ -7,7 +7,7 @@ use pyo3::prelude::*;
 use pyo3::sync::MutexExt;
 use pyo3::types::PyDict;
 
-use lpc_damper::metrics::RunSummary;
+use lpc_damper::metrics::{DamperSummary, RunSummary};
 
 /// One run: the sampled series as NumPy arrays (moved, not copied), the impacts as a dict of
 /// arrays, and the summary's `metrics`, `energy` and `noise` as dicts with `summary.json`'s keys.
@@ -32,6 +32,8 @@ pub(crate) struct Run {
     /// without keeping them (`impacts = "count"`).
     #[pyo3(get)]
     pub(crate) impact_count: usize,
+    /// Each damper's figures, when the scene has several (`summary.json`'s `dampers`).
+    pub(crate) damper_figures: Vec<DamperSummary>,
     /// The run, whose series move out as they are read.
     pub(crate) run: std::sync::Mutex<lpc_damper::run::Run>,
     /// Everything read so far, by name.
@@ -218,6 +220,13 @@ impl Run {
     pub(crate) fn noise(&self, py: Python<'_>) -> PyResult<Py<PyAny>> {
         self.part(py, "noise")
     }
+    /// Each damper's floor, balls, impacts, wall impacts and impact loss, as dicts with
+    /// `summary.json`'s keys; empty for a scene of one damper.
+    #[getter]
+    pub(crate) fn dampers(&self, py: Python<'_>) -> PyResult<Py<PyAny>> {
+        let value = serde_json::to_string(&self.damper_figures).map_err(|e| PyRuntimeError::new_err(e.to_string()))?;
+        Ok(py.import("json")?.call_method1("loads", (value,))?.unbind())
+    }
 
     pub(crate) fn __repr__(&self) -> String {
         format!("Run(scene={:?}, model={:?}, horizon={}, wall_time_s={:.3e})", self.scene, self.model, self.horizon, self.wall_time_s)
@@ -229,8 +238,10 @@ pub(crate) fn floats(py: Python<'_>, values: Vec<f64>) -> Py<PyAny> {
 }
 
 impl Run {
-    pub(crate) fn of(run: lpc_damper::run::Run) -> Run {
+    /// The run of `scene`.
+    pub(crate) fn of(scene: &lpc_damper::scene::Scene, run: lpc_damper::run::Run) -> Run {
         Run {
+            damper_figures: DamperSummary::of(scene, &run),
             scene: run.scene.clone(),
             model: run.model.name().into(),
             horizon: run.horizon,

@@ -303,3 +303,15 @@ def test_frf_needs_a_forced_scene_and_valid_frequencies(scenes):
     for bad in (-1.0, 0.0, float("nan")):
         with pytest.raises(lpc.SceneError, match=r"frequencies\[1\]"):
             lpc.frf(forced, [3.0, bad])
+
+
+def test_each_damper_of_several_has_its_figures(scenes):
+    """A run of several dampers gives each one's floor, balls, impacts and impact loss, as
+    `summary.json`'s `dampers`; a scene of one damper has none."""
+    two = lpc.load_scene(scenes.parent / "examples" / "scenes" / "dampers-two-floors.toml")
+    r = lpc.run(two, model="rapier", horizon=0.5)
+    assert [(d["damper"], d["floor"], d["balls"]) for d in r.dampers] == [(1, 2, 40), (2, 3, 40)]
+    assert sum(d["impacts"] for d in r.dampers) == r.impact_count > 0
+    losses = sum(d["impact_loss"] for d in r.dampers)
+    assert losses == pytest.approx(float(np.sum(r.impacts["energy_lost"])), rel=1e-12)
+    assert lpc.run(lpc.load_scene(scenes / "lpc-lsl.toml"), horizon=0.1).dampers == []
