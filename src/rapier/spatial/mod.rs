@@ -12,6 +12,7 @@
 
 mod carrier;
 mod contacts;
+mod records;
 mod strikes;
 mod world;
 
@@ -21,10 +22,11 @@ pub use contacts::closing_speed;
 pub use world::{SolverSettings, SpatialWorld};
 
 use crate::model::{Budget, Checks, Meter, Model, ModelError, OverBudget, RunOptions, STALL_EVENTS_PER_SIM_S};
-use crate::run::{EnergyAccount, Impact, Impacts, Recorder, Run, MAX_KEPT_IMPACTS};
-use crate::scene::{Body, Chamber, Scene, Wall};
+use crate::run::{EnergyAccount, Impacts, Recorder, Run, MAX_KEPT_IMPACTS};
+use crate::scene::{Chamber, Scene};
 use carrier::Carrier;
 use contacts::{Balls, Contact, Containers, FrameBody, Other};
+use records::{impact_record, sunk_too_deep};
 
 /// Default step of the spatial path, s: Rapier's steps are plastic and the bounces come from
 /// the impact law, so a millisecond resolves the flights between impacts of centimetre balls.
@@ -642,36 +644,6 @@ fn sample(
     }
 }
 
-/// The stop of a run in which Rapier's solve left a ball sunk into a wall (`sunk`: the ball,
-/// by how much, m, and the wall) deeper than `sink_limit` at `t`, the frame accelerating at
-/// `frame_acceleration` over the step.
-fn sunk_too_deep(scene: &Scene, t: f64, sunk: (usize, f64, Wall), sink_limit: f64, frame_acceleration: f64) -> ModelError {
-    let (ball, depth, wall) = sunk;
-    let into = match wall {
-        Wall::Left => "the left wall".into(),
-        Wall::Right => "the right wall".into(),
-        Wall::Front => "the front wall".into(),
-        Wall::Back => "the back wall".into(),
-        Wall::Floor => "the floor".into(),
-        Wall::Ceiling => "the ceiling".into(),
-        Wall::Divider(k) => format!("divider {}", k + 1),
-    };
-    ModelError::Unstable {
-        scene: scene.name.clone(),
-        model: Model::Rapier,
-        t,
-        reason: format!(
-            "at t = {t:.6e} s ball{} has sunk {:.3e} m into {into}, more than the {:.3e} m Rapier's soft contacts may sink ({} % of the largest radius): its solve cannot hold the load on the ball (the walls accelerate at {:.3e} m/s^2, gravity is {:.3e} m/s^2); the compliant model and, without friction, the reference run such scenes",
-            ball + 1,
-            depth,
-            sink_limit,
-            RESTING_SINK_FRACTION * 100.0,
-            frame_acceleration.abs(),
-            contacts_dot(scene.space.gravity, scene.space.gravity).sqrt(),
-        ),
-    }
-}
-
 /// A contact Rapier stopped in the step: its closing speed and what it was computed from.
 struct Closing {
     /// Approach speed at closing, m/s.
@@ -688,15 +660,4 @@ struct Closing {
 
 fn contacts_dot(a: [f64; 3], b: [f64; 3]) -> f64 {
     a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
-}
-
-/// The impact of contact `c` at time `t`, named as the run lists its pairs: the left wall
-/// before the ball, the right wall and the side walls after it.
-fn impact_record(t: f64, c: &Contact, approach: f64, lost: f64) -> Impact {
-    let (a, b) = match c.other {
-        Other::Ball(j) => (Body::Ball(c.ball), Body::Ball(j)),
-        Other::Wall(Wall::Left) => (Body::LeftWall, Body::Ball(c.ball)),
-        Other::Wall(wall) => (Body::Ball(c.ball), wall.body()),
-    };
-    Impact { t, a, b, approach_speed: approach, energy_lost: lost, impulses: 1, peak_force: None, contact_duration: None }
 }
