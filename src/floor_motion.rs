@@ -29,10 +29,25 @@ pub(crate) struct Piece {
     pub(crate) a1: f64,
     /// Modal coefficients at `start`.
     pub(crate) c: Vec<C64>,
-    /// The carrying floor's displacement as `Re sum w_k e^{L_k s}` (plus the particular part).
+    /// The watched floors' terms ([`FloorMotion::watching`]), the carrying floor's first.
+    pub(crate) floors: Vec<FloorTerms>,
+}
+
+/// One floor's displacement on a piece as `Re sum w_k e^{L_k s}` (plus the particular part),
+/// with the bounds of its derivatives.
+#[derive(Debug, Clone)]
+pub(crate) struct FloorTerms {
+    pub(crate) floor: usize,
     pub(crate) w: Vec<C64>,
-    /// `B_n = sum |w_k| |L_k|^n`, `n = 0..=5`.
+    /// `B_n = sum |w_k| |L_k|^n`, `n = 0..=5`, with the sine's share.
     pub(crate) bounds: [f64; 6],
+}
+
+impl Piece {
+    /// The terms of `floor`, one of the floors watched when the piece was made.
+    pub(crate) fn terms(&self, floor: usize) -> &FloorTerms {
+        self.floors.iter().find(|f| f.floor == floor).expect("only a watched floor's terms are asked for")
+    }
 }
 
 /// The stretch of no load and a still ground.
@@ -67,8 +82,8 @@ pub(crate) struct Sine {
     pub(crate) force: f64,
     /// The floors' steady response, `u = Re U e^{i w t}`.
     pub(crate) u: Vec<C64>,
-    /// The carrying floor's absolute acceleration in it, `Re H e^{i w t}`.
-    pub(crate) h: C64,
+    /// Each floor's absolute acceleration in it, `Re H_j e^{i w t}`.
+    pub(crate) h: Vec<C64>,
 }
 
 /// The floors' closed-form motion since the last impulse on the carrying floor: a segment
@@ -89,6 +104,8 @@ pub struct FloorMotion {
     forcing: Option<Forcing>,
     /// `K`.
     pub(crate) stiffness: DMatrix<f64>,
+    /// The floors whose terms each piece carries, the carrying floor first.
+    watched: Vec<usize>,
 }
 
 impl FloorMotion {
@@ -98,6 +115,7 @@ impl FloorMotion {
         let modes = Arc::new(structure.building.modes(structure.floor, 0.0, structure.load())?);
         let structure_stiffness = structure.building.stiffness();
         let z0 = structure.initial_displacements.iter().chain(&structure.initial_velocities).copied().collect();
+        let watched = vec![structure.floor];
         let mut m = FloorMotion {
             structure,
             modes: modes.clone(),
@@ -108,6 +126,7 @@ impl FloorMotion {
             sine: None,
             forcing,
             stiffness: structure_stiffness,
+            watched,
         };
         m.sine = m.steady_response()?;
         m.cache.push((0.0, modes, m.sine.clone()));
@@ -132,7 +151,7 @@ impl FloorMotion {
             .building
             .harmonic_response(&self.modes.masses, omega, &loads)
             .ok_or_else(|| format!("the structure has no steady response at {} Hz (undamped, at a natural frequency)", g.frequency))?;
-        let h = -u[d] * omega * omega + ag;
+        let h = u.iter().map(|u| -u * omega * omega + ag).collect();
         Ok(Some(Sine { omega, ground, force, u, h }))
     }
 
@@ -173,17 +192,35 @@ impl FloorMotion {
         let steady = self.sine_state(start);
         let departure: Vec<f64> = z.iter().zip(&steady).map(|(z, s)| z - s).collect();
         let c = self.modes.coefficients(&departure, g0, g1);
-        let w = self.modes.floor_terms(&c, self.structure.floor);
+        let floors = self.watched.iter().map(|&floor| self.floor_terms(&c, floor)).collect();
+        Piece { start, end: load.end, ground, g0, g1, a0, a1, c, floors }
+    }
+
+    /// The terms of `floor`'s displacement for the modal coefficients `c`.
+    fn floor_terms(&self, c: &[C64], floor: usize) -> FloorTerms {
+        let w = self.modes.floor_terms(c, floor);
         let mut bounds: [f64; 6] =
             std::array::from_fn(|n| w.iter().zip(&self.modes.lambda).map(|(w, l)| w.norm() * l.norm().powi(n as i32)).sum());
         if let Some(s) = &self.sine {
             // The sine's displacement (with the ground's) and its absolute acceleration.
-            let shift = s.u[self.structure.floor].norm() + s.ground;
+            let shift = s.u[floor].norm() + s.ground;
             for (n, b) in bounds.iter_mut().enumerate() {
-                *b += if n < 2 { shift * s.omega.powi(n as i32) } else { s.h.norm() * s.omega.powi(n as i32 - 2) };
+                *b += if n < 2 { shift * s.omega.powi(n as i32) } else { s.h[floor].norm() * s.omega.powi(n as i32 - 2) };
             }
         }
-        Piece { start, end: load.end, ground, g0, g1, a0, a1, c, w, bounds }
+        FloorTerms { floor, w, bounds }
+    }
+
+    /// The same motion with every piece carrying the terms of `floors` too (the floors that
+    /// carry dampers), so that each one's motion is read as the carrying floor's is.
+    pub(crate) fn watching(mut self, floors: &[usize]) -> Self {
+        for &f in floors {
+            if !self.watched.contains(&f) {
+                self.watched.push(f);
+            }
+        }
+        self.reset();
+        self
     }
 
     /// Drops the pieces of the last segment and starts from `(t0, z0)`.
@@ -255,7 +292,16 @@ impl FloorMotion {
 
     /// The carrying floor's absolute displacement and velocity at `t`.
     pub fn state(&self, t: f64) -> (f64, f64) {
-        let d = self.structure.floor;
+        self.floor_state(self.structure.floor, t)
+    }
+
+    /// Floor `d`'s absolute displacement and velocity at `t` (a watched floor's from its
+    /// terms, another's from the floors' whole state).
+    pub fn floor_state(&self, d: usize, t: f64) -> (f64, f64) {
+        if !self.watched.contains(&d) {
+            let (z, (xg, vg)) = self.floors(t);
+            return (xg + z[d], vg + z[self.n() + d]);
+        }
         if t == self.t0 {
             // At its start the segment is exactly the state it was made from.
             let (xg, vg) = self.ground(t);
@@ -264,7 +310,7 @@ impl FloorMotion {
         self.with_piece(t, |p| {
             let s = t - p.start;
             let (mut u, mut v) = self.modes.particular(d, p.g0, p.g1, s);
-            for (w, l) in p.w.iter().zip(&self.modes.lambda) {
+            for (w, l) in p.terms(d).w.iter().zip(&self.modes.lambda) {
                 let e = w * (l * s).exp();
                 u += e.re;
                 v += (e * l).re;

@@ -15,6 +15,7 @@ use crate::scene::Scene;
 #[derive(Debug, Clone, Copy)]
 struct FrameNow {
     segment: u64,
+    floor: usize,
     t: f64,
     xs: f64,
     vs: f64,
@@ -42,10 +43,13 @@ pub(super) struct FrameMotion {
     /// The frame's state and acceleration ahead at `t` under segment `segment`, kept while
     /// neither changes (a cascade of impulses at one instant asks for them every pass).
     now: Cell<Option<FrameNow>>,
-    /// The last frame state evaluated, `(segment, t, xs, vs)`: the searches of both walls and
-    /// the checks ask for the same instant in turn, and each evaluation costs an `exp` and a
-    /// `sin_cos` ([`FrameMotion::state`]).
-    last_state: Cell<(u64, f64, f64, f64)>,
+    /// The last frame state evaluated, `(segment, floor, t, xs, vs)`: the searches of both
+    /// walls and the checks ask for the same instant in turn, and each evaluation costs an
+    /// `exp` and a `sin_cos` ([`FrameMotion::state`]).
+    last_state: Cell<(u64, usize, f64, f64, f64)>,
+    /// The floor that carries the damper (0 on a frame): the one the queries without a floor
+    /// are about.
+    pub(super) carrying: usize,
     /// A structure of several storeys or a moving ground: the carrying floor's motion comes
     /// from it, and `seg` is unused.
     storeys: Option<Box<StoreyMotion>>,
@@ -58,8 +62,9 @@ impl FrameMotion {
         let osc = Oscillator::new(if mass.is_finite() { mass } else { 1.0 }, damping, stiffness);
         let load = scene.harmonic_load();
         let seg = Segment::new(0.0, scene.initial_displacement, 0.0, osc, load);
+        let floors: Vec<usize> = scene.damper_list().iter().map(|d| d.floor).collect();
         let storeys = match &scene.structure {
-            Some(s) => Some(Box::new(StoreyMotion::new(s.clone(), scene.forcing, scene.horizon)?)),
+            Some(s) => Some(Box::new(StoreyMotion::new(s.clone(), scene.forcing, scene.horizon, &floors)?)),
             None => None,
         };
         let span = storeys.as_ref().map_or_else(|| span(&seg, scene.horizon), |s| s.span);
@@ -75,7 +80,8 @@ impl FrameMotion {
             horizon: scene.horizon,
             sign_changes: Default::default(),
             now: Default::default(),
-            last_state: Cell::new((0, f64::NAN, 0.0, 0.0)),
+            last_state: Cell::new((0, 0, f64::NAN, 0.0, 0.0)),
+            carrying: scene.structure.as_ref().map_or(0, |s| s.floor),
             storeys,
         })
     }
@@ -110,10 +116,11 @@ impl FrameMotion {
         self.seg.reach
     }
 
-    /// A bound on the round-off of the frame's position at `t`.
-    pub(super) fn position_roundoff(&self, t: f64) -> f64 {
+    /// A bound on the round-off of the position of floor `floor` (the frame's on a frame)
+    /// at `t`.
+    pub(super) fn position_roundoff_of(&self, floor: usize, t: f64) -> f64 {
         match &self.storeys {
-            Some(s) => s.position_roundoff(t),
+            Some(s) => s.position_roundoff(floor, t),
             None => self.seg.position_roundoff(t),
         }
     }
@@ -143,8 +150,18 @@ impl FrameMotion {
     /// Starts a new segment at `t` from displacement `xs` with velocity `v`, the frame carrying
     /// `held_mass` of balls.
     pub(super) fn restart(&mut self, t: f64, xs: f64, v: f64) {
+        self.restart_of(self.carrying, t, xs, v);
+    }
+
+    /// [`FrameMotion::restart`] from an impulse on floor `floor` (the frame's on a frame),
+    /// which holds no balls unless it is the carrying floor.
+    pub(super) fn restart_of(&mut self, floor: usize, t: f64, xs: f64, v: f64) {
         if let Some(s) = &mut self.storeys {
-            s.restart(t, v, self.held_mass);
+            if floor == self.carrying {
+                s.restart(t, v, self.held_mass);
+            } else {
+                s.restart_floor(t, floor, v);
+            }
             self.segment += 1;
             self.span = s.span;
             return;
@@ -180,15 +197,21 @@ impl FrameMotion {
     /// The frame's state at `t` in the current segment (the last one asked for is kept).
     #[inline(always)]
     pub(super) fn state(&self, t: f64) -> (f64, f64) {
-        let (segment, last, xs, vs) = self.last_state.get();
-        if segment == self.segment && last == t {
+        self.state_of(self.carrying, t)
+    }
+
+    /// [`FrameMotion::state`] of floor `floor` (the frame's on a frame).
+    #[inline(always)]
+    pub(super) fn state_of(&self, floor: usize, t: f64) -> (f64, f64) {
+        let (segment, last_floor, last, xs, vs) = self.last_state.get();
+        if segment == self.segment && last_floor == floor && last == t {
             return (xs, vs);
         }
         let (xs, vs) = match &self.storeys {
-            Some(s) => s.state(t),
+            Some(s) => s.floor_state(floor, t),
             None => self.seg.state(t),
         };
-        self.last_state.set((self.segment, t, xs, vs));
+        self.last_state.set((self.segment, floor, t, xs, vs));
         (xs, vs)
     }
 
@@ -196,24 +219,30 @@ impl FrameMotion {
     /// `t`, the current instant (kept until it or the segment changes).
     #[inline(always)]
     pub(super) fn now(&self, t: f64) -> (f64, f64, f64) {
+        self.now_of(self.carrying, t)
+    }
+
+    /// [`FrameMotion::now`] of floor `floor` (the frame's on a frame).
+    #[inline(always)]
+    pub(super) fn now_of(&self, floor: usize, t: f64) -> (f64, f64, f64) {
         if let Some(n) = self.now.get() {
-            if n.segment == self.segment && n.t == t {
+            if n.segment == self.segment && n.floor == floor && n.t == t {
                 return (n.xs, n.vs, n.accel_ahead);
             }
         }
-        let (xs, vs) = self.state(t);
-        let accel_ahead = self.accel_ahead(t);
-        self.now.set(Some(FrameNow { segment: self.segment, t, xs, vs, accel_ahead }));
+        let (xs, vs) = self.state_of(floor, t);
+        let accel_ahead = self.accel_ahead_of(floor, t);
+        self.now.set(Some(FrameNow { segment: self.segment, floor, t, xs, vs, accel_ahead }));
         (xs, vs, accel_ahead)
     }
 
-    /// The frame's acceleration just after `t`: its value, with the sign of the first
-    /// derivative that is not round-off when the acceleration itself is (at a sign change).
-    /// Every sign involved is that of `-(c v + k x)` and its derivatives, whatever the mass
-    /// the frame carries, so holding and releasing a ball always agree.
-    pub(super) fn accel_ahead(&self, t: f64) -> f64 {
+    /// The acceleration of floor `floor` (the frame's on a frame) just after `t`: its value, with
+    /// the sign of the first derivative that is not round-off when the acceleration itself is (at
+    /// a sign change). Every sign involved is that of `-(c v + k x)` and its derivatives, whatever
+    /// the mass the frame carries, so holding and releasing a ball always agree.
+    pub(super) fn accel_ahead_of(&self, floor: usize, t: f64) -> f64 {
         if let Some(s) = &self.storeys {
-            return s.accel_ahead(t);
+            return s.accel_ahead(floor, t);
         }
         if let Some(f) = &self.seg.forced {
             return ahead(self.seg.forced_derivatives(f, t));
@@ -244,8 +273,13 @@ impl FrameMotion {
     /// A forced segment's sign changes are scanned once and kept ([`SignChanges`]); no search
     /// starts before `now`, so older ones are dropped.
     pub(super) fn next_sign_change(&self, t: f64, limit: f64, now: f64) -> f64 {
+        self.next_sign_change_of(self.carrying, t, limit, now)
+    }
+
+    /// [`FrameMotion::next_sign_change`] of floor `floor` (the frame's on a frame).
+    pub(super) fn next_sign_change_of(&self, floor: usize, t: f64, limit: f64, now: f64) -> f64 {
         if let Some(s) = &self.storeys {
-            return s.next_sign_change(t, limit);
+            return s.next_sign_change(floor, t, limit);
         }
         let Some(f) = &self.seg.forced else {
             return self.seg.free_sign_change(t);

@@ -12,6 +12,8 @@ use crate::oscillator::Oscillator;
 /// The gap between a ball moving at constant velocity along x and a wall of the frame.
 pub(super) struct FrameGap<'a> {
     pub(super) frame: &'a FrameMotion,
+    /// The floor whose walls these are (the frame's on a frame).
+    pub(super) floor: usize,
     pub(super) limits: &'a Limits,
     pub(super) horizon: f64,
     /// The instant at which the ball is at `x`, s.
@@ -55,7 +57,7 @@ impl FrameGap<'_> {
     /// The gap and its rate at `t`.
     #[inline(always)]
     pub(super) fn at(&self, t: f64) -> (f64, f64) {
-        let (xs, vs) = self.frame.state(t);
+        let (xs, vs) = self.frame.state_of(self.floor, t);
         let xb = self.x + self.v * (t - self.now);
         (self.s * (xb - xs) + self.k, self.s * (self.v - vs))
     }
@@ -68,7 +70,7 @@ impl FrameGap<'_> {
     /// reference takes no contact below minus this, and its postcondition checks it
     /// (docs/MODEL.md).
     pub(super) fn with_tolerance(&self, t: f64) -> (f64, f64, f64) {
-        let (xs, vs) = self.frame.state(t);
+        let (xs, vs) = self.frame.state_of(self.floor, t);
         let xb = self.x + self.v * (t - self.now);
         let rate = self.s * (self.v - vs);
         (self.s * (xb - xs) + self.k, rate, self.tolerance(t, xb, xs, rate))
@@ -81,7 +83,7 @@ impl FrameGap<'_> {
         let eps = f64::EPSILON;
         self.limits.tol
             + self.drift
-            + self.frame.position_roundoff(t)
+            + self.frame.position_roundoff_of(self.floor, t)
             + 4.0 * eps * (xb.abs() + xs.abs() + self.k.abs())
             + 2.0 * eps * t.abs() * rate.abs().max(self.limits.fastest)
     }
@@ -103,10 +105,10 @@ impl FrameGap<'_> {
         }
         let mut a = from;
         loop {
-            let b = self.frame.next_sign_change(a, limit, self.now).min(limit);
+            let b = self.frame.next_sign_change_of(self.floor, a, limit, self.now).min(limit);
             // The sign just after `a` holds over the whole piece; judged as `resolve` judges it,
             // so that the two agree even where the acceleration is round-off (a frame at rest).
-            let curvature = -self.s * self.frame.accel_ahead(a);
+            let curvature = -self.s * self.frame.accel_ahead_of(self.floor, a);
             let root = if curvature >= 0.0 { self.convex_root(a, b) } else { self.concave_root(a, b) };
             if let Some(t) = root {
                 return Candidate { t, exact: true };
@@ -200,7 +202,8 @@ impl FrameGap<'_> {
                     return Some(self.bisect_crossing(l, t));
                 }
             }
-            if gp >= 0.0 || (t == a && g <= self.limits.tol && self.limits.reopens(gp, -self.s * self.frame.accel_ahead(a))) {
+            if gp >= 0.0 || (t == a && g <= self.limits.tol && self.limits.reopens(gp, -self.s * self.frame.accel_ahead_of(self.floor, a)))
+            {
                 return None; // convex and not decreasing (or about to): it only rises from here on
             }
             if g <= self.limits.tol {
@@ -246,7 +249,7 @@ impl FrameGap<'_> {
             // Touching and not separating: a contact now if the wall presses, judged exactly as
             // `resolve` judges it (a piece can be an ulp long at a sign change, and its
             // midpoint then disagrees); otherwise the ball is about to leave the wall.
-            return (-self.s * self.frame.accel_ahead(a) < 0.0).then_some(a);
+            return (-self.s * self.frame.accel_ahead_of(self.floor, a) < 0.0).then_some(a);
         }
         let (gb, gpb) = self.at(b);
         if gb > self.limits.tol {
@@ -334,8 +337,18 @@ mod tests {
                 for v in [-3.0, -0.4, -0.01, 0.0, 0.02, 0.5, 2.5] {
                     for side in [1.0, -1.0] {
                         let k = if side > 0.0 { -0.005 } else { length - 0.005 };
-                        let gap =
-                            FrameGap { frame: &frame, limits: &limits, horizon: scene.horizon, now: from, x, v, drift: 0.0, s: side, k };
+                        let gap = FrameGap {
+                            frame: &frame,
+                            floor: frame.carrying,
+                            limits: &limits,
+                            horizon: scene.horizon,
+                            now: from,
+                            x,
+                            v,
+                            drift: 0.0,
+                            s: side,
+                            k,
+                        };
                         if gap.at(from).0 <= limits.tol {
                             continue; // in the wall already: not a ball the solver would hold
                         }

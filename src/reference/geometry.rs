@@ -90,6 +90,7 @@ impl Solver<'_> {
     pub(super) fn frame_gap(&self, ball: usize, s: f64, k: f64) -> FrameGap<'_> {
         FrameGap {
             frame: &self.frame,
+            floor: self.frame.carrying,
             limits: &self.limits,
             horizon: self.horizon,
             now: self.t,

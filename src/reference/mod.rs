@@ -91,11 +91,10 @@ impl Simulator for Reference {
     }
 
     fn supports(&self, scene: &Scene) -> Result<(), String> {
-        crate::model::one_damper(scene)?;
         if runs_in_space(scene) {
             spatial::refusal(scene).map_or(Ok(()), Err)
         } else {
-            Ok(())
+            crate::model::one_damper(scene)
         }
     }
 

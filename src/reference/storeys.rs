@@ -42,7 +42,8 @@ struct SignScan {
 /// sign changes of the carrying floor's acceleration found so far.
 pub(super) struct StoreyMotion {
     motion: FloorMotion,
-    scan: RefCell<SignScan>,
+    /// Each floor's scan (only the watched floors' are used).
+    scans: RefCell<Vec<SignScan>>,
     /// Longest scan step of the sign-change search: a sixteenth of the shortest period.
     pub(super) scan_step: f64,
     /// The longest period, or the horizon when no mode oscillates.
@@ -62,10 +63,12 @@ impl Deref for StoreyMotion {
 }
 
 impl StoreyMotion {
-    pub(super) fn new(structure: Arc<Structure>, forcing: Option<Forcing>, horizon: f64) -> Result<Self, String> {
-        let motion = FloorMotion::new(structure, forcing)?;
-        let scan = RefCell::new(SignScan { scanned_to: motion.t0, roots: Vec::new() });
-        let mut m = StoreyMotion { motion, scan, scan_step: 0.0, span: 0.0, failure: None, probes: Cell::new(0) };
+    /// The floors of `structure` under `forcing`, with the motion of each of `floors` (those
+    /// that carry dampers) read as the carrying floor's is.
+    pub(super) fn new(structure: Arc<Structure>, forcing: Option<Forcing>, horizon: f64, floors: &[usize]) -> Result<Self, String> {
+        let motion = FloorMotion::new(structure, forcing)?.watching(floors);
+        let scans = RefCell::new((0..motion.n()).map(|_| SignScan { scanned_to: motion.t0, roots: Vec::new() }).collect());
+        let mut m = StoreyMotion { motion, scans, scan_step: 0.0, span: 0.0, failure: None, probes: Cell::new(0) };
         m.set_scales(horizon);
         Ok(m)
     }
@@ -77,12 +80,13 @@ impl StoreyMotion {
         self.span = if self.modes.longest_period.is_finite() { self.modes.longest_period } else { horizon };
     }
 
-    /// The carrying floor's absolute acceleration, jerk and snap at `t`, with the size of the
+    /// Floor `floor`'s absolute acceleration, jerk and snap at `t`, with the size of the
     /// terms of each.
-    fn derivatives(&self, p: &Piece, t: f64) -> [(f64, f64); 3] {
+    fn derivatives(&self, p: &Piece, floor: usize, t: f64) -> [(f64, f64); 3] {
         let s = t - p.start;
         let mut d = [0.0; 3];
-        for (w, l) in p.w.iter().zip(&self.modes.lambda) {
+        let terms = p.terms(floor);
+        for (w, l) in terms.w.iter().zip(&self.modes.lambda) {
             let mut e = w * (l * s).exp() * l * l;
             for x in &mut d {
                 *x += e.re;
@@ -91,18 +95,19 @@ impl StoreyMotion {
         }
         if let Some(sine) = &self.sine {
             let i_w = C64::new(0.0, sine.omega);
-            let mut e = sine.h * C64::new(0.0, sine.omega * t).exp();
+            let mut e = sine.h[floor] * C64::new(0.0, sine.omega * t).exp();
             for x in &mut d {
                 *x += e.re;
                 e *= i_w;
             }
         }
-        [(d[0] + p.a0 + p.a1 * s, p.bounds[2] + (p.a0 + p.a1 * s).abs()), (d[1] + p.a1, p.bounds[3] + p.a1.abs()), (d[2], p.bounds[4])]
+        let bounds = &terms.bounds;
+        [(d[0] + p.a0 + p.a1 * s, bounds[2] + (p.a0 + p.a1 * s).abs()), (d[1] + p.a1, bounds[3] + p.a1.abs()), (d[2], bounds[4])]
     }
 
-    fn probe(&self, p: &Piece, t: f64) -> Probe {
+    fn probe(&self, p: &Piece, floor: usize, t: f64) -> Probe {
         self.probes.set(self.probes.get() + 1);
-        let [(a, _), (jerk, _), _] = self.derivatives(p, t);
+        let [(a, _), (jerk, _), _] = self.derivatives(p, floor, t);
         Probe { t, a, jerk }
     }
 
@@ -112,15 +117,16 @@ impl StoreyMotion {
     /// over the floor's mass: at a segment's start that state is exactly the one it was made
     /// from, so the sign is the same whatever mass the floor holds, and holding and releasing
     /// a ball agree at the instant they happen.
-    pub(super) fn accel_ahead(&self, t: f64) -> f64 {
+    pub(super) fn accel_ahead(&self, d: usize, t: f64) -> f64 {
         let n = self.n();
-        let d = self.structure.floor;
+        let carrying = self.structure.floor;
         let b = &self.structure.building;
         let m = &self.modes.masses;
         let (z, _) = self.floors(t);
         let (u, v) = z.split_at(n);
-        // The external force on the carrying floor and its rate, and the ground's acceleration.
-        let mut elsewhere = None;
+        // The external force on floor `d` and its rate, and the ground's acceleration; forces
+        // on other floors move `d` through them.
+        let mut elsewhere = [None, None];
         let (force, force_rate, ag) = {
             let stretch = self.stretch(t);
             let s = t - stretch.start;
@@ -129,23 +135,27 @@ impl StoreyMotion {
                 None => (0.0, 0.0, line.0),
                 Some(j) if j == d => (line.0, line.1, 0.0),
                 Some(j) => {
-                    // A force on another floor moves the carrying floor through that floor.
-                    elsewhere = Some((j, line.0));
+                    elsewhere[0] = Some((j, line.0));
                     (0.0, 0.0, 0.0)
                 }
             };
             if let Some(sine) = &self.sine {
                 let (sin, cos) = (sine.omega * t).sin_cos();
                 let w = sine.omega;
-                f += sine.force * sin;
-                fr += sine.force * w * cos;
+                // The sine's force acts on the carrying floor.
+                if carrying == d {
+                    f += sine.force * sin;
+                    fr += sine.force * w * cos;
+                } else {
+                    elsewhere[1] = Some((carrying, sine.force * sin));
+                }
                 g -= sine.ground * w * w * sin;
             }
             (f, fr, g)
         };
         let mut forces = b.restoring_forces(u, v);
         forces[d] += force;
-        if let Some((j, f)) = elsewhere {
+        for (j, f) in elsewhere.into_iter().flatten() {
             forces[j] += f;
         }
         let row = |j: usize| (self.stiffness[(d, j)], b.damping[(d, j)]);
@@ -167,7 +177,7 @@ impl StoreyMotion {
         let sign = if jerk.abs() > ROUNDOFF_RELATIVE * jerk_size {
             jerk.signum()
         } else {
-            let snap = self.with_piece(t, |p| self.derivatives(p, t)[2].0);
+            let snap = self.with_piece(t, |p| self.derivatives(p, d, t)[2].0);
             if snap == 0.0 {
                 return 0.0;
             }
@@ -176,24 +186,23 @@ impl StoreyMotion {
         sign * a.abs().max(f64::MIN_POSITIVE)
     }
 
-    /// A bound on the round-off of the carrying floor's absolute position at `t`.
-    pub(super) fn position_roundoff(&self, t: f64) -> f64 {
+    /// A bound on the round-off of floor `d`'s absolute position at `t`.
+    pub(super) fn position_roundoff(&self, d: usize, t: f64) -> f64 {
         self.with_piece(t, |p| {
             let s = (t - p.start).max(0.0);
-            let d = self.structure.floor;
             let (up, _) = self.modes.particular(d, p.g0, p.g1, s);
             let sg = t - p.ground.start;
             let g = &p.ground;
             let ground = g.x0.abs() + sg * (g.v0.abs() + sg * (0.5 * g.g0.abs() + sg * g.g1.abs() / 6.0));
             let phase = self.sine.as_ref().map_or(0.0, |sine| sine.omega * t.abs());
-            let free = (2.0 + self.modes.rate * s + phase) * p.bounds[0];
+            let free = (2.0 + self.modes.rate * s + phase) * p.terms(d).bounds[0];
             ROUNDOFF_ULPS * f64::EPSILON * (free + up.abs() + self.modes.influence[d].abs() * p.g0.abs() + ground)
         })
     }
 
-    /// The next time after `t` at which the carrying floor's acceleration changes sign or the
+    /// The next time after `t` at which floor `floor`'s acceleration changes sign or the
     /// ground's acceleration changes its line (a piece ends), or `limit` if none comes first.
-    pub(super) fn next_sign_change(&self, t: f64, limit: f64) -> f64 {
+    pub(super) fn next_sign_change(&self, floor: usize, t: f64, limit: f64) -> f64 {
         if !(limit > t) {
             return limit;
         }
@@ -201,7 +210,8 @@ impl StoreyMotion {
         let limit = limit.min(boundary);
         loop {
             {
-                let scan = self.scan.borrow();
+                let scans = self.scans.borrow();
+                let scan = &scans[floor];
                 let k = scan.roots.partition_point(|&r| r <= t);
                 if let Some(&root) = scan.roots.get(k) {
                     return root.min(limit);
@@ -210,7 +220,7 @@ impl StoreyMotion {
                     return limit;
                 }
             }
-            let from = self.scan.borrow().scanned_to;
+            let from = self.scans.borrow()[floor].scanned_to;
             let k = self.index(from);
             let pieces = self.pieces.borrow();
             let p = &pieces[k];
@@ -222,18 +232,19 @@ impl StoreyMotion {
             }
             let mut found = Vec::new();
             if end > from {
-                let mut left = self.probe(p, from);
-                let right = self.probe(p, end);
-                while let Some(root) = self.first_sign_change(p, &left, &right) {
+                let mut left = self.probe(p, floor, from);
+                let right = self.probe(p, floor, end);
+                while let Some(root) = self.first_sign_change(p, floor, &left, &right) {
                     found.push(root);
                     if root >= right.t {
                         break;
                     }
-                    left = self.probe(p, root);
+                    left = self.probe(p, floor, root);
                 }
             }
             drop(pieces);
-            let mut scan = self.scan.borrow_mut();
+            let mut scans = self.scans.borrow_mut();
+            let scan = &mut scans[floor];
             scan.roots.extend(found);
             scan.scanned_to = end;
         }
@@ -243,30 +254,35 @@ impl StoreyMotion {
     /// monotone (`order` 1), over `[l.t, r.t]`, with every round-off margin: a function `y`
     /// with `|y''| <= M` is at least `min(|y(l)|, |y(r)|) - M h^2 / 8` in magnitude between
     /// ends of one sign.
-    fn holds(&self, p: &Piece, l: &Probe, r: &Probe, order: usize) -> bool {
+    fn holds(&self, p: &Piece, floor: usize, l: &Probe, r: &Probe, order: usize) -> bool {
         let (yl, yr) = if order == 0 { (l.a, r.a) } else { (l.jerk, r.jerk) };
         if !((yl > 0.0 && yr > 0.0) || (yl < 0.0 && yr < 0.0)) {
             return false;
         }
         let h = r.t - l.t;
-        let curvature = self.bound(p, l.t, order + 4);
-        yl.abs().min(yr.abs()) - self.roundoff(p, l.t, r.t, order) > curvature * (1.0 + ROUNDOFF_ULPS * f64::EPSILON) * h * h / 8.0
+        let curvature = self.bound(p, floor, l.t, order + 4);
+        yl.abs().min(yr.abs()) - self.roundoff(p, floor, l.t, r.t, order) > curvature * (1.0 + ROUNDOFF_ULPS * f64::EPSILON) * h * h / 8.0
     }
 
-    /// `B_n` from `from` on: the bound on the `n`-th derivative of the carrying floor's
+    /// `B_n` from `from` on: the bound on the `n`-th derivative of floor `floor`'s
     /// position over the rest of piece `p`, each mode's term decayed to `from` (`|e^{L s}|`
     /// only falls where damping is `>= 0`). A run whose motion dies away keeps bounds of the
     /// motion's own size, so that the scan's steps do not shrink as it decays.
-    fn bound(&self, p: &Piece, from: f64, n: usize) -> f64 {
+    fn bound(&self, p: &Piece, floor: usize, from: f64, n: usize) -> f64 {
         let s = (from - p.start).max(0.0);
-        let modal: f64 =
-            p.w.iter().zip(&self.modes.lambda).map(|(w, l)| w.norm() * l.norm().powi(n as i32) * (l.re * s).exp().min(1.0)).sum();
+        let modal: f64 = p
+            .terms(floor)
+            .w
+            .iter()
+            .zip(&self.modes.lambda)
+            .map(|(w, l)| w.norm() * l.norm().powi(n as i32) * (l.re * s).exp().min(1.0))
+            .sum();
         let sine = self.sine.as_ref().map_or(0.0, |sine| {
-            let shift = sine.u[self.structure.floor].norm() + sine.ground;
+            let shift = sine.u[floor].norm() + sine.ground;
             if n < 2 {
                 shift * sine.omega.powi(n as i32)
             } else {
-                sine.h.norm() * sine.omega.powi(n as i32 - 2)
+                sine.h[floor].norm() * sine.omega.powi(n as i32 - 2)
             }
         });
         modal + sine
@@ -275,42 +291,42 @@ impl StoreyMotion {
     /// A bound on the round-off of the acceleration (`order` 0) or the jerk (`order` 1) of the
     /// carrying floor evaluated anywhere in `[from, t]` on piece `p`: each term rounds relative
     /// to its own size, at most its size at `from`.
-    fn roundoff(&self, p: &Piece, from: f64, t: f64, order: usize) -> f64 {
+    fn roundoff(&self, p: &Piece, floor: usize, from: f64, t: f64, order: usize) -> f64 {
         let s = t - p.start;
         let line = if order == 0 { p.a0.abs() + p.a1.abs() * s } else { p.a1.abs() };
         let phase = self.sine.as_ref().map_or(0.0, |sine| sine.omega * t.abs());
-        ROUNDOFF_ULPS * f64::EPSILON * ((2.0 + self.modes.rate * s + phase) * self.bound(p, from, order + 2) + line)
+        ROUNDOFF_ULPS * f64::EPSILON * ((2.0 + self.modes.rate * s + phase) * self.bound(p, floor, from, order + 2) + line)
     }
 
     /// Whether the acceleration is round-off over all of `[l.t, r.t]`, so that its sign there
     /// says nothing: both ends within their round-off `err`, and its curvature bound keeping it
     /// within `2 err` in between (a floor starting from rest, whose acceleration grows as the
     /// square of time). No sign change is taken there.
-    fn is_roundoff(&self, p: &Piece, l: &Probe, r: &Probe) -> bool {
-        let err = self.roundoff(p, l.t, r.t, 0);
+    fn is_roundoff(&self, p: &Piece, floor: usize, l: &Probe, r: &Probe) -> bool {
+        let err = self.roundoff(p, floor, l.t, r.t, 0);
         let h = r.t - l.t;
-        l.a.abs() <= err && r.a.abs() <= err && self.bound(p, l.t, 4) * h * h / 8.0 <= err
+        l.a.abs() <= err && r.a.abs() <= err && self.bound(p, floor, l.t, 4) * h * h / 8.0 <= err
     }
 
     /// The first sign change of the acceleration in `(l.t, r.t]`: depth-first over halves.
-    fn first_sign_change(&self, p: &Piece, l: &Probe, r: &Probe) -> Option<f64> {
+    fn first_sign_change(&self, p: &Piece, floor: usize, l: &Probe, r: &Probe) -> Option<f64> {
         let same_sign = (l.a > 0.0 && r.a > 0.0) || (l.a < 0.0 && r.a < 0.0);
-        if (same_sign && self.holds(p, l, r, 0)) || self.is_roundoff(p, l, r) {
+        if (same_sign && self.holds(p, floor, l, r, 0)) || self.is_roundoff(p, floor, l, r) {
             return None;
         }
-        if !same_sign && l.a != 0.0 && r.a != 0.0 && self.holds(p, l, r, 1) {
-            return Some(self.illinois(p, l, r));
+        if !same_sign && l.a != 0.0 && r.a != 0.0 && self.holds(p, floor, l, r, 1) {
+            return Some(self.illinois(p, floor, l, r));
         }
         if r.t - l.t <= self.time_resolution(r.t) {
             return (!same_sign).then_some(r.t);
         }
-        let m = self.probe(p, 0.5 * (l.t + r.t));
-        self.first_sign_change(p, l, &m).or_else(|| self.first_sign_change(p, &m, r))
+        let m = self.probe(p, floor, 0.5 * (l.t + r.t));
+        self.first_sign_change(p, floor, l, &m).or_else(|| self.first_sign_change(p, floor, &m, r))
     }
 
     /// The one root of a monotone acceleration between `l` and `r` (of opposite signs).
-    fn illinois(&self, p: &Piece, l: &Probe, r: &Probe) -> f64 {
-        illinois((l.t, l.a), (r.t, r.a), |b| self.time_resolution(b), |m| self.probe(p, m).a)
+    fn illinois(&self, p: &Piece, floor: usize, l: &Probe, r: &Probe) -> f64 {
+        illinois((l.t, l.a), (r.t, r.a), |b| self.time_resolution(b), |m| self.probe(p, floor, m).a)
     }
 
     fn time_resolution(&self, t: f64) -> f64 {
@@ -323,7 +339,19 @@ impl StoreyMotion {
         if let Err(why) = self.motion.restart(t, v, held) {
             self.failure = Some(why);
         }
-        *self.scan.get_mut() = SignScan { scanned_to: t, roots: Vec::new() };
+        self.clear_scans(t);
+    }
+
+    /// Starts a new segment at `t`, floor `floor` moving at `v` (absolute), no balls held.
+    pub(super) fn restart_floor(&mut self, t: f64, floor: usize, v: f64) {
+        self.motion.restart_floors(t, &[(floor, v)]);
+        self.clear_scans(t);
+    }
+
+    fn clear_scans(&mut self, t: f64) {
+        for scan in self.scans.get_mut() {
+            *scan = SignScan { scanned_to: t, roots: Vec::new() };
+        }
     }
 }
 
@@ -348,7 +376,7 @@ mod tests {
             ground: None,
             force: None,
         };
-        StoreyMotion::new(Arc::new(structure), None, 1.35).unwrap()
+        StoreyMotion::new(Arc::new(structure), None, 1.35, &[2]).unwrap()
     }
 
     /// The scan's cost does not grow as the motion dies away: finding every sign change of
@@ -362,7 +390,7 @@ mod tests {
         let (mut t, end) = (0.0, 1.35);
         let mut changes = 0;
         while t < end {
-            t = motion.next_sign_change(t, end);
+            t = motion.next_sign_change(2, t, end);
             changes += 1;
         }
         let steps = end / motion.scan_step;

@@ -1,7 +1,7 @@
 //! Several dampers on one structure (docs/MODEL.md §18): each container's balls push their own
-//! floor in the compliant and contact models, a damper that touches nothing leaves the others'
-//! run as it was, one `[[damper]]` is the scene of today's format, and the reference refuses
-//! several with the reason.
+//! floor in every model, a damper that touches nothing leaves the others'
+//! run as it was, one `[[damper]]` is the scene of today's format, and the reference carries
+//! several beyond one line and refuses them on lines with the reason.
 
 use lpc_damper::metrics::DamperSummary;
 use lpc_damper::model::{Model, RunOptions};
@@ -114,14 +114,76 @@ fn one_damper_table_is_todays_scene() {
     assert!(!listed.has_several_dampers());
 }
 
-/// The reference, which carries one damper, refuses several with the reason; the contact and
-/// compliant models take them.
+/// [`building`] without friction and under gravity: the reference's spatial path runs it.
+fn smooth(text: &str) -> String {
+    text.replace("friction = 0.1\n", "friction = 0.0\ngravity = [0.0, 0.0, -9.81]\n")
+}
+
+fn reference(scene: &Scene) -> Run {
+    let run = Model::Reference.simulate(scene, &RunOptions::default()).unwrap_or_else(|e| panic!("{e}"));
+    judge(Model::Reference, scene, &run).unwrap_or_else(|f| panic!("{} {}", f.check, f.detail));
+    run
+}
+
+/// The impacts of `run` on the end walls of the container of the balls in `balls`.
+fn end_wall_impacts(run: &Run, balls: std::ops::Range<usize>) -> usize {
+    use lpc_damper::scene::Body;
+    run.impacts
+        .iter()
+        .filter(|i| match (i.a, i.b) {
+            (Body::LeftWall, Body::Ball(k)) | (Body::Ball(k), Body::RightWall) => balls.contains(&k),
+            _ => false,
+        })
+        .count()
+}
+
+/// The reference on lines holds one container: it refuses several dampers there with the
+/// reason, and friction as ever; the contact and compliant models take them.
 #[test]
-fn the_reference_refuses_several_dampers_with_the_reason() {
-    let two = scene(&building(&format!("[[damper]]\nfloor = 2\n{0}[[damper]]\nfloor = 3\n{0}", three_balls("damper."))));
-    let why = Model::Reference.supports(&two).unwrap_err();
-    assert!(why.contains("2 dampers") && why.contains("compliant"), "{why}");
-    assert!(Model::Compliant.supports(&two).is_ok() && Model::Rapier.supports(&two).is_ok());
+fn the_reference_refuses_several_dampers_on_lines_with_the_reason() {
+    let two = format!("[[damper]]\nfloor = 2\n{0}[[damper]]\nfloor = 3\n{0}", three_balls("damper."));
+    let on_lines = scene(&building(&two).replace("friction = 0.1", "friction = 0.0"));
+    let why = Model::Reference.supports(&on_lines).unwrap_err();
+    assert!(why.contains("2 dampers") && why.contains("on their lines") && why.contains("compliant"), "{why}");
+    let rough = scene(&building(&two));
+    assert!(Model::Reference.supports(&rough).unwrap_err().contains("friction"));
+    assert!(Model::Compliant.supports(&rough).is_ok() && Model::Rapier.supports(&rough).is_ok());
+}
+
+/// The reference hands each damper's impulses to its own floor: an idle damper on floor 2
+/// listed before the active one on floor 3 leaves the run that of the active one alone there,
+/// floors and balls, to round-off (the idle ball falls and rests in its own box).
+#[test]
+fn the_reference_hands_impulses_to_each_dampers_floor() {
+    let alone = scene(&smooth(&building(&format!("damper_floor = 3\n{}", three_balls("")))));
+    let with_idle =
+        scene(&smooth(&building(&format!("[[damper]]\nfloor = 2\n{IDLE_DAMPER}[[damper]]\nfloor = 3\n{}", three_balls("damper.")))));
+    let (a, b) = (reference(&alone), reference(&with_idle));
+    assert!(end_wall_impacts(&a, 0..3) > 0, "the active box's balls strike its end walls");
+    assert_eq!(end_wall_impacts(&b, 1..4), end_wall_impacts(&a, 0..3));
+    let mut worst = 0.0f64;
+    for k in 0..a.series.len() {
+        for j in 0..3 {
+            worst = worst.max((a.series.floor(j, k).unwrap().0 - b.series.floor(j, k).unwrap().0).abs());
+        }
+        for i in 0..3 {
+            worst = worst.max((a.series.x(i)[k] - b.series.x(i + 1)[k]).abs());
+        }
+    }
+    assert!(worst <= 1e-12, "the floors and balls differ by {worst:e} m");
+}
+
+/// The reference carries two dampers on two floors: the run passes the stress checks (its
+/// energy balance closes only if each impulse moves the floor whose mass it was weighed with)
+/// and each box's balls strike its own end walls.
+#[test]
+fn the_reference_carries_two_dampers_on_two_floors() {
+    let two = scene(&smooth(&building(&format!("[[damper]]\nfloor = 2\n{0}[[damper]]\nfloor = 3\n{0}", three_balls("damper.")))));
+    let run = reference(&two);
+    assert!(end_wall_impacts(&run, 0..3) > 0 && end_wall_impacts(&run, 3..6) > 0);
+    let dampers = DamperSummary::of(&two, &run);
+    assert_eq!(dampers.iter().map(|d| d.impacts).sum::<usize>(), run.impact_count());
+    assert!(run.energy.balance_error.abs() <= 1e-12, "{:?}", run.energy);
 }
 
 /// The contact model: an idle damper on the active one's floor, listed after it, leaves its run

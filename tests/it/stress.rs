@@ -57,17 +57,19 @@ fn random_beds_on_buildings_pass_every_check() {
 }
 
 /// Beds drawn as two dampers on floors of their own draws (`lpc stress --beds --structures
-/// --dampers`): the contact and compliant models run every one and pass every check on what
-/// they run within their budget (each damper's balls in their own box, energy never gained, the
-/// compliant model's energy balance with forces handed to each floor); the reference refuses
-/// them, naming the dampers.
+/// --dampers`): every model runs them and passes every check on what it runs within its budget
+/// (each damper's balls in their own box, energy never gained, the energy balance with each
+/// damper's impulses or forces handed to its own floor); the reference refuses only those with
+/// friction.
 #[test]
 fn random_dampers_on_buildings_pass_every_check() {
     let draws = Draws { max_wall_s: Some(3.0), beds: true, structures: true, dampers: true, ..Draws::plausible(1.0) };
     run_and_pass(draws, &[(Model::Rapier, 8), (Model::Compliant, 4)]);
-    for o in stress(Model::Reference, 30, 2, draws, &|| {}) {
-        assert!(o.refused.as_ref().is_some_and(|why| why.contains("2 dampers") || why.contains("friction")), "{:?}", o.refused);
-    }
+    let outcomes = stress(Model::Reference, 1, 24, Draws { max_wall_s: Some(2.0), ..draws }, &|| {});
+    assert_all_pass(&outcomes);
+    let refused: Vec<&String> = outcomes.iter().filter_map(|o| o.refused.as_ref()).collect();
+    assert!(refused.iter().all(|why| why.contains("friction")), "{refused:?}");
+    assert!(refused.len() < outcomes.len(), "some draws are frictionless and run");
 }
 
 /// The same under a random harmonic force or base motion (`lpc stress --forced`): besides the

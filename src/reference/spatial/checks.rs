@@ -18,16 +18,17 @@ impl Solver<'_> {
     /// The postcondition for ball `k` (brought to now) against the walls: it overlaps none
     /// beyond the contact tolerance (docs/MODEL.md §14).
     pub(super) fn check_walls(&self, k: usize) -> Result<(), ModelError> {
-        let (xs, _) = self.frame.state(self.t);
         let b = self.balls[k];
-        let tol = self.pair_tolerance(k, k, 0.0) + self.frame.position_roundoff(self.t);
+        let (ends, half) = (self.walls[b.damper as usize], self.cells[b.damper as usize].half);
+        let (xs, _) = self.frame.state_of(ends.floor, self.t);
+        let tol = self.pair_tolerance(k, k, 0.0) + self.frame.position_roundoff_of(ends.floor, self.t);
         let walls = [
             ("left-wall", b.p[0] - b.radius - xs),
-            ("right-wall", xs + self.length - b.p[0] - b.radius),
-            ("front wall", b.p[1] + self.cells.half[0] - b.radius),
-            ("back wall", self.cells.half[0] - b.p[1] - b.radius),
-            ("floor", b.p[2] + self.cells.half[1] - b.radius),
-            ("ceiling", self.cells.half[1] - b.p[2] - b.radius),
+            ("right-wall", xs + ends.length - b.p[0] - b.radius),
+            ("front wall", b.p[1] + half[0] - b.radius),
+            ("back wall", half[0] - b.p[1] - b.radius),
+            ("floor", b.p[2] + half[1] - b.radius),
+            ("ceiling", half[1] - b.p[2] - b.radius),
         ];
         for (name, gap) in walls {
             if gap < -tol {
@@ -48,7 +49,7 @@ impl Solver<'_> {
     pub(super) fn check_neighbours(&self, k: usize) -> Result<(), ModelError> {
         let p = self.balls[k].p;
         let mut checked = Ok(());
-        self.cells.around(self.balls[k].cell, |o| {
+        self.cells[self.balls[k].damper as usize].around(self.balls[k].cell, |o| {
             let o = o as usize;
             if checked.is_ok() && o != k {
                 let (po, _) = self.balls[o].at(self.t, self.gravity);

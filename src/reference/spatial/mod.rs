@@ -61,10 +61,12 @@ pub(super) fn refusal(scene: &Scene) -> Option<String> {
             space.gravity[0]
         ));
     }
-    if scene.container.is_none() || space.section[0] <= 0.0 || space.section[1] <= 0.0 {
+    if scene.container.is_none() || scene.damper_list().iter().any(|d| d.section[0] <= 0.0 || d.section[1] <= 0.0) {
         return Some("the scene's balls leave their lines but it gives the container no cross-section (width and height)".into());
     }
-    if space.chains() > 1 {
+    // Each damper's balls start a chain of their own; more than one in a damper are divided.
+    let chains_in = |d: &crate::scene::Damper| space.chain_starts.iter().filter(|s| d.balls.contains(s)).count();
+    if scene.damper_list().iter().any(|d| chains_in(d) > 1 || d.channel > 0.0) {
         return Some("the reference beyond one line has one chamber: it has no dividers between chains".into());
     }
     None
@@ -143,6 +145,20 @@ struct Ball {
     cell: [i64; 3],
     /// A bound on the rounding gathered in `p[0]`, m.
     drift: f64,
+    /// The damper it is in.
+    damper: u32,
+}
+
+/// What a damper's end walls are: how far apart, and the floor (or frame) that moves them.
+#[derive(Debug, Clone, Copy)]
+struct EndWalls {
+    /// The container's inner length, m.
+    length: f64,
+    /// The floor that carries it (0 on a frame).
+    floor: usize,
+    /// That floor's mass (the frame's on a frame), kg: what the balls' impulses on the walls
+    /// move.
+    mass: f64,
 }
 
 /// The spatial reference's run of one scene.
@@ -151,7 +167,10 @@ struct Solver<'a> {
     balls: Vec<Ball>,
     frame: FrameMotion,
     limits: Limits,
-    cells: Cells,
+    /// Each damper's cells: balls of two dampers never meet.
+    cells: Vec<Cells>,
+    /// Each damper's end walls.
+    walls: Vec<EndWalls>,
     /// Every entry but the balls' contacts with the frame's walls, each owned by its `ball`.
     calendar: Calendar<Entry>,
     /// The balls' contacts with the frame's walls, apart: each impact on those walls changes
@@ -177,7 +196,6 @@ struct Solver<'a> {
     e: f64,
     /// The collapse rule's contact duration, s.
     t_c: f64,
-    length: f64,
     t: f64,
     horizon: f64,
     events: u64,
@@ -200,10 +218,12 @@ fn wall_index(side: f64) -> usize {
 /// them down. What the impacts and the damping take from then on comes off it.
 fn reach_energy(scene: &Scene, frame: &FrameMotion, balls: &[Ball]) -> f64 {
     let g = scene.space.gravity;
-    let half = [0.5 * scene.space.section[0], 0.5 * scene.space.section[1]];
     let given: f64 = balls
         .iter()
-        .map(|b| {
+        .enumerate()
+        .map(|(i, b)| {
+            let section = scene.section_of(i);
+            let half = [0.5 * section[0], 0.5 * section[1]];
             let lowest: f64 = (1..3).map(|k| g[k].abs() * (half[k - 1] - b.radius).max(0.0)).sum();
             b.mass * (0.5 * dot(b.v, b.v) + (lowest - dot(g, b.p)).max(0.0))
         })
@@ -332,10 +352,25 @@ fn simulate_with(scene: &Scene, options: &RunOptions, waits: bool, max_events: u
 
 impl<'a> Solver<'a> {
     fn new(scene: &'a Scene, impacts: ImpactRecord) -> Result<Self, ModelError> {
-        let container = scene.container.expect("refusal checks the container");
-        let largest = scene.balls.iter().map(|b| b.radius).fold(0.0, f64::max);
-        let mut cells = Cells::new(largest, container.length, scene.space.section, scene.balls.len());
+        let dampers = scene.damper_list();
         let frame = FrameMotion::new(scene).map_err(ModelError::Refused)?;
+        let mut cells: Vec<Cells> = dampers
+            .iter()
+            .map(|d| {
+                let largest = scene.balls[d.balls.clone()].iter().map(|b| b.radius).fold(0.0, f64::max);
+                Cells::new(largest, d.container.length, d.section, scene.balls.len())
+            })
+            .collect();
+        let walls = dampers
+            .iter()
+            .map(|d| {
+                let mass = match &scene.structure {
+                    Some(s) if d.floor != frame.carrying => s.building.masses[d.floor],
+                    _ => frame.mass,
+                };
+                EndWalls { length: d.container.length, floor: d.floor, mass }
+            })
+            .collect();
         let balls: Vec<Ball> = scene
             .balls
             .iter()
@@ -344,8 +379,9 @@ impl<'a> Solver<'a> {
                 let [y, z] = scene.space.lateral_of(i);
                 let [vy, vz] = scene.space.lateral_velocity_of(i);
                 let p = [scene.initial_positions[i], y, z];
-                let cell = cells.cell_of(p);
-                cells.insert(cell, i as u32);
+                let damper = scene.damper_of(i);
+                let cell = cells[damper].cell_of(p);
+                cells[damper].insert(cell, i as u32);
                 Ball {
                     p,
                     v: [scene.initial_velocities[i], vy, vz],
@@ -357,6 +393,7 @@ impl<'a> Solver<'a> {
                     stamp: 0,
                     cell,
                     drift: 0.0,
+                    damper: damper as u32,
                 }
             })
             .collect();
@@ -369,6 +406,7 @@ impl<'a> Solver<'a> {
             frame,
             limits: Limits::new(scene),
             cells,
+            walls,
             calendar: Calendar::new(scene.balls.len()),
             frame_calendar: BinaryHeap::new(),
             frame_reach,
@@ -379,7 +417,6 @@ impl<'a> Solver<'a> {
             gravity: scene.space.gravity,
             e: scene.restitution,
             t_c: scene.reference.contact_duration,
-            length: container.length,
             t: 0.0,
             horizon: scene.horizon,
             events: 0,
@@ -401,12 +438,14 @@ impl<'a> Solver<'a> {
         b.since = self.t;
     }
 
-    /// Ball `i` (at the current time) against the frame's wall on side `side`.
+    /// Ball `i` (at the current time) against its damper's end wall on side `side`.
     fn frame_gap(&self, i: usize, side: f64) -> FrameGap<'_> {
         let b = &self.balls[i];
-        let k = if side > 0.0 { -b.radius } else { self.length - b.radius };
+        let walls = &self.walls[b.damper as usize];
+        let k = if side > 0.0 { -b.radius } else { walls.length - b.radius };
         FrameGap {
             frame: &self.frame,
+            floor: walls.floor,
             limits: &self.limits,
             horizon: self.horizon,
             now: b.since,

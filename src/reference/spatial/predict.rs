@@ -87,7 +87,7 @@ impl Solver<'_> {
         let motion = b.motion(t, self.gravity);
         let a = motion.2;
         for axis in 1..3 {
-            let half = self.cells.half[axis - 1];
+            let half = self.cells[b.damper as usize].half[axis - 1];
             for side in [1.0, -1.0] {
                 if b.rest == Some((axis, side)) {
                     continue;
@@ -102,7 +102,7 @@ impl Solver<'_> {
             self.predict_frame_wall(i, side);
         }
         self.predict_crossing(i, a);
-        let predicted = self.predict_pairs(i, motion, self.cells.heads(Cells::around_block(b.cell)), check);
+        let predicted = self.predict_pairs(i, motion, self.cells[b.damper as usize].heads(Cells::around_block(b.cell)), check);
         self.calendar.release();
         predicted
     }
@@ -115,8 +115,10 @@ impl Solver<'_> {
         let motion = b.motion(self.t, self.gravity);
         self.calendar.hold(i);
         self.predict_crossing(i, motion.2);
-        if let Some(slab) = self.cells.slab_block(b.cell, axis, dir) {
-            self.predict_pairs(i, motion, self.cells.heads(slab), false).expect("a prediction without a check cannot fail");
+        let cells = &self.cells[b.damper as usize];
+        if let Some(slab) = cells.slab_block(b.cell, axis, dir) {
+            let heads = cells.heads(slab);
+            self.predict_pairs(i, motion, heads, false).expect("a prediction without a check cannot fail");
         }
         self.calendar.release();
     }
@@ -124,10 +126,11 @@ impl Solver<'_> {
     /// When ball `i` (brought to now), accelerated by `a`, next leaves its cell.
     pub(super) fn predict_crossing(&mut self, i: usize, a: [f64; 3]) {
         let b = self.balls[i];
+        let cells = &self.cells[b.damper as usize];
         // The earliest crossing, at a tie the first axis's; never when the time is infinite.
         let mut crossing: (f64, usize, i64) = (f64::INFINITY, 0, 1);
         for axis in 0..3 {
-            let lower = self.cells.face(b.cell, axis);
+            let lower = cells.face(b.cell, axis);
             let v = b.v[axis];
             if a[axis] == 0.0 {
                 // Without acceleration along the axis, only the face ahead is crossed, at the
@@ -135,17 +138,17 @@ impl Solver<'_> {
                 // on the velocity's sign, which is as good as random.
                 let ahead = v > 0.0;
                 let dir = if ahead { 1 } else { -1 };
-                let g0 = std::hint::select_unpredictable(ahead, lower + self.cells.size - b.p[axis], b.p[axis] - lower);
+                let g0 = std::hint::select_unpredictable(ahead, lower + cells.size - b.p[axis], b.p[axis] - lower);
                 let dt = g0.max(0.0) / v.abs();
-                let earlier = (v != 0.0) & self.cells.has_neighbour(b.cell, axis, dir) & (dt < crossing.0);
+                let earlier = (v != 0.0) & cells.has_neighbour(b.cell, axis, dir) & (dt < crossing.0);
                 crossing = std::hint::select_unpredictable(earlier, (dt, axis, dir), crossing);
                 continue;
             }
             for dir in [1i64, -1] {
-                if !self.cells.has_neighbour(b.cell, axis, dir) {
+                if !cells.has_neighbour(b.cell, axis, dir) {
                     continue;
                 }
-                let (g0, side) = if dir > 0 { (lower + self.cells.size - b.p[axis], 1.0) } else { (b.p[axis] - lower, -1.0) };
+                let (g0, side) = if dir > 0 { (lower + cells.size - b.p[axis], 1.0) } else { (b.p[axis] - lower, -1.0) };
                 if let Some(dt) = plane_time(g0.max(0.0), side, v, a[axis]) {
                     if dt < crossing.0 {
                         crossing = (dt, axis, dir);
@@ -173,10 +176,11 @@ impl Solver<'_> {
         // The cells' lists are walked here rather than gathered into a list first: a ball's
         // pairs are most of what an event costs.
         let (heads, count) = heads;
+        let damper = self.balls[i].damper as usize;
         for &head in &heads[..count] {
             let mut next = Some(head);
             while let Some(j) = next {
-                next = self.cells.next(j);
+                next = self.cells[damper].next(j);
                 let j = j as usize;
                 if j == i {
                     continue;

@@ -66,8 +66,9 @@ impl Solver<'_> {
                 let old = b.cell;
                 b.cell[axis as usize] += dir as i64;
                 let new = b.cell;
-                self.cells.remove(old, i as u32);
-                self.cells.insert(new, i as u32);
+                let cells = &mut self.cells[b.damper as usize];
+                cells.remove(old, i as u32);
+                cells.insert(new, i as u32);
                 self.predict_slab(i, axis as usize, dir as i64);
             }
             Kind::Pair(j) => {
@@ -120,7 +121,7 @@ impl Solver<'_> {
                 if approach > 0.0 || (approach == 0.0 && pressed > 0.0) {
                     let e = self.restitution(i, None);
                     let after = e * approach;
-                    let half = self.cells.half[axis - 1];
+                    let half = self.cells[self.balls[i].damper as usize].half[axis - 1];
                     let ball = &mut self.balls[i];
                     let rests = pressed > 0.0 && 2.0 * after < pressed * self.t_c;
                     let lost = if rests {
@@ -157,19 +158,20 @@ impl Solver<'_> {
                     return Ok(());
                 }
                 self.bring(i);
-                let (xs, vs, accel) = self.frame.now(self.t);
                 let b = self.balls[i];
+                let walls = self.walls[b.damper as usize];
+                let (xs, vs, accel) = self.frame.now_of(walls.floor, self.t);
                 let approach = side * (vs - b.v[0]);
                 if let Some(after) = separation(approach, side * accel, self.restitution(i, None), self.t_c) {
                     // The wall on the left (`side > 0`) leaves the ball behind it, the right one ahead.
-                    let (vb, vf) = separate(b.mass, b.v[0], self.frame.mass, vs, -side * after);
-                    let lost = 0.5 * reduced_mass(b.mass, self.frame.mass) * (approach * approach - after * after);
+                    let (vb, vf) = separate(b.mass, b.v[0], walls.mass, vs, -side * after);
+                    let lost = 0.5 * reduced_mass(b.mass, walls.mass) * (approach * approach - after * after);
                     let (damping, work) = self.frame.segment_energy(self.t, self.scene);
                     self.damping_loss += damping;
                     self.forcing_work += work;
                     let mut searched_before = Vec::new();
                     if self.frame.exists() {
-                        self.frame.restart(self.t, xs, vf);
+                        self.frame.restart_of(walls.floor, self.t, xs, vf);
                         // Every entry against the frame's walls belongs to the motion just ended.
                         self.frame_calendar.clear();
                         searched_before = self.searches_ended(lost);

@@ -166,8 +166,8 @@ fn frictionless_copy(scene: &Scene, frictionless: bool) -> Result<Option<Scene>>
             // The flag helps only where friction is all the reference refuses.
             let mut smooth = scene.clone();
             smooth.space.friction = 0.0;
-            if Model::Reference.supports(&smooth).is_err() {
-                return Err(ModelError::Refused(why).into());
+            if let Err(smooth_why) = Model::Reference.supports(&smooth) {
+                return Err(ModelError::Refused(format!("{why}; and without friction, {smooth_why}")).into());
             }
             return Err(ModelError::Refused(format!(
                 "{why}; `lpc compare --frictionless-reference` compares the others with the reference on the frictionless copy"

@@ -48,8 +48,8 @@ pub struct Args {
     #[arg(long, conflicts_with = "extreme")]
     structures: bool,
     /// With --beds, draw each bed as two dampers in copies of its box, the second holding 1 to as
-    /// many balls on a floor drawn at random (the contact and compliant models run them; the
-    /// reference refuses several dampers).
+    /// many balls on a floor drawn at random (every model runs them; the reference when they are
+    /// frictionless).
     #[arg(long, requires = "beds")]
     dampers: bool,
     /// Seconds of computing each run may take; a run that takes longer stops (a typed stop,
