@@ -39,6 +39,8 @@ pub(crate) struct Piece {
 pub(crate) struct FloorTerms {
     pub(crate) floor: usize,
     pub(crate) w: Vec<C64>,
+    /// `|w_k|`.
+    pub(crate) norms: Vec<f64>,
     /// `B_n = sum |w_k| |L_k|^n`, `n = 0..=5`, with the sine's share.
     pub(crate) bounds: [f64; 6],
 }
@@ -199,8 +201,9 @@ impl FloorMotion {
     /// The terms of `floor`'s displacement for the modal coefficients `c`.
     fn floor_terms(&self, c: &[C64], floor: usize) -> FloorTerms {
         let w = self.modes.floor_terms(c, floor);
+        let norms: Vec<f64> = w.iter().map(|w| w.norm()).collect();
         let mut bounds: [f64; 6] =
-            std::array::from_fn(|n| w.iter().zip(&self.modes.lambda).map(|(w, l)| w.norm() * l.norm().powi(n as i32)).sum());
+            std::array::from_fn(|n| norms.iter().zip(&self.modes.lambda_norms).map(|(w, l)| w * l.powi(n as i32)).sum());
         if let Some(s) = &self.sine {
             // The sine's displacement (with the ground's) and its absolute acceleration.
             let shift = s.u[floor].norm() + s.ground;
@@ -208,7 +211,7 @@ impl FloorMotion {
                 *b += if n < 2 { shift * s.omega.powi(n as i32) } else { s.h[floor].norm() * s.omega.powi(n as i32 - 2) };
             }
         }
-        FloorTerms { floor, w, bounds }
+        FloorTerms { floor, w, norms, bounds }
     }
 
     /// The same motion with every piece carrying the terms of `floors` too (the floors that

@@ -272,10 +272,10 @@ impl StoreyMotion {
         let s = (from - p.start).max(0.0);
         let modal: f64 = p
             .terms(floor)
-            .w
+            .norms
             .iter()
-            .zip(&self.modes.lambda)
-            .map(|(w, l)| w.norm() * l.norm().powi(n as i32) * (l.re * s).exp().min(1.0))
+            .zip(self.modes.lambda.iter().zip(&self.modes.lambda_norms))
+            .map(|(w, (l, norm))| w * norm.powi(n as i32) * (l.re * s).exp().min(1.0))
             .sum();
         let sine = self.sine.as_ref().map_or(0.0, |sine| {
             let shift = sine.u[floor].norm() + sine.ground;

@@ -2,6 +2,8 @@
 //! PEER `.AT2` file, scaled, and interpolated linearly between its points, so that the ground's
 //! velocity and displacement are its exact integrals (piecewise quadratic and cubic).
 
+use std::sync::atomic::{AtomicUsize, Ordering};
+
 /// Standard gravity, m/s^2: the unit of `.AT2` records.
 pub const STANDARD_GRAVITY: f64 = 9.80665;
 
@@ -15,6 +17,26 @@ pub struct GroundRecord {
     pub accel: Vec<f64>,
     /// The ground's displacement and velocity at each point (it starts at rest at 0), m and m/s.
     pub ground: Vec<(f64, f64)>,
+    /// The stretch the last lookup found.
+    last: LastStretch,
+}
+
+/// The stretch a record's last lookup found: lookups mostly come in time order, so the next is
+/// most often in the same stretch. Only a hint: every answer is the one the search gives, and
+/// two records with different hints are equal.
+#[derive(Debug, Default)]
+struct LastStretch(AtomicUsize);
+
+impl Clone for LastStretch {
+    fn clone(&self) -> Self {
+        LastStretch(AtomicUsize::new(self.0.load(Ordering::Relaxed)))
+    }
+}
+
+impl PartialEq for LastStretch {
+    fn eq(&self, _: &Self) -> bool {
+        true
+    }
 }
 
 /// One stretch of a record on which the acceleration is linear.
@@ -65,12 +87,21 @@ impl GroundRecord {
                 v += h * (accel[j] + 0.5 * g1 * h);
             }
         }
-        GroundRecord { times, accel, ground }
+        GroundRecord { times, accel, ground, last: LastStretch::default() }
     }
 
     /// The stretch that holds `t` (`t >= 0`); at a point, the stretch that starts there.
     pub fn stretch(&self, t: f64) -> Stretch {
-        let j = self.times.partition_point(|&s| s <= t).saturating_sub(1);
+        let n = self.times.len();
+        let hint = self.last.0.load(Ordering::Relaxed);
+        // The last point at or before `t`: the hint's when `t` lies in its stretch.
+        let j = if hint < n && self.times[hint] <= t && (hint + 1 == n || t < self.times[hint + 1]) {
+            hint
+        } else {
+            let j = self.times.partition_point(|&s| s <= t).saturating_sub(1);
+            self.last.0.store(j, Ordering::Relaxed);
+            j
+        };
         self.stretch_at(j)
     }
 

@@ -174,6 +174,8 @@ pub struct Modes {
     pub masses: Vec<f64>,
     /// Eigenvalues `L` of the state matrix (`2n`), 1/s.
     pub lambda: Vec<C64>,
+    /// `|L|` of each, 1/s.
+    pub lambda_norms: Vec<f64>,
     /// Eigenvectors, one column per eigenvalue (`2n x 2n`).
     pub vectors: DMatrix<C64>,
     inverse: DMatrix<C64>,
@@ -246,13 +248,15 @@ impl Modes {
         };
         let influence: Vec<f64> = (kinv.clone() * pattern).iter().copied().collect();
         let lag: Vec<f64> = (kinv * &b.damping * DVector::from_vec(influence.clone())).iter().copied().collect();
-        let rate = lambda.iter().map(|l| l.norm()).fold(0.0, f64::max);
+        let lambda_norms: Vec<f64> = lambda.iter().map(|l| l.norm()).collect();
+        let rate = lambda_norms.iter().copied().fold(0.0, f64::max);
         let periods = lambda.iter().filter(|l| l.im > 0.0).map(|l| 2.0 * std::f64::consts::PI / l.im);
         let (longest_period, shortest_period) = periods.fold((0.0f64, f64::INFINITY), |(lo, sh), p| (lo.max(p), sh.min(p)));
         Ok(Modes {
             n,
             masses,
             lambda,
+            lambda_norms,
             vectors,
             inverse,
             influence,
