@@ -63,7 +63,14 @@ impl Solver<'_> {
                     .collect();
             }
         }
-        let c = self.frame_gap(i, side).search(self.t, self.horizon);
+        // On a structure the walls' motion changes at every end-wall impact of any ball, and
+        // where a bed presses its walls those come a contact duration apart: a search is cut at
+        // a scan step of the floors' motion, where it goes on unless the motion has changed.
+        let bound = match self.frame.storeys() {
+            Some(s) => self.t + s.scan_step,
+            None => self.horizon,
+        };
+        let c = self.frame_gap(i, side).search(self.t, bound);
         if c.t.is_finite() {
             self.push(c.t, i, Kind::Frame(side as i8, c.exact), None);
         }
