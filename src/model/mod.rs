@@ -15,17 +15,6 @@ pub use options::{Budget, Limits, Meter, Progress, RunOptions};
 use crate::run::Run;
 use crate::scene::Scene;
 
-/// Why the reference on lines, which carries one damper, cannot run `scene`, when it has several.
-pub fn one_damper(scene: &Scene) -> Result<(), String> {
-    if !scene.has_several_dampers() {
-        return Ok(());
-    }
-    Err(format!(
-        "the scene has {} dampers whose balls stay on their lines; the reference carries several dampers only when their balls leave their lines (on lines it holds one container): run the contact or compliant model, or give one [[damper]]",
-        scene.dampers.len()
-    ))
-}
-
 /// A model of the damper.
 pub trait Simulator: Sync {
     /// Which model this is.

@@ -85,6 +85,18 @@ fn runs_in_space(scene: &Scene) -> bool {
     scene.space.beyond_lines(&scene.initial_positions).is_some()
 }
 
+/// Why the reference on lines, which holds one container, cannot run `scene`, when it has
+/// several dampers.
+fn one_damper_on_lines(scene: &Scene) -> Result<(), String> {
+    if !scene.has_several_dampers() {
+        return Ok(());
+    }
+    Err(format!(
+        "the scene has {} dampers whose balls stay on their lines; the reference carries several dampers only when their balls leave their lines (on lines it holds one container): run the contact or compliant model, or give one [[damper]]",
+        scene.dampers.len()
+    ))
+}
+
 impl Simulator for Reference {
     fn model(&self) -> Model {
         Model::Reference
@@ -94,7 +106,7 @@ impl Simulator for Reference {
         if runs_in_space(scene) {
             spatial::refusal(scene).map_or(Ok(()), Err)
         } else {
-            crate::model::one_damper(scene)
+            one_damper_on_lines(scene)
         }
     }
 
