@@ -61,12 +61,13 @@ pub(super) fn refusal(scene: &Scene) -> Option<String> {
             space.gravity[0]
         ));
     }
-    if scene.container.is_none() || scene.damper_list().iter().any(|d| d.section[0] <= 0.0 || d.section[1] <= 0.0) {
+    let dampers = scene.damper_list();
+    if scene.container.is_none() || dampers.iter().any(|d| d.section[0] <= 0.0 || d.section[1] <= 0.0) {
         return Some("the scene's balls leave their lines but it gives the container no cross-section (width and height)".into());
     }
     // Each damper's balls start a chain of their own; more than one in a damper are divided.
     let chains_in = |d: &crate::scene::Damper| space.chain_starts.iter().filter(|s| d.balls.contains(s)).count();
-    if scene.damper_list().iter().any(|d| chains_in(d) > 1 || d.channel > 0.0) {
+    if dampers.iter().any(|d| chains_in(d) > 1 || d.channel > 0.0) {
         return Some("the reference beyond one line has one chamber: it has no dividers between chains".into());
     }
     None
@@ -364,10 +365,8 @@ impl<'a> Solver<'a> {
         let walls = dampers
             .iter()
             .map(|d| {
-                let mass = match &scene.structure {
-                    Some(s) if d.floor != frame.carrying => s.building.masses[d.floor],
-                    _ => frame.mass,
-                };
+                // A floor's own mass; the carrying floor's is the frame's.
+                let mass = scene.structure.as_ref().map_or(frame.mass, |s| s.building.masses[d.floor]);
                 EndWalls { length: d.container.length, floor: d.floor, mass }
             })
             .collect();
