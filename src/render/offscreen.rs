@@ -91,7 +91,9 @@ fn app_for(scene: &Scene, run: Run, size: (u32, u32)) -> Result<(App, Handle<Ima
     target.texture_descriptor.usage |= TextureUsages::RENDER_ATTACHMENT | TextureUsages::COPY_SRC | TextureUsages::TEXTURE_BINDING;
     let target = app.world_mut().resource_mut::<Assets<Image>>().add(target);
     let layout = Layout::of(scene);
-    app.insert_resource(layout).insert_resource(Playback::new(run)).add_systems(PostUpdate, pose.before(TransformSystems::Propagate));
+    app.insert_resource(layout.clone())
+        .insert_resource(Playback::new(run))
+        .add_systems(PostUpdate, pose.before(TransformSystems::Propagate));
     let world = app.world_mut();
     world.resource_scope(|world, mut meshes: Mut<Assets<Mesh>>| {
         world.resource_scope(|world, mut materials: Mut<Assets<StandardMaterial>>| {

@@ -21,75 +21,106 @@ pub const BACKGROUND: [u8; 3] = [232, 234, 238];
 /// How long an impact flash lasts, in simulated seconds.
 pub const FLASH: f64 = 0.03;
 
-/// Where the parts of the structure are, from the scene's sizes: the frame's rest position
-/// puts the container's left inner face at x = 0.
-#[derive(Resource, Debug, Clone, Copy, PartialEq)]
-pub struct Layout {
-    /// Container inner length, m.
+/// One damper's container as drawn: on its floor, beside the containers before it on the
+/// same floor.
+#[derive(Debug, Clone, PartialEq)]
+pub struct BoxLayout {
+    /// The floor that carries it, 0 at the bottom.
+    pub floor: usize,
+    /// Its balls, a run of the scene's.
+    pub balls: std::ops::Range<usize>,
+    /// Inner length, m.
     pub length: f32,
+    /// Inner width (across the motion, drawn along the picture's depth), m.
+    pub depth: f32,
+    /// Inner height, m.
+    pub height: f32,
+    /// How far along the motion the picture moves it from where the physics has it: the
+    /// containers of one floor occupy the same place in the models (their balls never meet)
+    /// and are drawn side by side. 0 for the first container on its floor, m.
+    pub shift: f32,
+    /// Height of its middle (of its balls' centres on a line), m.
+    pub ball_y: f32,
+    /// Its chains' dividers, each at its place across the motion, m.
+    pub dividers: Vec<f32>,
+}
+
+/// Where the parts of the structure are, from the scene's sizes: each floor's rest position
+/// puts the left inner face of its first container at x = 0.
+#[derive(Resource, Debug, Clone, PartialEq)]
+pub struct Layout {
     /// Largest ball radius, m.
     pub radius: f32,
-    /// Wall and floor thickness of the container, m.
+    /// Wall and floor thickness of the containers, m.
     pub wall: f32,
-    /// Height of the columns from the ground to the platform, m.
+    /// Height of each storey's columns, m.
     pub column_height: f32,
-    /// Platform (the frame's mass) thickness, m.
+    /// Platform (a floor's mass) thickness, m.
     pub platform: f32,
-    /// Height of the balls' centres, m.
-    pub ball_y: f32,
-    /// Overhang of the platform beyond the container on each side, m.
+    /// Overhang of the platforms beyond the containers on each side, m.
     pub overhang: f32,
-    /// The container's inner width (across the motion, drawn along the picture's depth), m.
-    pub depth: f32,
-    /// The container's inner height, m.
-    pub height: f32,
-    /// Floors of the structure that carries the container (1 for a frame).
+    /// Length of the widest floor's row of containers (gaps included), m.
+    pub width: f32,
+    /// Floors of the structure that carries the containers (1 for a frame).
     pub floors: usize,
-    /// The floor that carries the container, 0 at the bottom.
-    pub carrying: usize,
+    /// Every damper's container, in the scene's order.
+    pub boxes: Vec<BoxLayout>,
 }
 
 impl Layout {
     /// The layout of `scene` (a chain without a frame gets a container around its balls).
     pub fn of(scene: &Scene) -> Layout {
         let radius = scene.balls.iter().map(|b| b.radius).fold(0.005, f64::max) as f32;
-        let length = scene.container.map_or_else(
-            || {
-                let (lo, hi) = scene.initial_positions.iter().fold((f64::MAX, f64::MIN), |(a, b), &x| (a.min(x), b.max(x)));
-                // No balls at all: an empty stretch of a few radii, not `MIN - MAX`.
-                if lo <= hi {
-                    (hi - lo) as f32 + 4.0 * radius
-                } else {
-                    4.0 * radius
-                }
-            },
-            |c| c.length as f32,
-        );
         let wall = 0.2 * radius;
         let platform = 0.5 * radius;
+        let floors = scene.structure.as_ref().map_or(1, |s| s.floors());
         // A line of balls gets a box a little wider and higher than its balls; a scene with a
         // cross-section gets that.
-        let [width, high] = scene.space.section.map(|a| a as f32);
-        let depth = (3.0 * radius).max(width);
-        let height = (2.4 * radius).max(high);
-        let (floors, carrying) = scene.structure.as_ref().map_or((1, 0), |s| (s.floors(), s.floor));
-        // A storey above the container is tall enough to clear it.
-        let clear = if carrying + 1 < floors { 1.3 * (wall + height) } else { 0.0 };
-        let column_height = (0.7 * length.max(6.0 * radius)).max(clear);
-        let base = (carrying + 1) as f32 * (column_height + platform);
-        Layout {
-            length,
-            radius,
-            wall,
-            column_height,
-            platform,
-            ball_y: base + wall + 0.5 * height,
-            overhang: 0.25 * length.max(6.0 * radius),
-            depth,
-            height,
-            floors,
-            carrying,
+        let drawn = |section: [f64; 2]| ((3.0 * radius).max(section[0] as f32), (2.4 * radius).max(section[1] as f32));
+        let mut boxes: Vec<BoxLayout> = scene
+            .damper_list()
+            .into_iter()
+            .map(|d| {
+                let (depth, height) = drawn(d.section);
+                let chains = d.balls.clone().map(|i| scene.space.chain_of(i)).collect::<std::collections::BTreeSet<_>>().len();
+                let dividers = (1..chains).map(|k| k as f32 * d.channel as f32 - 0.5 * depth).collect();
+                BoxLayout {
+                    floor: d.floor,
+                    balls: d.balls,
+                    length: d.container.length as f32,
+                    depth,
+                    height,
+                    shift: 0.0,
+                    ball_y: 0.0,
+                    dividers,
+                }
+            })
+            .collect();
+        if boxes.is_empty() {
+            let (lo, hi) = scene.initial_positions.iter().fold((f64::MAX, f64::MIN), |(a, b), &x| (a.min(x), b.max(x)));
+            // No balls at all: an empty stretch of a few radii, not `MIN - MAX`.
+            let length = if lo <= hi { (hi - lo) as f32 + 4.0 * radius } else { 4.0 * radius };
+            let (depth, height) = drawn(scene.space.section);
+            let chains = scene.space.chains();
+            let dividers = (1..chains).map(|k| k as f32 * scene.space.channel as f32 - 0.5 * depth).collect();
+            boxes.push(BoxLayout { floor: 0, balls: 0..scene.balls.len(), length, depth, height, shift: 0.0, ball_y: 0.0, dividers });
         }
+        // The containers of a floor stand in a row, a few radii apart.
+        let gap = 2.0 * wall + 4.0 * radius;
+        let mut row_ends = vec![0.0f32; floors];
+        for b in &mut boxes {
+            let end = &mut row_ends[b.floor];
+            b.shift = if *end > 0.0 { *end + gap } else { 0.0 };
+            *end = b.shift + b.length;
+        }
+        let width = row_ends.iter().copied().fold(0.0, f32::max);
+        // A storey above a container is tall enough to clear it.
+        let clear = boxes.iter().filter(|b| b.floor + 1 < floors).map(|b| 1.3 * (wall + b.height)).fold(0.0, f32::max);
+        let column_height = (0.7 * width.max(6.0 * radius)).max(clear);
+        for b in &mut boxes {
+            b.ball_y = (b.floor + 1) as f32 * (column_height + platform) + wall + 0.5 * b.height;
+        }
+        Layout { radius, wall, column_height, platform, overhang: 0.25 * width.max(6.0 * radius), width, floors, boxes }
     }
 
     /// The height of floor `i`'s platform's centre (0 at the bottom): each storey is its
@@ -98,41 +129,58 @@ impl Layout {
         (i + 1) as f32 * self.column_height + (i as f32 + 0.5) * self.platform
     }
 
-    /// World position of a ball centre at `x` (the models' coordinate) and `[y, z]` across
+    /// The container ball `i` is in (the last one for an index beyond the balls).
+    pub fn box_of(&self, i: usize) -> &BoxLayout {
+        self.boxes.iter().find(|b| b.balls.contains(&i)).unwrap_or(&self.boxes[self.boxes.len() - 1])
+    }
+
+    /// World position of ball `i`'s centre at `x` (the models' coordinate) and `[y, z]` across
     /// the motion (the scene's `y` is the picture's depth, its `z` the picture's up).
-    pub fn ball(&self, x: f64, across: [f64; 2]) -> Vec3 {
-        Vec3::new(x as f32, self.ball_y + across[1] as f32, across[0] as f32)
+    pub fn ball(&self, i: usize, x: f64, across: [f64; 2]) -> Vec3 {
+        let b = self.box_of(i);
+        Vec3::new(x as f32 + b.shift, b.ball_y + across[1] as f32, across[0] as f32)
     }
 
-    /// The height of the structure's top above the ground: the container's top, or the top
-    /// floor above it.
+    /// The lowest and the highest floor that carry a container.
+    fn carrying(&self) -> (usize, usize) {
+        self.boxes.iter().fold((usize::MAX, 0), |(lo, hi), b| (lo.min(b.floor), hi.max(b.floor)))
+    }
+
+    /// The height of the highest container's top.
+    fn boxes_top(&self) -> f32 {
+        self.boxes.iter().map(|b| b.ball_y + 0.5 * b.height).fold(0.0, f32::max)
+    }
+
+    /// The height of the structure's top above the ground: the highest container's top, or
+    /// the top floor above it.
     fn top(&self) -> f32 {
-        (self.ball_y + 0.5 * self.height).max(self.floor_y(self.floors - 1) + 0.5 * self.platform)
+        self.boxes_top().max(self.floor_y(self.floors - 1) + 0.5 * self.platform)
     }
 
-    /// The heights the camera frames, bottom and top: the container and the storeys around it,
-    /// at most [`STOREYS_SHOWN_BELOW`] under it (from the ground when it rides no higher) and one
-    /// above it. A tall building shown whole would leave its damper a few pixels wide.
+    /// The heights the camera frames, bottom and top: the containers and the storeys around
+    /// them, at most [`STOREYS_SHOWN_BELOW`] under the lowest (from the ground when it rides
+    /// no higher) and one above the highest. A tall building shown whole would leave its
+    /// damper a few pixels wide.
     pub fn shown(&self) -> (f32, f32) {
-        let bottom =
-            if self.carrying < STOREYS_SHOWN_BELOW { 0.0 } else { self.floor_y(self.carrying - STOREYS_SHOWN_BELOW) - 0.5 * self.platform };
-        let above = self.floor_y((self.carrying + 1).min(self.floors - 1)) + 0.5 * self.platform;
-        (bottom, self.top().min(above.max(self.ball_y + 0.5 * self.height)))
+        let (lowest, highest) = self.carrying();
+        let bottom = if lowest < STOREYS_SHOWN_BELOW { 0.0 } else { self.floor_y(lowest - STOREYS_SHOWN_BELOW) - 0.5 * self.platform };
+        let above = self.floor_y((highest + 1).min(self.floors - 1)) + 0.5 * self.platform;
+        (bottom, self.top().min(above.max(self.boxes_top())))
     }
 
-    /// The point the camera looks at: mid-container, a little below the balls (below the
-    /// middle of a tall box's inside), or 0.6 of the way up what it frames ([`Layout::shown`]).
+    /// The point the camera looks at: mid-row, 0.6 of the way up what it frames
+    /// ([`Layout::shown`]).
     pub fn camera_target(&self) -> Vec3 {
         let (bottom, top) = self.shown();
-        Vec3::new(0.5 * self.length, bottom + 0.6 * (top - bottom), 0.0)
+        Vec3::new(0.5 * self.width, bottom + 0.6 * (top - bottom), 0.0)
     }
 
     /// The camera: in front of the structure, a little above and to the right, framing what
-    /// [`Layout::shown`] gives (from the ground to the container's top on a low structure).
+    /// [`Layout::shown`] gives (from the ground to the containers' top on a low structure).
     pub fn camera(&self) -> Transform {
         let target = self.camera_target();
         let (bottom, top) = self.shown();
-        let span = (self.length + 2.0 * self.overhang).max(top - bottom);
+        let span = (self.width + 2.0 * self.overhang).max(top - bottom);
         let eye = target + Vec3::new(0.1 * span, 0.3 * span, 1.1 * span);
         Transform::from_translation(eye).looking_at(target, Vec3::Y)
     }
@@ -184,37 +232,47 @@ impl Playback {
         self.impacts.partition_point(|i| i.0 <= t + 1e-12)
     }
 
-    /// Whether `body` was struck within [`FLASH`] before the sample shown.
-    pub fn flashing(&self, body: Body) -> bool {
+    /// The impacts within [`FLASH`] before the sample shown.
+    fn recent_impacts(&self) -> impl Iterator<Item = &(f64, Body, Body)> {
         let t = self.time();
         let from = self.impacts.partition_point(|i| i.0 < t - FLASH);
-        self.impacts[from..].iter().take_while(|i| i.0 <= t + 1e-12).any(|i| i.1 == body || i.2 == body)
+        self.impacts[from..].iter().take_while(move |i| i.0 <= t + 1e-12)
+    }
+
+    /// Whether ball `i` was struck within [`FLASH`] before the sample shown.
+    pub fn ball_flashing(&self, i: usize) -> bool {
+        self.recent_impacts().any(|imp| imp.1 == Body::Ball(i) || imp.2 == Body::Ball(i))
+    }
+
+    /// Whether `wall` of the container holding `balls` was struck by one of them within
+    /// [`FLASH`] before the sample shown: every container's walls share their names.
+    pub fn wall_flashing(&self, wall: Body, balls: &std::ops::Range<usize>) -> bool {
+        let ours = |b: Body| matches!(b, Body::Ball(j) if balls.contains(&j));
+        self.recent_impacts().any(|imp| (imp.1 == wall && ours(imp.2)) || (imp.2 == wall && ours(imp.1)))
     }
 }
 
-/// A ball's mesh (index left to right).
+/// A ball's mesh (index left to right) and its place across the motion on its line.
 #[derive(Component, Debug, Clone, Copy)]
 pub struct BallMesh(pub usize, pub [f64; 2]);
-/// A part that moves with the frame: offset of its centre from the frame's displacement.
+/// A part that moves with a floor (the frame's on a frame): the floor and its centre when
+/// the floor is at rest.
 #[derive(Component, Debug, Clone, Copy)]
-pub struct FramePart(pub Vec3);
-/// A container wall (for its flash).
+pub struct FloorPart(pub usize, pub Vec3);
+/// A container's end wall (for its flash) and the container's index among the layout's
+/// boxes.
 #[derive(Component, Debug, Clone, Copy)]
-pub struct WallMesh(pub Body);
+pub struct WallMesh(pub Body, pub usize);
 /// A column of storey `.1` (0 at the bottom), leaning with its floor over the one below (the
 /// ground under the first): its foot's position when the structure is at rest.
 #[derive(Component, Debug, Clone, Copy)]
 pub struct Column(pub Vec3, pub usize);
-/// A floor of a structure other than the carrying one (which is the frame's platform): its
-/// index and its centre at rest.
-#[derive(Component, Debug, Clone, Copy)]
-pub struct FloorSlab(pub usize, pub Vec3);
 
 fn srgb(c: [u8; 3]) -> Color {
     Color::srgb_u8(c[0], c[1], c[2])
 }
 
-/// Spawns ground, columns, platform, container, balls and light (not the camera).
+/// Spawns ground, columns, floors, containers, balls and light (not the camera).
 pub fn spawn_stage(
     commands: &mut Commands,
     meshes: &mut Assets<Mesh>,
@@ -222,7 +280,7 @@ pub fn spawn_stage(
     scene: &Scene,
     layout: &Layout,
 ) {
-    let l = *layout;
+    let l = layout;
     let steel = materials.add(StandardMaterial {
         base_color: Color::srgb(0.42, 0.44, 0.48),
         metallic: 0.3,
@@ -236,20 +294,20 @@ pub fn spawn_stage(
         perceptual_roughness: 0.1,
         ..default()
     });
-    let span = l.length + 2.0 * l.overhang;
+    let span = l.width + 2.0 * l.overhang;
     commands.spawn((
         Mesh3d(meshes.add(Plane3d::default().mesh().size(3.0 * span, 2.0 * span))),
         MeshMaterial3d(ground),
-        Transform::from_xyz(0.5 * l.length, 0.0, 0.0),
+        Transform::from_xyz(0.5 * l.width, 0.0, 0.0),
     ));
-    let depth = l.depth;
+    let depth = l.boxes.iter().map(|b| b.depth).fold(0.0, f32::max);
     // Columns stand under each platform's ends; their feet follow the floor below (the ground
     // stays), their tops the floor they hold.
     let col = 0.35 * l.radius;
     let column = meshes.add(Cuboid::new(col, l.column_height, col));
     for storey in 0..l.floors {
         let foot_y = if storey == 0 { 0.0 } else { l.floor_y(storey - 1) + 0.5 * l.platform };
-        for foot_x in [-0.6 * l.overhang, l.length + 0.6 * l.overhang] {
+        for foot_x in [-0.6 * l.overhang, l.width + 0.6 * l.overhang] {
             commands.spawn((
                 Column(Vec3::new(foot_x, foot_y, 0.0), storey),
                 Mesh3d(column.clone()),
@@ -258,58 +316,40 @@ pub fn spawn_stage(
             ));
         }
     }
-    let frame_part = |commands: &mut Commands, mesh: Handle<Mesh>, material: Handle<StandardMaterial>, centre: Vec3| {
-        commands.spawn((FramePart(centre), Mesh3d(mesh), MeshMaterial3d(material), Transform::from_translation(centre))).id()
+    let floor_part = |commands: &mut Commands, floor: usize, mesh: Handle<Mesh>, material: Handle<StandardMaterial>, centre: Vec3| {
+        commands.spawn((FloorPart(floor, centre), Mesh3d(mesh), MeshMaterial3d(material), Transform::from_translation(centre))).id()
     };
     let slab = meshes.add(Cuboid::new(span, l.platform, depth * 1.4));
-    frame_part(commands, slab.clone(), steel.clone(), Vec3::new(0.5 * l.length, l.floor_y(l.carrying), 0.0));
-    for i in (0..l.floors).filter(|&i| i != l.carrying) {
-        let centre = Vec3::new(0.5 * l.length, l.floor_y(i), 0.0);
-        commands.spawn((FloorSlab(i, centre), Mesh3d(slab.clone()), MeshMaterial3d(steel.clone()), Transform::from_translation(centre)));
+    for i in 0..l.floors {
+        floor_part(commands, i, slab.clone(), steel.clone(), Vec3::new(0.5 * l.width, l.floor_y(i), 0.0));
     }
-    let floor_y = l.floor_y(l.carrying) + 0.5 * l.platform + 0.5 * l.wall;
-    frame_part(
-        commands,
-        meshes.add(Cuboid::new(l.length + 2.0 * l.wall, l.wall, depth)),
-        steel.clone(),
-        Vec3::new(0.5 * l.length, floor_y, 0.0),
-    );
-    let height = l.height;
-    let wall_y = l.ball_y;
-    for (body, x) in [(Body::LeftWall, -0.5 * l.wall), (Body::RightWall, l.length + 0.5 * l.wall)] {
-        let m = materials.add(StandardMaterial { base_color: Color::srgb(0.5, 0.52, 0.56), ..default() });
-        let id = frame_part(commands, meshes.add(Cuboid::new(l.wall, height, depth)), m, Vec3::new(x, wall_y, 0.0));
-        commands.entity(id).insert(WallMesh(body));
-    }
-    // The see-through box: front, back and lid (the end walls are drawn opaque).
-    frame_part(
-        commands,
-        meshes.add(Cuboid::new(l.length, height, 0.02 * l.radius)),
-        glass.clone(),
-        Vec3::new(0.5 * l.length, wall_y, 0.5 * depth),
-    );
-    frame_part(
-        commands,
-        meshes.add(Cuboid::new(l.length, height, 0.02 * l.radius)),
-        glass.clone(),
-        Vec3::new(0.5 * l.length, wall_y, -0.5 * depth),
-    );
-    frame_part(
-        commands,
-        meshes.add(Cuboid::new(l.length, 0.02 * l.radius, depth)),
-        glass.clone(),
-        Vec3::new(0.5 * l.length, wall_y + 0.5 * height, 0.0),
-    );
-
-    // The dividers between chains.
-    for k in 1..scene.space.chains() {
-        let y = k as f32 * scene.space.channel as f32 - 0.5 * depth;
-        frame_part(
+    for (k, b) in l.boxes.iter().enumerate() {
+        let (f, middle) = (b.floor, b.shift + 0.5 * b.length);
+        let pane = |commands: &mut Commands, meshes: &mut Assets<Mesh>, size: Vec3, centre: Vec3| {
+            floor_part(commands, f, meshes.add(Cuboid::from_size(size)), glass.clone(), centre);
+        };
+        let floor_y = l.floor_y(f) + 0.5 * l.platform + 0.5 * l.wall;
+        floor_part(
             commands,
-            meshes.add(Cuboid::new(l.length, height, 0.02 * l.radius)),
-            glass.clone(),
-            Vec3::new(0.5 * l.length, wall_y, y),
+            f,
+            meshes.add(Cuboid::new(b.length + 2.0 * l.wall, l.wall, b.depth)),
+            steel.clone(),
+            Vec3::new(middle, floor_y, 0.0),
         );
+        for (body, x) in [(Body::LeftWall, b.shift - 0.5 * l.wall), (Body::RightWall, b.shift + b.length + 0.5 * l.wall)] {
+            let m = materials.add(StandardMaterial { base_color: Color::srgb(0.5, 0.52, 0.56), ..default() });
+            let id = floor_part(commands, f, meshes.add(Cuboid::new(l.wall, b.height, b.depth)), m, Vec3::new(x, b.ball_y, 0.0));
+            commands.entity(id).insert(WallMesh(body, k));
+        }
+        // The see-through box: front, back and lid (the end walls are drawn opaque), and the
+        // dividers between chains.
+        let thin = 0.02 * l.radius;
+        pane(commands, meshes, Vec3::new(b.length, b.height, thin), Vec3::new(middle, b.ball_y, 0.5 * b.depth));
+        pane(commands, meshes, Vec3::new(b.length, b.height, thin), Vec3::new(middle, b.ball_y, -0.5 * b.depth));
+        pane(commands, meshes, Vec3::new(b.length, thin, b.depth), Vec3::new(middle, b.ball_y + 0.5 * b.height, 0.0));
+        for &z in &b.dividers {
+            pane(commands, meshes, Vec3::new(b.length, b.height, thin), Vec3::new(middle, b.ball_y, z));
+        }
     }
     let sphere = meshes.add(Sphere::new(1.0).mesh().uv(48, 24));
     for (i, b) in scene.balls.iter().enumerate() {
@@ -319,7 +359,7 @@ pub fn spawn_stage(
             BallMesh(i, scene.space.lateral_of(i)),
             Mesh3d(sphere.clone()),
             MeshMaterial3d(m),
-            Transform::from_translation(l.ball(scene.initial_positions[i], scene.space.lateral_of(i)))
+            Transform::from_translation(l.ball(i, scene.initial_positions[i], scene.space.lateral_of(i)))
                 .with_scale(Vec3::splat(b.radius as f32)),
         ));
     }
@@ -335,30 +375,25 @@ type BallParts<'w, 's> = Query<
     'w,
     's,
     (&'static BallMesh, &'static mut Transform, &'static MeshMaterial3d<StandardMaterial>),
-    (Without<FramePart>, Without<Column>, Without<FloorSlab>),
+    (Without<FloorPart>, Without<Column>),
 >;
-/// The frame's parts (walls, floor), posed by [`pose`].
-type FrameParts<'w, 's> = Query<
+/// The parts that move with a floor (platforms, containers), posed by [`pose`].
+type FloorParts<'w, 's> = Query<
     'w,
     's,
-    (&'static FramePart, &'static mut Transform, Option<&'static WallMesh>, &'static MeshMaterial3d<StandardMaterial>),
-    (Without<BallMesh>, Without<Column>, Without<FloorSlab>),
+    (&'static FloorPart, &'static mut Transform, Option<&'static WallMesh>, &'static MeshMaterial3d<StandardMaterial>),
+    (Without<BallMesh>, Without<Column>),
 >;
-/// The columns the frame stands on, posed by [`pose`].
-type Columns<'w, 's> =
-    Query<'w, 's, (&'static Column, &'static mut Transform), (Without<BallMesh>, Without<FramePart>, Without<FloorSlab>)>;
-/// A structure's floors other than the carrying one, posed by [`pose`].
-type FloorSlabs<'w, 's> =
-    Query<'w, 's, (&'static FloorSlab, &'static mut Transform), (Without<BallMesh>, Without<FramePart>, Without<Column>)>;
+/// The columns the floors stand on, posed by [`pose`].
+type Columns<'w, 's> = Query<'w, 's, (&'static Column, &'static mut Transform), (Without<BallMesh>, Without<FloorPart>)>;
 
 /// Poses every part at the playback's sample and lights the flashes.
 pub fn pose(
     playback: Res<Playback>,
     layout: Res<Layout>,
     mut balls: BallParts,
-    mut parts: FrameParts,
+    mut parts: FloorParts,
     mut columns: Columns,
-    mut slabs: FloorSlabs,
     mut materials: ResMut<Assets<StandardMaterial>>,
 ) {
     let (xs, x) = super::state_at_sample(&playback.run, playback.sample);
@@ -380,15 +415,9 @@ pub fn pose(
             // Balls that move across the motion are where the series has them; balls on lines
             // stay at their place across.
             let across = if series.has_across() { series.across(b.0, k) } else { b.1 };
-            t.translation = layout.ball(xi, across);
+            t.translation = layout.ball(b.0, xi, across);
         }
-        glow(m, playback.flashing(Body::Ball(b.0)));
-    }
-    for (p, mut t, wall, m) in &mut parts {
-        t.translation = p.0 + Vec3::X * xs as f32;
-        if let Some(w) = wall {
-            glow(m, playback.flashing(w.0));
-        }
+        glow(m, playback.ball_flashing(b.0));
     }
     // Each floor's displacement relative to the ground: a structure's from its series, a
     // frame's (one floor) its own.
@@ -399,8 +428,11 @@ pub fn pose(
             xs as f32
         }
     };
-    for (slab, mut t) in &mut slabs {
-        t.translation = slab.1 + Vec3::X * floor_x(slab.0);
+    for (p, mut t, wall, m) in &mut parts {
+        t.translation = p.1 + Vec3::X * floor_x(p.0);
+        if let Some(w) = wall {
+            glow(m, playback.wall_flashing(w.0, &layout.boxes[w.1].balls));
+        }
     }
     for (c, mut t) in &mut columns {
         // Lean so that the top follows the floor it holds while the foot follows the one below.

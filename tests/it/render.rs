@@ -82,7 +82,7 @@ fn balls_are_drawn_where_the_physics_puts_them() {
         assert!((series.t()[sample] - k as f64 / FPS).abs() < 1e-9, "frame {k} falls on a sample");
         let mut centres = vec![];
         for (i, ball) in scene.balls.iter().enumerate() {
-            let centre = layout.ball(series.x(i)[sample], scene.space.lateral_of(i));
+            let centre = layout.ball(i, series.x(i)[sample], scene.space.lateral_of(i));
             let p = layout.project(SIZE, centre);
             let r_px = layout.projected_radius(SIZE, centre, ball.radius as f32);
             assert!(r_px > 3.0, "ball{} is {r_px} px across: too small to check", i + 1);
@@ -220,7 +220,7 @@ fn a_box_of_balls_is_drawn_ball_by_ball() {
         let sample = k * per_frame;
         let at = |p: bevy::math::Vec2| pixel((w, h, &px, channels), p, k);
         for i in 0..scene.balls.len() {
-            let centre = layout.ball(series.x(i)[sample], series.across(i, sample));
+            let centre = layout.ball(i, series.x(i)[sample], series.across(i, sample));
             let p = layout.project(size, centre);
             let r_px = layout.projected_radius(size, centre, scene.balls[i].radius as f32);
             assert!(r_px > 3.0, "ball{} is {r_px} px across: too small to check", i + 1);
@@ -303,8 +303,9 @@ fn a_box_on_a_building_is_drawn_on_its_floor() {
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     let scene = load_scene(path).unwrap();
     let layout = Layout::of(&scene);
-    assert_eq!((layout.floors, layout.carrying), (3, 2));
-    assert!(layout.floor_y(1) + layout.platform < layout.ball_y - 0.5 * layout.height, "the box rides above the floors under it");
+    let container = &layout.boxes[0];
+    assert_eq!((layout.floors, layout.boxes.len(), container.floor), (3, 1, 2));
+    assert!(layout.floor_y(1) + layout.platform < container.ball_y - 0.5 * container.height, "the box rides above the floors under it");
     let series = read_series_csv(&out.path().join("series.csv")).unwrap();
     assert_eq!(series.floor_count(), 3);
     let (_, per_frame) = lpc_damper::run::frame_sampling(FPS, scene.sample_dt);
@@ -324,7 +325,7 @@ fn a_box_on_a_building_is_drawn_on_its_floor() {
             assert!(!is_steel(above), "frame {k}: something is drawn between floors {} and {} ({above:?})", i + 1, i + 2);
         }
         for i in 0..scene.balls.len() {
-            let centre = layout.ball(series.x(i)[sample], series.across(i, sample));
+            let centre = layout.ball(i, series.x(i)[sample], series.across(i, sample));
             let p = layout.project(size, centre);
             let r_px = layout.projected_radius(size, centre, scene.balls[i].radius as f32);
             assert!(r_px > 3.0, "ball{} is {r_px} px across: too small to check", i + 1);
@@ -354,12 +355,12 @@ fn a_tall_buildings_damper_fills_the_picture() {
     let size = (640, 480);
     let low = storeys(3, 3);
     let box_width = |l: &Layout| {
-        let y = l.ball_y;
-        l.project(size, bevy::math::Vec3::new(l.length, y, 0.0)).x - l.project(size, bevy::math::Vec3::new(0.0, y, 0.0)).x
+        let (y, length) = (l.boxes[0].ball_y, l.boxes[0].length);
+        l.project(size, bevy::math::Vec3::new(length, y, 0.0)).x - l.project(size, bevy::math::Vec3::new(0.0, y, 0.0)).x
     };
     for (n, floor) in [(10, 10), (20, 20), (20, 12)] {
         let tall = storeys(n, floor);
-        assert_eq!((tall.floors, tall.carrying), (n, floor - 1));
+        assert_eq!((tall.floors, tall.boxes[0].floor), (n, floor - 1));
         // On the top floor the box is about as wide as on the three-storey building (its
         // framing reaches a little higher); below the top, the storey above is framed too and
         // the box is narrower, by less than half. Shown whole, twenty storeys leave it a
@@ -372,6 +373,96 @@ fn a_tall_buildings_damper_fills_the_picture() {
         for i in floor - STOREYS_SHOWN_BELOW..floor {
             let p = tall.project(size, bevy::math::Vec3::new(0.0, tall.floor_y(i), 0.0));
             assert!((0.0..size.1 as f32).contains(&p.y), "{n} storeys: floor {} is out of the picture at {p}", i + 1);
+        }
+    }
+}
+
+/// Several dampers (issue 54): each container is drawn on its own floor, moving with it, and
+/// each ball inside its own container where the physics puts it.
+#[test]
+fn several_dampers_are_drawn_each_on_its_floor() {
+    let out = tempfile::tempdir().unwrap();
+    let path = "examples/scenes/dampers-two-floors.toml";
+    let size = (640, 480);
+    let o = lpc([
+        "render",
+        path,
+        "--model",
+        "rapier",
+        "--out",
+        out.path().to_str().unwrap(),
+        "--horizon",
+        "0.1",
+        "--fps",
+        "20",
+        "--size",
+        "640x480",
+    ]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let scene = load_scene(path).unwrap();
+    let layout = Layout::of(&scene);
+    let floors: Vec<usize> = layout.boxes.iter().map(|b| b.floor).collect();
+    assert_eq!(floors, [1, 2]);
+    let (lower, upper) = (&layout.boxes[0], &layout.boxes[1]);
+    assert!(lower.ball_y + 0.5 * lower.height < layout.floor_y(2) - 0.5 * layout.platform, "the lower box stands under the top floor");
+    assert!(upper.ball_y - 0.5 * upper.height > layout.floor_y(2), "the upper box stands on the top floor");
+    let series = read_series_csv(&out.path().join("series.csv")).unwrap();
+    let (_, per_frame) = lpc_damper::run::frame_sampling(FPS, scene.sample_dt);
+    for k in 0..=2 {
+        let (w, h, px, channels) = decode(&out.path().join(format!("frame_{k:05}.png")));
+        assert_eq!((w, h), size);
+        let sample = k * per_frame;
+        let at = |p: bevy::math::Vec2| pixel((w, h, &px, channels), p, k);
+        for (d, container) in layout.boxes.iter().enumerate() {
+            // The container's floor under its middle, moving with that floor.
+            let (u, _, _) = series.floor(container.floor, sample).unwrap();
+            for i in container.balls.clone() {
+                let x = series.x(i)[sample];
+                assert!(x >= u - 1e-9 && x <= u + f64::from(container.length) + 1e-9, "ball{} is in damper {}'s container", i + 1, d + 1);
+                let centre = layout.ball(i, x, series.across(i, sample));
+                let p = layout.project(size, centre);
+                let r_px = layout.projected_radius(size, centre, scene.balls[i].radius as f32);
+                assert!(r_px > 3.0, "ball{} is {r_px} px across: too small to check", i + 1);
+                let c = at(p);
+                assert!(
+                    is_shaded_large(c) || is_small(c) || is_large(c),
+                    "frame {k}: ball{} of damper {} at pixel {p} is not drawn",
+                    i + 1,
+                    d + 1
+                );
+            }
+        }
+    }
+}
+
+/// Containers on one floor occupy the same place in the models (their balls never meet); the
+/// picture stands them side by side on that floor, all in view.
+#[test]
+fn dampers_on_one_floor_stand_side_by_side() {
+    let text = std::fs::read_to_string("examples/scenes/dampers-two-floors.toml").unwrap().replace("floor = 2 ", "floor = 3 ");
+    let scene = lpc_damper::scene::parse(&text, "examples/scenes/one-floor.toml", "one-floor").unwrap().scene.unwrap();
+    assert_eq!(scene.dampers.iter().map(|d| d.floor).collect::<Vec<_>>(), [2, 2]);
+    let layout = Layout::of(&scene);
+    let (first, second) = (&layout.boxes[0], &layout.boxes[1]);
+    assert_eq!((first.floor, second.floor, first.ball_y), (2, 2, second.ball_y));
+    assert!(second.shift >= first.shift + first.length + 2.0 * layout.wall, "the containers overlap: {first:?}, {second:?}");
+    assert!(layout.width >= second.shift + second.length);
+    let size = (640, 480);
+    for b in &layout.boxes {
+        for x in [b.shift - layout.wall, b.shift + b.length + layout.wall] {
+            for y in [b.ball_y - 0.5 * b.height, b.ball_y + 0.5 * b.height] {
+                let p = layout.project(size, bevy::math::Vec3::new(x, y, 0.0));
+                assert!(
+                    p.x > 0.0 && p.x < size.0 as f32 && p.y > 0.0 && p.y < size.1 as f32,
+                    "a corner of a container is out of the picture at {p}"
+                );
+            }
+        }
+        // Each ball is drawn inside its own container.
+        for i in b.balls.clone() {
+            let c = layout.ball(i, scene.initial_positions[i], scene.space.lateral_of(i));
+            let r = scene.balls[i].radius as f32;
+            assert!(c.x - r >= b.shift - 1e-6 && c.x + r <= b.shift + b.length + 1e-6, "ball{} is drawn outside its container", i + 1);
         }
     }
 }

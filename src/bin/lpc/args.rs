@@ -186,15 +186,6 @@ pub fn override_scene(scene: &mut Scene, overrides: Overrides, path: &Path) -> s
 }
 
 /// A flag (or a field of the scene at `path`) that breaks `rule`.
-/// Refuses a scene of several dampers for a picture, which draws one damper's container.
-pub fn one_damper_drawn(scene: &Scene, path: &Path) -> std::result::Result<(), SceneError> {
-    if !scene.has_several_dampers() {
-        return Ok(());
-    }
-    let rule = format!("lists {} dampers; pictures draw one damper: give one [[damper]] to draw it", scene.dampers.len());
-    Err(invalid(path, "damper", rule))
-}
-
 pub fn invalid(path: &Path, field: &str, rule: impl Into<String>) -> SceneError {
     SceneError::Invalid { file: path.display().to_string(), field: field.into(), rule: rule.into() }
 }

@@ -47,7 +47,6 @@ pub fn run(a: Args) -> Result<ExitStatus> {
         return Err(invalid(&a.scene, "--fps", format!("must lie in (0, 10000] (got {})", a.fps)).into());
     }
     let s = load_scene(&a.scene, a.settings.overrides(None, None))?;
-    crate::args::one_damper_drawn(&s, &a.scene)?;
     // Frames fall on samples: the run is sampled at a step dividing the frame interval.
     let (sample_dt, per_frame) = lpc_damper::run::frame_sampling(a.fps, s.sample_dt);
     let timing = Overrides { horizon: a.horizon, sample_dt: Some(sample_dt), ..Overrides::default() };

@@ -37,7 +37,6 @@ pub fn run(a: Args) -> Result<ExitStatus> {
         )));
     }
     let s = load_scene(&a.scene, a.settings.overrides(a.horizon, None))?;
-    crate::args::one_damper_drawn(&s, &a.scene)?;
     let run = crate::watch::watched(a.model, &s, RunOptions::limited(a.budget.limits(&a.scene)?))?;
     #[cfg(feature = "render")]
     lpc_damper::render::window::view(&s, run);
