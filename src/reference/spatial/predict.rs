@@ -63,11 +63,12 @@ impl Solver<'_> {
                     .collect();
             }
         }
-        // On a structure the walls' motion changes at every end-wall impact of any ball, and
-        // where a bed presses its walls those come a contact duration apart: a search is cut at
-        // a scan step of the floors' motion, where it goes on unless the motion has changed.
-        let bound = match self.frame.storeys() {
-            Some(s) => self.t + s.scan_step,
+        // On a forced frame or a structure the walls' motion changes at every end-wall impact
+        // of any ball, and where a bed presses its walls those come a contact duration apart: a
+        // search is cut at a scan step of the walls' motion, where it goes on unless the
+        // motion has changed.
+        let bound = match self.frame.scan_step() {
+            Some(step) => self.t + step,
             None => self.horizon,
         };
         let c = self.frame_gap(i, side).search(self.t, bound);
