@@ -49,6 +49,35 @@ fn is_steel(p: [u8; 3]) -> bool {
 const FPS: f64 = 20.0;
 const SIZE: (u32, u32) = (480, 270);
 
+/// Renders the first 0.1 s of the scene at `path` with the contact model at 20 fps into `out`
+/// (frames of 640x480), and returns the scene, its layout and the run's series.
+fn render_tenth_of_a_second(path: &str, out: &Path) -> (lpc_damper::scene::Scene, Layout, lpc_damper::run::Series) {
+    let o =
+        lpc(["render", path, "--model", "rapier", "--out", out.to_str().unwrap(), "--horizon", "0.1", "--fps", "20", "--size", "640x480"]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let scene = load_scene(path).unwrap();
+    let layout = Layout::of(&scene);
+    let series = read_series_csv(&out.join("series.csv")).unwrap();
+    (scene, layout, series)
+}
+
+/// Asserts that ball `i` shows a ball's colour at its centre's pixel in frame `k` (its own, or
+/// that of a ball in front of it), `at` reading that frame's pixels.
+fn assert_ball_drawn(
+    (scene, layout, series): (&lpc_damper::scene::Scene, &Layout, &lpc_damper::run::Series),
+    i: usize,
+    (k, sample): (usize, usize),
+    at: impl Fn(bevy::math::Vec2) -> [u8; 3],
+) {
+    let size = (640, 480);
+    let centre = layout.ball(i, series.x(i)[sample], series.across(i, sample));
+    let p = layout.project(size, centre);
+    let r_px = layout.projected_radius(size, centre, scene.balls[i].radius as f32);
+    assert!(r_px > 3.0, "ball{} is {r_px} px across: too small to check", i + 1);
+    let c = at(p);
+    assert!(is_shaded_large(c) || is_small(c) || is_large(c), "frame {k}: ball{} at pixel {p} is not drawn ({c:?})", i + 1);
+}
+
 #[test]
 fn balls_are_drawn_where_the_physics_puts_them() {
     let out = tempfile::tempdir().unwrap();
@@ -284,31 +313,13 @@ fn a_damper_on_a_building_renders() {
 #[test]
 fn a_box_on_a_building_is_drawn_on_its_floor() {
     let out = tempfile::tempdir().unwrap();
-    let path = "examples/scenes/small-box-building.toml";
-    let size = (640, 480);
-    let o = lpc([
-        "render",
-        path,
-        "--model",
-        "rapier",
-        "--out",
-        out.path().to_str().unwrap(),
-        "--horizon",
-        "0.1",
-        "--fps",
-        "20",
-        "--size",
-        "640x480",
-    ]);
-    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
-    let scene = load_scene(path).unwrap();
-    let layout = Layout::of(&scene);
+    let (scene, layout, series) = render_tenth_of_a_second("examples/scenes/small-box-building.toml", out.path());
     let container = &layout.boxes[0];
     assert_eq!((layout.floors, layout.boxes.len(), container.floor), (3, 1, 2));
     assert!(layout.floor_y(1) + layout.platform < container.ball_y - 0.5 * container.height, "the box rides above the floors under it");
-    let series = read_series_csv(&out.path().join("series.csv")).unwrap();
     assert_eq!(series.floor_count(), 3);
     let (_, per_frame) = lpc_damper::run::frame_sampling(FPS, scene.sample_dt);
+    let size = (640, 480);
     for k in 0..=2 {
         let (w, h, px, channels) = decode(&out.path().join(format!("frame_{k:05}.png")));
         assert_eq!((w, h), size);
@@ -325,11 +336,7 @@ fn a_box_on_a_building_is_drawn_on_its_floor() {
             assert!(!is_steel(above), "frame {k}: something is drawn between floors {} and {} ({above:?})", i + 1, i + 2);
         }
         for i in 0..scene.balls.len() {
-            let centre = layout.ball(i, series.x(i)[sample], series.across(i, sample));
-            let p = layout.project(size, centre);
-            let r_px = layout.projected_radius(size, centre, scene.balls[i].radius as f32);
-            assert!(r_px > 3.0, "ball{} is {r_px} px across: too small to check", i + 1);
-            assert!(is_shaded_large(at(p)) || is_small(at(p)) || is_large(at(p)), "frame {k}: ball{} at pixel {p} is not drawn", i + 1);
+            assert_ball_drawn((&scene, &layout, &series), i, (k, sample), at);
         }
     }
 }
@@ -382,54 +389,25 @@ fn a_tall_buildings_damper_fills_the_picture() {
 #[test]
 fn several_dampers_are_drawn_each_on_its_floor() {
     let out = tempfile::tempdir().unwrap();
-    let path = "examples/scenes/dampers-two-floors.toml";
-    let size = (640, 480);
-    let o = lpc([
-        "render",
-        path,
-        "--model",
-        "rapier",
-        "--out",
-        out.path().to_str().unwrap(),
-        "--horizon",
-        "0.1",
-        "--fps",
-        "20",
-        "--size",
-        "640x480",
-    ]);
-    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
-    let scene = load_scene(path).unwrap();
-    let layout = Layout::of(&scene);
+    let (scene, layout, series) = render_tenth_of_a_second("examples/scenes/dampers-two-floors.toml", out.path());
     let floors: Vec<usize> = layout.boxes.iter().map(|b| b.floor).collect();
     assert_eq!(floors, [1, 2]);
     let (lower, upper) = (&layout.boxes[0], &layout.boxes[1]);
     assert!(lower.ball_y + 0.5 * lower.height < layout.floor_y(2) - 0.5 * layout.platform, "the lower box stands under the top floor");
     assert!(upper.ball_y - 0.5 * upper.height > layout.floor_y(2), "the upper box stands on the top floor");
-    let series = read_series_csv(&out.path().join("series.csv")).unwrap();
     let (_, per_frame) = lpc_damper::run::frame_sampling(FPS, scene.sample_dt);
     for k in 0..=2 {
         let (w, h, px, channels) = decode(&out.path().join(format!("frame_{k:05}.png")));
-        assert_eq!((w, h), size);
+        assert_eq!((w, h), (640, 480));
         let sample = k * per_frame;
         let at = |p: bevy::math::Vec2| pixel((w, h, &px, channels), p, k);
         for (d, container) in layout.boxes.iter().enumerate() {
-            // The container's floor under its middle, moving with that floor.
+            // The container's left wall moves with its floor.
             let (u, _, _) = series.floor(container.floor, sample).unwrap();
             for i in container.balls.clone() {
                 let x = series.x(i)[sample];
                 assert!(x >= u - 1e-9 && x <= u + f64::from(container.length) + 1e-9, "ball{} is in damper {}'s container", i + 1, d + 1);
-                let centre = layout.ball(i, x, series.across(i, sample));
-                let p = layout.project(size, centre);
-                let r_px = layout.projected_radius(size, centre, scene.balls[i].radius as f32);
-                assert!(r_px > 3.0, "ball{} is {r_px} px across: too small to check", i + 1);
-                let c = at(p);
-                assert!(
-                    is_shaded_large(c) || is_small(c) || is_large(c),
-                    "frame {k}: ball{} of damper {} at pixel {p} is not drawn",
-                    i + 1,
-                    d + 1
-                );
+                assert_ball_drawn((&scene, &layout, &series), i, (k, sample), at);
             }
         }
     }
