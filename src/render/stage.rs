@@ -75,35 +75,20 @@ impl Layout {
         let platform = 0.5 * radius;
         let floors = scene.structure.as_ref().map_or(1, |s| s.floors());
         // A line of balls gets a box a little wider and higher than its balls; a scene with a
-        // cross-section gets that.
-        let drawn = |section: [f64; 2]| ((3.0 * radius).max(section[0] as f32), (2.4 * radius).max(section[1] as f32));
-        let mut boxes: Vec<BoxLayout> = scene
-            .damper_list()
-            .into_iter()
-            .map(|d| {
-                let (depth, height) = drawn(d.section);
-                let chains = d.balls.clone().map(|i| scene.space.chain_of(i)).collect::<std::collections::BTreeSet<_>>().len();
-                let dividers = (1..chains).map(|k| k as f32 * d.channel as f32 - 0.5 * depth).collect();
-                BoxLayout {
-                    floor: d.floor,
-                    balls: d.balls,
-                    length: d.container.length as f32,
-                    depth,
-                    height,
-                    shift: 0.0,
-                    ball_y: 0.0,
-                    dividers,
-                }
-            })
-            .collect();
+        // cross-section gets that. Its chains are divided at their channels' edges.
+        let placed = |floor: usize, balls: std::ops::Range<usize>, length: f32, section: [f64; 2], channel: f64| {
+            let (depth, height) = ((3.0 * radius).max(section[0] as f32), (2.4 * radius).max(section[1] as f32));
+            let chains = balls.clone().map(|i| scene.space.chain_of(i)).collect::<std::collections::BTreeSet<_>>().len();
+            let dividers = (1..chains).map(|k| k as f32 * channel as f32 - 0.5 * depth).collect();
+            BoxLayout { floor, balls, length, depth, height, shift: 0.0, ball_y: 0.0, dividers }
+        };
+        let mut boxes: Vec<BoxLayout> =
+            scene.damper_list().into_iter().map(|d| placed(d.floor, d.balls, d.container.length as f32, d.section, d.channel)).collect();
         if boxes.is_empty() {
             let (lo, hi) = scene.initial_positions.iter().fold((f64::MAX, f64::MIN), |(a, b), &x| (a.min(x), b.max(x)));
             // No balls at all: an empty stretch of a few radii, not `MIN - MAX`.
             let length = if lo <= hi { (hi - lo) as f32 + 4.0 * radius } else { 4.0 * radius };
-            let (depth, height) = drawn(scene.space.section);
-            let chains = scene.space.chains();
-            let dividers = (1..chains).map(|k| k as f32 * scene.space.channel as f32 - 0.5 * depth).collect();
-            boxes.push(BoxLayout { floor: 0, balls: 0..scene.balls.len(), length, depth, height, shift: 0.0, ball_y: 0.0, dividers });
+            boxes.push(placed(0, 0..scene.balls.len(), length, scene.space.section, scene.space.channel));
         }
         // The containers of a floor stand in a row, a few radii apart.
         let gap = 2.0 * wall + 4.0 * radius;
