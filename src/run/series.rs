@@ -502,6 +502,11 @@ impl Recorder {
     /// [`Recorder::sample`] has just taken (kept with it, or not at all).
     fn sample_across(&mut self, across: impl Fn(usize) -> [f64; 2]) {
         if let (true, Some(s)) = (self.kept_last, &mut self.series) {
+            // Room for every sample at once: growing by doubling would copy the whole of a
+            // long run's positions several times over.
+            if s.across.is_empty() {
+                s.across.reserve_exact(2 * s.balls * s.capacity);
+            }
             s.across.extend((0..s.balls).flat_map(across));
         }
     }

@@ -25,3 +25,44 @@ fn sweeps_are_identical_on_one_and_two_threads() {
         assert_eq!(one, sweep_on(2, model), "{}: second run differs", model.name());
     }
 }
+
+/// `series.csv` is formatted in chunks of rows on every thread: it must not depend on their
+/// number, and it must hold every value of the series, each read back to the same `f64`.
+#[test]
+fn series_csv_is_the_same_on_any_threads_and_reads_back_exactly() {
+    let mut scene = load("examples/scenes/small-box-building.toml").unwrap().scene.unwrap();
+    scene.horizon = 0.3;
+    let run = Model::Rapier.simulate(&scene, &lpc_damper::model::RunOptions::default()).unwrap();
+    let s = &run.series;
+    assert!(s.has_across() && s.floor_count() == 3 && s.len() > 256, "the run has balls in space, floors and several chunks");
+    let on = |threads: usize| {
+        let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
+        pool.install(|| lpc_damper::output::series_csv(&run))
+    };
+    let text = on(1);
+    assert_eq!(text, on(3));
+    let mut reader = csv::Reader::from_reader(text.as_slice());
+    let header = reader.headers().unwrap().clone();
+    let rows: Vec<Vec<f64>> = reader.records().map(|r| r.unwrap().iter().map(|x| x.parse().unwrap()).collect()).collect();
+    assert_eq!(rows.len(), s.len());
+    let column = |name: &str| header.iter().position(|h| h == name).unwrap_or_else(|| panic!("no column {name}"));
+    for (k, row) in rows.iter().enumerate() {
+        assert_eq!(row.len(), header.len());
+        let same = |name: &str, value: f64| assert_eq!(row[column(name)].to_bits(), value.to_bits(), "{name} at row {k}");
+        same("t", s.t()[k]);
+        same("xs", s.xs()[k]);
+        for i in 0..s.balls() {
+            same(&format!("x{}", i + 1), s.x(i)[k]);
+            same(&format!("v{}", i + 1), s.v(i)[k]);
+            let [y, z] = s.across(i, k);
+            same(&format!("y{}", i + 1), y);
+            same(&format!("z{}", i + 1), z);
+        }
+        for i in 0..3 {
+            let (u, v, a) = s.floor(i, k).unwrap();
+            same(&format!("xs{}", i + 1), u);
+            same(&format!("vs{}", i + 1), v);
+            same(&format!("as{}", i + 1), a);
+        }
+    }
+}
