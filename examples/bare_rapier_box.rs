@@ -35,7 +35,9 @@ fn main() -> anyhow::Result<()> {
         bail!("{path}: the bare pipeline drives one damper on a frame in free vibration only");
     }
     let frame = scene.frame.context("the scene has no frame")?;
-    let mut world = rapier_world(&scene).map_err(anyhow::Error::msg)?;
+    let built = rapier_world(&scene).map_err(anyhow::Error::msg)?;
+    let balls: Vec<RigidBodyHandle> = built.balls.iter().map(|b| b.body).collect();
+    let mut world = built.dampers.into_iter().next().context("the scene has no damper")?;
     // Rapier's own: its contact settings and restitution, at the step asked for.
     let length_unit = world.physics.integration_parameters.length_unit;
     world.physics.integration_parameters = IntegrationParameters { dt: dt as f32, length_unit, ..IntegrationParameters::default() };
@@ -46,15 +48,15 @@ fn main() -> anyhow::Result<()> {
     let masses: Vec<f64> = scene.balls.iter().map(|b| b.mass).collect();
     let oscillator = Oscillator::new(frame.mass, frame.damping, frame.stiffness);
     let (mut xs, mut vs) = (scene.initial_displacement, 0.0);
-    let mut vx: Vec<f64> = world.balls.iter().map(|h| world.physics.bodies[*h].linvel().x as f64).collect();
+    let mut vx: Vec<f64> = balls.iter().map(|h| world.physics.bodies[*h].linvel().x as f64).collect();
     let steps = (horizon / dt).round().max(1.0) as u64;
     let started = Instant::now();
     for _ in 0..steps {
         let (x1, v1) = oscillator.state(xs, vs, dt);
-        world.physics.bodies[world.frames[0]].set_next_kinematic_translation(Vector::new(x1 as f32, 0.0, 0.0));
+        world.physics.bodies[world.frame].set_next_kinematic_translation(Vector::new(x1 as f32, 0.0, 0.0));
         world.physics.step();
         let mut momentum = 0.0;
-        for (i, h) in world.balls.iter().enumerate() {
+        for (i, h) in balls.iter().enumerate() {
             let v = world.physics.bodies[*h].linvel().x as f64;
             momentum += masses[i] * (v - vx[i]);
             vx[i] = v;

@@ -16,7 +16,7 @@ mod records;
 mod strikes;
 mod world;
 
-use bevy_rapier3d::rapier::prelude::{ActiveHooks, RigidBodyHandle, RigidBodySet, Vector};
+use bevy_rapier3d::rapier::prelude::{ActiveHooks, Vector};
 
 pub use contacts::closing_speed;
 pub use world::{SolverSettings, SpatialWorld};
@@ -68,9 +68,6 @@ pub fn refusal(scene: &Scene) -> Option<String> {
         return Some("the scene has no frame; the spatial contact model needs a container on a frame".into());
     }
     let dampers = scene.damper_list();
-    if dampers.len() > world::MOST_DAMPERS {
-        return Some(format!("the scene has {} dampers; the contact model holds at most {}", dampers.len(), world::MOST_DAMPERS));
-    }
     let several = dampers.len() > 1;
     for (k, d) in dampers.iter().enumerate() {
         if let Err(reason) = Chamber::of_damper(scene, d) {
@@ -201,9 +198,9 @@ struct BallState {
 }
 
 impl BallState {
-    fn read(&mut self, bodies: &RigidBodySet, handles: &[RigidBodyHandle]) {
-        for (k, &h) in handles.iter().enumerate() {
-            let b = &bodies[h];
+    fn read(&mut self, world: &SpatialWorld) {
+        for k in 0..world.balls.len() {
+            let b = world.ball(k);
             let (p, v, w) = (b.translation(), b.linvel(), b.angvel());
             self.x[k] = [p.x as f64, p.y as f64, p.z as f64];
             self.v[k] = [v.x as f64, v.y as f64, v.z as f64];
@@ -213,12 +210,13 @@ impl BallState {
 
     /// Gives Rapier the velocities of the balls marked in `which`, keeping what it will read
     /// back (the `f32` velocity).
-    fn write_velocities(&mut self, bodies: &mut RigidBodySet, handles: &[RigidBodyHandle], which: &[bool]) {
-        for (k, &h) in handles.iter().enumerate() {
+    fn write_velocities(&mut self, world: &mut SpatialWorld, which: &[bool]) {
+        for k in 0..world.balls.len() {
             if which[k] {
                 let v = self.v[k];
-                bodies[h].set_linvel(Vector::new(v[0] as f32, v[1] as f32, v[2] as f32), true);
-                let r = bodies[h].linvel();
+                let body = world.ball_mut(k);
+                body.set_linvel(Vector::new(v[0] as f32, v[1] as f32, v[2] as f32), true);
+                let r = body.linvel();
                 self.v[k] = [r.x as f64, r.y as f64, r.z as f64];
             }
         }
@@ -256,7 +254,7 @@ pub fn simulate_spatial_with(scene: &Scene, solver: SolverSettings, options: &Ru
     let e = scene.restitution;
     let mut carrier = Carrier::new(scene).map_err(ModelError::Refused)?;
     let mut now = BallState { x: vec![[0.0; 3]; n], v: vec![[0.0; 3]; n], w: vec![[0.0; 3]; n] };
-    now.read(&world.physics.bodies, &world.balls);
+    now.read(&world);
     let start_positions = now.x.clone();
     let mut before = BallState { x: now.x.clone(), v: now.v.clone(), w: now.w.clone() };
     let (mut xs, mut vs): (Vec<f64>, Vec<f64>) = carrier.starts().into_iter().unzip();
@@ -284,8 +282,8 @@ pub fn simulate_spatial_with(scene: &Scene, solver: SolverSettings, options: &Ru
         let pressing = if piled { g_norm } else { contacts_dot(g, c.normal).abs() };
         2.0 * (pressing + c.normal[0].abs() * walls_a[body_of[c.ball]]) * solver.dt + speed_floor
     };
-    let prediction = world.physics.integration_parameters.normalized_prediction_distance;
-    let lu = world.physics.integration_parameters.length_unit;
+    let prediction = world.dampers[0].physics.integration_parameters.normalized_prediction_distance;
+    let lu = solver.length_unit as f32;
     // A ball sunk deeper into a wall stops the run rather than leave the container. (Balls
     // may sink deeper into each other: Rapier's solve holds a pile by the overlaps of its
     // balls, which nothing outside the run sees.)
@@ -297,7 +295,7 @@ pub fn simulate_spatial_with(scene: &Scene, solver: SolverSettings, options: &Ru
     let mut kicked = vec![false; n];
     let mut cascade = contacts::Cascade::default();
     let mut strikes = strikes::Strikes::default();
-    let mut unsolved = Vec::new();
+    let mut unsolved = vec![Vec::new(); dampers.len()];
     let height_at_start = scene.height_energy_at_start();
     let energy_of = |carrier: &Carrier, state: &BallState, t: f64, xs: &[f64], vs: &[f64]| -> f64 {
         let mut e = carrier.energy(t, xs[0], vs[0]) + height_at_start;
@@ -338,7 +336,7 @@ pub fn simulate_spatial_with(scene: &Scene, solver: SolverSettings, options: &Ru
         let starts: Vec<(f64, f64)> = xs.iter().copied().zip(vs.iter().copied()).collect();
         carrier.restart_bodies(0.0, &starts, &frame.vs).map_err(ModelError::Refused)?;
         vs = frame.vs;
-        now.write_velocities(&mut world.physics.bodies, &world.balls, &struck);
+        now.write_velocities(&mut world, &struck);
     }
     let mut t = 0.0;
     let mut steps: u64 = 0;
@@ -404,7 +402,9 @@ pub fn simulate_spatial_with(scene: &Scene, solver: SolverSettings, options: &Ru
         // round-off: then the step is the same as in a longer run.
         let left = scene.horizon - t;
         let h = if left >= solver.dt * (1.0 - 1e-6) { solver.dt } else { left };
-        world.physics.integration_parameters.dt = h as f32;
+        for damper in &mut world.dampers {
+            damper.physics.integration_parameters.dt = h as f32;
+        }
         // The frame to where its closed form is at the step's end; Rapier moves the walls
         // there in a straight line.
         let (t0, t1) = (t, t + h);
@@ -412,9 +412,9 @@ pub fn simulate_spatial_with(scene: &Scene, solver: SolverSettings, options: &Ru
         let (damping, work) = carrier.energy_flows(t0, h);
         damping_loss += damping;
         forcing_work += work;
-        for (d, &frame) in world.frames.iter().enumerate() {
+        for (d, damper) in world.dampers.iter_mut().enumerate() {
             let x = x1[body_of_damper[d]];
-            world.physics.bodies[frame].set_next_kinematic_translation(Vector::new(x as f32, 0.0, 0.0));
+            damper.physics.bodies[damper.frame].set_next_kinematic_translation(Vector::new(x as f32, 0.0, 0.0));
         }
         // The walls' mean velocity over the step: Rapier moves them there in a straight line.
         let mean_vs: Vec<f64> = (0..bodies).map(|b| (x1[b] - xs[b]) / h).collect();
@@ -425,25 +425,30 @@ pub fn simulate_spatial_with(scene: &Scene, solver: SolverSettings, options: &Ru
         let fastest =
             now.v.iter().zip(&body_of).map(|(v, &b)| ((v[0] - mean_vs[b]).powi(2) + v[1] * v[1] + v[2] * v[2]).sqrt()).fold(0.0, f64::max);
         let closing = (2.0 * fastest * h + g_norm * h * h) as f32 / lu;
-        world.physics.integration_parameters.normalized_prediction_distance = prediction.max(closing);
+        for damper in &mut world.dampers {
+            damper.physics.integration_parameters.normalized_prediction_distance = prediction.max(closing);
+        }
         // Strikes on touching groups are kept out of Rapier's solve of their pair (`strikes`).
         // The walls' mean acceleration over the step, as its closed form moves them.
         let walls_a: Vec<f64> = (0..bodies).map(|b| ((v1[b] - vs[b]) / h).abs()).collect();
         strikes.predict(&found, &now.v, |k| vs[body_of[k]], touching, h, |c| resting_speed(c, &in_pile, &walls_a));
-        unsolved.clear();
-        unsolved.extend(strikes.list.iter().map(|s| (world.colliders[s.striker], world.colliders[s.target])));
+        // Each damper's strikes, as pairs of its world's colliders.
+        unsolved.iter_mut().for_each(Vec::clear);
         for s in &strikes.list {
-            world.physics.colliders[world.colliders[s.striker]].set_active_hooks(ActiveHooks::MODIFY_SOLVER_CONTACTS);
+            let (striker, target) = (world.balls[s.striker], world.balls[s.target]);
+            unsolved[striker.damper].push((striker.collider, target.collider));
+            world.collider_mut(s.striker).set_active_hooks(ActiveHooks::MODIFY_SOLVER_CONTACTS);
         }
         std::mem::swap(&mut before, &mut now);
-        world.physics.step_with_events(&strikes::Unsolved { pairs: &unsolved }, &());
-        now.read(&world.physics.bodies, &world.balls);
+        for (damper, pairs) in world.dampers.iter_mut().zip(&unsolved) {
+            damper.physics.step_with_events(&strikes::Unsolved { pairs }, &());
+        }
+        now.read(&world);
         for s in &strikes.list {
-            world.physics.colliders[world.colliders[s.striker]].set_active_hooks(ActiveHooks::empty());
+            world.collider_mut(s.striker).set_active_hooks(ActiveHooks::empty());
             if strikes::bring_back(*s, &mut now.x, &now.v, mean_vs[body_of[s.striker]], &radius, h) {
                 let p = now.x[s.striker].map(|c| c as f32);
-                let body = &mut world.physics.bodies[world.balls[s.striker]];
-                body.set_translation(Vector::new(p[0], p[1], p[2]), true);
+                world.ball_mut(s.striker).set_translation(Vector::new(p[0], p[1], p[2]), true);
                 now.x[s.striker] = p.map(f64::from);
             }
         }
@@ -565,7 +570,7 @@ pub fn simulate_spatial_with(scene: &Scene, solver: SolverSettings, options: &Ru
                 });
             }
         }
-        now.write_velocities(&mut world.physics.bodies, &world.balls, &kicked);
+        now.write_velocities(&mut world, &kicked);
         impact_loss += step_impact_loss;
         // What Rapier's step took beyond the impact law's losses (see
         // `SpatialReport::contact_loss`): the balls' and the frame's energy change, less

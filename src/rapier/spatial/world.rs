@@ -1,22 +1,56 @@
-//! The scene as a Rapier world: a kinematic body per damper carrying its container's six walls
-//! (and the dividers between chains), and a dynamic sphere per ball, free in 3D, under the
-//! scene's gravity and friction. Every contact Rapier solves is plastic: the stepper gives the
-//! bounces. Several dampers share the world's space; each collides only with itself.
+//! The scene as Rapier worlds, one per damper: a kinematic body carrying the container's six
+//! walls (and the dividers between chains), and a dynamic sphere per ball of that damper, free
+//! in 3D, under the scene's gravity and friction. Every contact Rapier solves is plastic: the
+//! stepper gives the bounces. Dampers never touch each other, so each is solved alone, and
+//! nothing one damper does (the order of its constraints) reaches another's solve.
 
 use bevy_rapier3d::rapier::prelude::*;
 
 use crate::scene::{Chamber, Scene, Wall};
 
-/// The Rapier world of a scene and the handles the stepper reads.
+/// The Rapier worlds of a scene and the handles the stepper reads.
 pub struct SpatialWorld {
+    /// Each damper's world, in the scene's order.
+    pub dampers: Vec<DamperWorld>,
+    /// Each ball's body and collider in its damper's world, in the scene's order.
+    pub balls: Vec<BallHandles>,
+}
+
+/// One damper's Rapier world.
+pub struct DamperWorld {
     /// Rapier's state.
     pub physics: PhysicsWorld,
-    /// Each damper's kinematic body (the frame's, or its floor's), in the scene's order.
-    pub frames: Vec<RigidBodyHandle>,
-    /// One dynamic body per ball, in the scene's order.
-    pub balls: Vec<RigidBodyHandle>,
-    /// Each ball's collider, in the same order.
-    pub colliders: Vec<ColliderHandle>,
+    /// The kinematic body that carries the container (the frame's, or its floor's).
+    pub frame: RigidBodyHandle,
+}
+
+/// Where a ball lives.
+#[derive(Debug, Clone, Copy)]
+pub struct BallHandles {
+    /// Its damper, the index of its world.
+    pub damper: usize,
+    /// Its dynamic body there.
+    pub body: RigidBodyHandle,
+    /// Its sphere there.
+    pub collider: ColliderHandle,
+}
+
+impl SpatialWorld {
+    /// The body of ball `i`.
+    pub fn ball(&self, i: usize) -> &RigidBody {
+        let h = self.balls[i];
+        &self.dampers[h.damper].physics.bodies[h.body]
+    }
+    /// The body of ball `i`, to change.
+    pub fn ball_mut(&mut self, i: usize) -> &mut RigidBody {
+        let h = self.balls[i];
+        &mut self.dampers[h.damper].physics.bodies[h.body]
+    }
+    /// The sphere of ball `i`, to change.
+    pub fn collider_mut(&mut self, i: usize) -> &mut Collider {
+        let h = self.balls[i];
+        &mut self.dampers[h.damper].physics.colliders[h.collider]
+    }
 }
 
 /// How stiff Rapier's contacts are and how it steps.
@@ -37,17 +71,12 @@ pub struct SolverSettings {
 /// The walls are this many largest radii thick: no ball crosses one in a step.
 const WALL_THICKNESS_RADII: f64 = 4.0;
 
-/// Most dampers one world holds: each has a collision group of its own.
-pub const MOST_DAMPERS: usize = 32;
-
-/// Builds the world of `scene` (validated for the spatial path by `super::refusal`), each
+/// Builds the worlds of `scene` (validated for the spatial path by `super::refusal`), each
 /// damper's container from `chambers`.
 pub fn build(scene: &Scene, chambers: &[Chamber], solver: SolverSettings) -> SpatialWorld {
-    let mut physics = PhysicsWorld::new();
     let [gx, gy, gz] = scene.space.gravity;
-    physics.gravity = Vector::new(gx as f32, gy as f32, gz as f32);
     let lu = solver.length_unit as f32;
-    physics.integration_parameters = IntegrationParameters {
+    let parameters = IntegrationParameters {
         dt: solver.dt as f32,
         length_unit: lu,
         num_solver_iterations: solver.solver_iterations,
@@ -70,34 +99,30 @@ pub fn build(scene: &Scene, chambers: &[Chamber], solver: SolverSettings) -> Spa
             .restitution(0.0)
             .restitution_combine_rule(CoefficientCombineRule::Min)
     };
-    // Several dampers each collide only within themselves; one keeps Rapier's default groups.
-    let dampers = scene.damper_list();
-    let own = |d: usize, b: ColliderBuilder| {
-        if dampers.len() < 2 {
-            return b;
-        }
-        let group = Group::from_bits_truncate(1 << (d % MOST_DAMPERS));
-        b.collision_groups(InteractionGroups::new(group, group, InteractionTestMode::And))
-    };
-    let mut frames = Vec::with_capacity(dampers.len());
-    for (d, (damper, geometry)) in dampers.iter().zip(chambers).enumerate() {
-        let start = scene.damper_start(damper);
-        let frame = physics
-            .insert_body(RigidBodyBuilder::kinematic_position_based().translation(Vector::new(start as f32, 0.0, 0.0)).can_sleep(false));
-        let thick = WALL_THICKNESS_RADII * geometry.largest_radius;
-        for wall in geometry.walls() {
-            let (centre, half) = wall_box(geometry, wall, thick);
-            let collider = plastic(ColliderBuilder::cuboid(half[0] as f32, half[1] as f32, half[2] as f32)).translation(Vector::new(
-                centre[0] as f32,
-                centre[1] as f32,
-                centre[2] as f32,
-            ));
-            physics.insert_collider(own(d, collider), Some(frame));
-        }
-        frames.push(frame);
-    }
+    let mut dampers: Vec<DamperWorld> =
+        scene
+            .damper_list()
+            .iter()
+            .zip(chambers)
+            .map(|(damper, geometry)| {
+                let mut physics = PhysicsWorld::new();
+                physics.gravity = Vector::new(gx as f32, gy as f32, gz as f32);
+                physics.integration_parameters = parameters;
+                let start = scene.damper_start(damper);
+                let frame = physics.insert_body(
+                    RigidBodyBuilder::kinematic_position_based().translation(Vector::new(start as f32, 0.0, 0.0)).can_sleep(false),
+                );
+                let thick = WALL_THICKNESS_RADII * geometry.largest_radius;
+                for wall in geometry.walls() {
+                    let (centre, half) = wall_box(geometry, wall, thick);
+                    let collider = plastic(ColliderBuilder::cuboid(half[0] as f32, half[1] as f32, half[2] as f32))
+                        .translation(Vector::new(centre[0] as f32, centre[1] as f32, centre[2] as f32));
+                    physics.insert_collider(collider, Some(frame));
+                }
+                DamperWorld { physics, frame }
+            })
+            .collect();
     let mut balls = Vec::with_capacity(scene.balls.len());
-    let mut colliders = Vec::with_capacity(scene.balls.len());
     for (i, ball) in scene.balls.iter().enumerate() {
         let [y, z] = scene.space.lateral_of(i);
         let [vy, vz] = scene.space.lateral_velocity_of(i);
@@ -105,12 +130,12 @@ pub fn build(scene: &Scene, chambers: &[Chamber], solver: SolverSettings) -> Spa
             .translation(Vector::new(scene.initial_positions[i] as f32, y as f32, z as f32))
             .linvel(Vector::new(scene.initial_velocities[i] as f32, vy as f32, vz as f32))
             .can_sleep(false);
-        let collider = own(scene.damper_of(i), plastic(ColliderBuilder::ball(ball.radius as f32)).mass(ball.mass as f32));
-        let (body, collider) = physics.insert(body, collider);
-        balls.push(body);
-        colliders.push(collider);
+        let collider = plastic(ColliderBuilder::ball(ball.radius as f32)).mass(ball.mass as f32);
+        let damper = scene.damper_of(i);
+        let (body, collider) = dampers[damper].physics.insert(body, collider);
+        balls.push(BallHandles { damper, body, collider });
     }
-    SpatialWorld { physics, frames, balls, colliders }
+    SpatialWorld { dampers, balls }
 }
 
 /// The box of a wall in the frame's coordinates (origin at the left wall's inner face on the
