@@ -40,6 +40,10 @@ pub const DEFAULT_SPATIAL_ITERATIONS: usize = 4;
 pub const CONTACT_FREQUENCY_PER_STEP_RATE: f64 = 0.25;
 /// Damping ratio of Rapier's contact springs (Rapier's default: overdamped, no rebound).
 pub const CONTACT_DAMPING_RATIO: f64 = 10.0;
+/// The least distance ahead at which Rapier predicts contacts, in its length unit (the largest
+/// diameter): a pair closer than that is in Rapier's solve even when nothing moves it, so that
+/// what the step's own solve sets moving (a ball squeezed out between two others) is caught.
+pub const LEAST_PREDICTION: f32 = 0.02;
 /// Pairs closer than this fraction of Rapier's length unit (the largest diameter) touch: the
 /// impacts of a step set touching pairs approaching, which then strike in turn.
 pub const TOUCHING_FRACTION: f64 = 2e-3;
@@ -282,7 +286,6 @@ pub fn simulate_spatial_with(scene: &Scene, solver: SolverSettings, options: &Ru
         let pressing = if piled { g_norm } else { contacts_dot(g, c.normal).abs() };
         2.0 * (pressing + c.normal[0].abs() * walls_a[body_of[c.ball]]) * solver.dt + speed_floor
     };
-    let prediction = world.dampers[0].physics.integration_parameters.normalized_prediction_distance;
     let lu = solver.length_unit as f32;
     // A ball sunk deeper into a wall stops the run rather than leave the container. (Balls
     // may sink deeper into each other: Rapier's solve holds a pile by the overlaps of its
@@ -296,6 +299,10 @@ pub fn simulate_spatial_with(scene: &Scene, solver: SolverSettings, options: &Ru
     let mut cascade = contacts::Cascade::default();
     let mut strikes = strikes::Strikes::default();
     let mut unsolved = vec![Vec::new(); dampers.len()];
+    let mut fastest = vec![0.0f64; dampers.len()];
+    // How far ahead each damper's broad-phase boxes reach, in Rapier's length unit: the first
+    // step makes them.
+    let mut boxed_for = vec![f32::INFINITY; dampers.len()];
     let height_at_start = scene.height_energy_at_start();
     let energy_of = |carrier: &Carrier, state: &BallState, t: f64, xs: &[f64], vs: &[f64]| -> f64 {
         let mut e = carrier.energy(t, xs[0], vs[0]) + height_at_start;
@@ -418,15 +425,32 @@ pub fn simulate_spatial_with(scene: &Scene, solver: SolverSettings, options: &Ru
         }
         // The walls' mean velocity over the step: Rapier moves them there in a straight line.
         let mean_vs: Vec<f64> = (0..bodies).map(|b| (x1[b] - xs[b]) / h).collect();
-        // Rapier stops a pair at contact only when it predicts it: as far ahead as the scene's
-        // speed carries a body in a step, and further when a ball moves faster than that
-        // relative to the walls (light balls struck by heavy ones), by what any pair can then
-        // close in the step (twice the fastest ball's speed, and gravity's pull).
-        let fastest =
-            now.v.iter().zip(&body_of).map(|(v, &b)| ((v[0] - mean_vs[b]).powi(2) + v[1] * v[1] + v[2] * v[2]).sqrt()).fold(0.0, f64::max);
-        let closing = (2.0 * fastest * h + g_norm * h * h) as f32 / lu;
-        for damper in &mut world.dampers {
-            damper.physics.integration_parameters.normalized_prediction_distance = prediction.max(closing);
+        // Rapier stops a pair at contact only when it predicts it: in each damper, as far ahead
+        // as any of its pairs can close in the step (twice its fastest ball's speed relative to
+        // its walls, and gravity's pull), and never nearer than [`LEAST_PREDICTION`]. A contact
+        // predicted further ahead than that cannot act in the step and only adds to Rapier's
+        // solve.
+        fastest.iter_mut().for_each(|f| *f = 0.0);
+        for (i, v) in now.v.iter().enumerate() {
+            let relative = ((v[0] - mean_vs[body_of[i]]).powi(2) + v[1] * v[1] + v[2] * v[2]).sqrt();
+            let d = damper_of[i] as usize;
+            fastest[d] = fastest[d].max(relative);
+        }
+        for ((damper, fastest), boxed) in world.dampers.iter_mut().zip(&fastest).zip(&mut boxed_for) {
+            let closing = (2.0 * fastest * h + g_norm * h * h) as f32 / lu;
+            let prediction = closing.max(LEAST_PREDICTION);
+            damper.physics.integration_parameters.normalized_prediction_distance = prediction;
+            // Rapier boxes its colliders for the broad phase at a step's end, as far ahead as
+            // that step predicted: boxes made for a slower step would hide pairs this one can
+            // close, so they are made anew when the prediction grows.
+            if prediction > *boxed {
+                let physics = &mut damper.physics;
+                for (handle, collider) in physics.colliders.iter() {
+                    let aabb = collider.compute_broad_phase_aabb(&physics.integration_parameters, &physics.bodies);
+                    physics.broad_phase.set_aabb(&physics.integration_parameters, handle, aabb);
+                }
+            }
+            *boxed = prediction;
         }
         // Strikes on touching groups are kept out of Rapier's solve of their pair (`strikes`).
         // The walls' mean acceleration over the step, as its closed form moves them.

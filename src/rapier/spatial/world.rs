@@ -2,7 +2,8 @@
 //! walls (and the dividers between chains), and a dynamic sphere per ball of that damper, free
 //! in 3D, under the scene's gravity and friction. Every contact Rapier solves is plastic: the
 //! stepper gives the bounces. Dampers never touch each other, so each is solved alone, and
-//! nothing one damper does (the order of its constraints) reaches another's solve.
+//! nothing one damper does (how far ahead its contacts are predicted, the order of its
+//! constraints) reaches another's solve.
 
 use bevy_rapier3d::rapier::prelude::*;
 
@@ -85,8 +86,9 @@ pub fn build(scene: &Scene, chambers: &[Chamber], solver: SolverSettings) -> Spa
         static_contact_softness: SpringCoefficients::new(solver.contact_frequency as f32, solver.contact_damping as f32),
         // The default clamps every body at 400 length units per second.
         normalized_max_linear_velocity: f32::MAX,
-        // Contacts are found as far ahead as the fastest expected pair closes in a step.
-        normalized_prediction_distance: ((super::super::resources::speed_scale(scene) * solver.dt) as f32 / lu).max(0.02),
+        // The stepper sets how far ahead contacts are found before each step, from how fast
+        // its balls move.
+        normalized_prediction_distance: super::LEAST_PREDICTION,
         // Coulomb's law at each contact point: a sphere touches at one point, so Rapier's
         // default (one friction constraint per manifold plus a "twist" constraint that stops
         // spin about the normal) would add a torque Coulomb friction has not.
