@@ -218,6 +218,27 @@ pub fn closing_speed(gap0: f64, w0: f64, g_n: f64, h: f64) -> f64 {
     -(w0 - g_n * tau)
 }
 
+/// The unit direction from one ball's centre to the other's at the instant free flight brings
+/// them to touch, from the offset `d` of their centres and their relative velocity `dv` now and
+/// the sum `reach` of their radii: `None` when they touch already, or free flight does not bring
+/// them to touch within `within` seconds.
+pub fn touching_normal(d: [f64; 3], dv: [f64; 3], reach: f64, within: f64) -> Option<[f64; 3]> {
+    // |d + dv t| = reach: a t^2 + 2 b t + c = 0.
+    let (a, b, c) = (dot(dv, dv), dot(d, dv), dot(d, d) - reach * reach);
+    let disc = b * b - a * c;
+    if c <= 0.0 || b >= 0.0 || disc < 0.0 {
+        return None;
+    }
+    // The smaller root, in the form that keeps its digits when `a c` is small.
+    let t = c / (-b + disc.sqrt());
+    if t > within {
+        return None;
+    }
+    let p: [f64; 3] = std::array::from_fn(|k| d[k] + dv[k] * t);
+    let length = dot(p, p).sqrt();
+    Some(p.map(|x| x / length))
+}
+
 /// A touching contact listed in the knock-on cascade's calendar: its relative normal velocity
 /// when listed (negative: approaching), its index among the step's contacts and its stamp then.
 #[derive(Debug, Clone, Copy)]

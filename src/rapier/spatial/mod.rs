@@ -295,6 +295,7 @@ pub fn simulate_spatial_with(scene: &Scene, solver: SolverSettings, options: &Ru
     // How fast pairs may close, m/s: twice the fastest expected speed.
     let reach = 2.0 * speed;
     let mut found: Vec<Contact> = Vec::new();
+    let (mut near, mut held) = (vec![0u32; n], vec![0u32; n]);
     let mut kicked = vec![false; n];
     let mut cascade = contacts::Cascade::default();
     let mut strikes = strikes::Strikes::default();
@@ -498,6 +499,18 @@ pub fn simulate_spatial_with(scene: &Scene, solver: SolverSettings, options: &Ru
             let b = body_of[c.ball];
             return Err(sunk_too_deep(scene, t1, (c.ball, -c.gap, wall), sink_limit, (v1[b] - vs[b]) / h));
         }
+        // How many of the step's contacts each ball is in (`near`), and how many of them touch
+        // (`held`).
+        near.iter_mut().chain(held.iter_mut()).for_each(|count| *count = 0);
+        for c in &found {
+            let touches = u32::from(c.gap <= touching);
+            near[c.ball] += 1;
+            held[c.ball] += touches;
+            if let Other::Ball(j) = c.other {
+                near[j] += 1;
+                held[j] += touches;
+            }
+        }
         for (k, c) in found.iter().enumerate() {
             report.deepest_overlap = report.deepest_overlap.max(-c.gap);
             if strikes.holds(c) {
@@ -505,21 +518,37 @@ pub fn simulate_spatial_with(scene: &Scene, solver: SolverSettings, options: &Ru
                 let balls = Balls { v: &mut now.v, mass: &mass };
                 let approach = -contacts::relative(c, &balls, &frame).0;
                 if c.gap <= touching && approach > 0.0 {
-                    new.push(Closing { approach, k, gap0: 0.0, w0: -approach, g_n: 0.0 });
+                    new.push(Closing { approach, k, gap0: 0.0, w0: -approach, g_n: 0.0, solved: None });
                 }
                 continue;
             }
-            let (gap0, w0, w_end, g_n) = match c.other {
+            let (gap0, w0, w_end, g_n, solved) = match c.other {
                 Other::Ball(j) => {
                     let d: [f64; 3] = std::array::from_fn(|a| before.x[j][a] - before.x[c.ball][a]);
                     let dv: [f64; 3] = std::array::from_fn(|a| before.v[j][a] - before.v[c.ball][a]);
                     let dv_end: [f64; 3] = std::array::from_fn(|a| now.v[j][a] - now.v[c.ball][a]);
-                    (
-                        contacts_dot(d, d).sqrt() - radius[c.ball] - radius[j],
-                        contacts_dot(dv, c.normal),
-                        contacts_dot(dv_end, c.normal),
-                        0.0,
-                    )
+                    let distance = contacts_dot(d, d).sqrt();
+                    // Two balls that meet in flight touch along the line of their centres at
+                    // that instant, and their impact acts along it; Rapier solved the pair
+                    // along a line of its own, near that of their centres at the step's start.
+                    // When nothing else is near either ball, all the step did to the pair is
+                    // that solve, undone whole; when they touch nothing else, it is undone
+                    // along the centres' line at the step's start. A ball that touches others
+                    // (a pile holding it up) keeps Rapier's solve.
+                    let sum = radius[c.ball] + radius[j];
+                    let (alone, free) = (near[c.ball] == 1 && near[j] == 1, held[c.ball] <= 1 && held[j] <= 1);
+                    let solved = contacts::touching_normal(d, dv, sum, 2.0 * h).filter(|_| free).map(|normal| {
+                        let change: [f64; 3] = std::array::from_fn(|a| dv_end[a] - dv[a]);
+                        let size = contacts_dot(change, change).sqrt();
+                        if alone && size > 0.0 {
+                            Solved { along: change.map(|x| x / size), change: size, normal }
+                        } else {
+                            let along = d.map(|c| c / distance);
+                            Solved { along, change: contacts_dot(dv_end, along) - contacts_dot(dv, along), normal }
+                        }
+                    });
+                    let normal = solved.map_or(c.normal, |s| s.normal);
+                    (distance - sum, contacts_dot(dv, normal), contacts_dot(dv_end, normal), 0.0, solved)
                 }
                 Other::Wall(wall) => {
                     let p = before.x[c.ball];
@@ -531,6 +560,7 @@ pub fn simulate_spatial_with(scene: &Scene, solver: SolverSettings, options: &Ru
                         wall_n - contacts_dot(before.v[c.ball], c.normal),
                         wall_n - contacts_dot(now.v[c.ball], c.normal),
                         contacts_dot(g, c.normal),
+                        None,
                     )
                 }
             };
@@ -540,7 +570,7 @@ pub fn simulate_spatial_with(scene: &Scene, solver: SolverSettings, options: &Ru
             let approach = closing_speed(gap0, w0, g_n, h);
             let stopped = w_end - (w0 - g_n * h) > resting;
             if approach > resting && stopped && c.gap <= touching + 2.0 * (-w0).max(0.0) * h {
-                new.push(Closing { approach, k, gap0, w0, g_n });
+                new.push(Closing { approach, k, gap0, w0, g_n, solved });
             }
         }
         new.sort_by(|a, b| b.approach.total_cmp(&a.approach));
@@ -554,7 +584,25 @@ pub fn simulate_spatial_with(scene: &Scene, solver: SolverSettings, options: &Ru
             for closing in &new {
                 let c = found[closing.k];
                 let (approach, lost) = match c.other {
-                    Other::Ball(_) => (closing.approach, contacts::strike(&c, closing.approach, e, &mut balls, &mut frame)),
+                    Other::Ball(_) => {
+                        let (mut c, mut approach) = (c, closing.approach);
+                        if let Some(solved) = closing.solved {
+                            // Rapier's plastic solve of the pair is undone, and the impact acts
+                            // along the line the balls touch along: mixing the two lines lost
+                            // energy at e = 1.
+                            let along = Contact { normal: solved.along, ..c };
+                            let (_, inv_a, inv_b) = contacts::relative(&along, &balls, &frame);
+                            contacts::push_apart(&along, -solved.change / (inv_a + inv_b), &mut balls, &mut frame);
+                            c.normal = solved.normal;
+                            // It strikes at the speed it approaches with now, after the
+                            // step's impacts before it.
+                            approach = -contacts::relative(&c, &balls, &frame).0;
+                            if approach <= 0.0 {
+                                continue;
+                            }
+                        }
+                        (approach, contacts::strike(&c, approach, e, &mut balls, &mut frame))
+                    }
                     Other::Wall(_) => {
                         let n = c.normal;
                         let b = body_of[c.ball];
@@ -685,6 +733,19 @@ struct Closing {
     w0: f64,
     /// Gravity along the normal (towards a wall), m/s^2.
     g_n: f64,
+    /// For two balls that met in flight, how Rapier solved them and where they touched.
+    solved: Option<Solved>,
+}
+
+/// How Rapier's plastic solve changed a pair of balls that met in flight in a step.
+#[derive(Clone, Copy)]
+struct Solved {
+    /// The line along which the step's change of the pair's relative velocity is undone.
+    along: [f64; 3],
+    /// That change along it, m/s.
+    change: f64,
+    /// The line of the centres where free flight brings them to touch: the impact's normal.
+    normal: [f64; 3],
 }
 
 fn contacts_dot(a: [f64; 3], b: [f64; 3]) -> f64 {

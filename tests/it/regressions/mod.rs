@@ -23,6 +23,7 @@ mod impacts_out_of_order;
 mod issue_14_touching_chain;
 mod json_prints_every_impact;
 mod loaded_contact_sinks;
+mod oblique_impact_in_flight;
 mod overdamped_bed_balance;
 mod pile_at_rest_struck;
 mod plugin_driven_by_app_update;
