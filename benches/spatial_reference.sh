@@ -14,28 +14,7 @@ counts=${*:-100 1000 10000}
 dir=$(mktemp -d)
 printf '| balls | horizon | impacts | events | computed in | impacts per second | events per second |\n|---|---|---|---|---|---|---|\n'
 for n in $counts; do
-  python3 - "$n" "$dir/box$n.toml" <<'PY'
-import random, sys
-n, path = int(sys.argv[1]), sys.argv[2]
-r, pitch = 0.005, 0.0125
-cells = 1
-while cells ** 3 < n:
-    cells += 1
-side = cells * pitch
-mass = 4.0 / 3.0 * 3.141592653589793 * r ** 3 * 7800.0
-rng = random.Random(1)
-lines = [f'name = "gas-box-{n}"', "[frame]", f"mass = {1.35 * n / 300:.6g}", f"stiffness = {865.0 * n / 300:.6g}",
-         "damping = 0.0", "initial_displacement = 0.0185", "[container]", f"length = {side:.6g}",
-         f"width = {side:.6g}", f"height = {side:.6g}", "[world]", "gravity = [0.0, 0.0, 0.0]", "friction = 0.0",
-         "restitution = 0.9", "[run]", "horizon = 0.1", "sample_dt = 0.001"]
-for i in range(n):
-    c = (i % cells, (i // cells) % cells, i // cells ** 2)
-    x, y, z = (c[0] + 0.5) * pitch, (c[1] + 0.5) * pitch - side / 2, (c[2] + 0.5) * pitch - side / 2
-    v = [rng.uniform(-0.5, 0.5) for _ in range(3)]
-    lines += ["[[ball]]", f"position = [{x:.6g}, {y:.6g}, {z:.6g}]", f"mass = {mass:.9g}", f"radius = {r}",
-              f"velocity = [{v[0]:.6g}, {v[1]:.6g}, {v[2]:.6g}]"]
-open(path, "w").write("\n".join(lines) + "\n")
-PY
+  python3 "$(dirname "$0")/gas_box.py" "$n" "$dir/box$n.toml" 1 0.9 0.1 ordered
   for k in $(seq "${REPEAT:-5}"); do
     "$lpc" run "$dir/box$n.toml" --format json > "$dir/out$n.$k.json"
   done
