@@ -1,10 +1,10 @@
 //! Two balls meeting in flight off their line of centres lost energy at e = 1 in the contact
 //! model (6 % of it at a 1 ms step, with the normal at 53 degrees to their paths), and a gas of
-//! such balls lost a third of its energy in 0.2 s. Rapier solved the pair along the line of
-//! their centres at the step's start, the impact law acted along the line at the step's end,
-//! and the part of Rapier's plastic solve off the second line stayed. The impact now acts along
-//! the line the balls touch along in free flight, after Rapier's solve of the pair is undone
-//! along the line it solved it along (docs/MODEL.md §9).
+//! such balls lost a third of its energy in 0.2 s. Rapier pushed the pair apart along a line of
+//! its own, near the line of their centres at the step's start, the impact law acted along the
+//! line at the step's end, and the part of Rapier's push off the second line stayed. The impact
+//! now acts along the line the balls touch along in free flight, after Rapier's push on the
+//! pair is undone (docs/MODEL.md §9, "Balls meeting in flight").
 
 use lpc_damper::model::RunOptions;
 use lpc_damper::rapier::spatial::simulate_spatial;
@@ -19,7 +19,7 @@ fn balls_meeting_in_flight_off_their_line_bounce_elastically() {
     // Equal balls, no gravity or friction, far from the walls: the second sits 8 mm off the
     // first's path, so they touch along n = (0.6, 0.8, 0) and exchange their normal velocities.
     let (v_a, v_b, mass) = (0.5f64, -0.3f64, 0.00408f64);
-    for dt in [1e-3, 5e-4] {
+    for dt in [1e-3, 5e-4, 1e-4] {
         let text = format!(
             "[frame]\nmass = 100.0\nstiffness = 1000.0\ndamping = 0.0\ninitial_displacement = 0.0\n\
              [container]\nlength = 0.1\nwidth = 0.1\nheight = 0.1\n\
