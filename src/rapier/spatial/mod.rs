@@ -410,7 +410,8 @@ pub fn simulate_spatial_with(scene: &Scene, solver: SolverSettings, options: &Ru
                     // (a pile holding it up) keeps Rapier's solve.
                     let sum = radius[c.ball] + radius[j];
                     let (alone, free) = (near[c.ball] == 1 && near[j] == 1, held[c.ball] <= 1 && held[j] <= 1);
-                    let solved = contacts::touching_normal(d, dv, sum, 2.0 * h).filter(|_| free).map(|normal| {
+                    let touched = if free { contacts::touching_normal(d, dv, sum, 2.0 * h) } else { None };
+                    let solved = touched.map(|normal| {
                         let change: [f64; 3] = std::array::from_fn(|a| dv_end[a] - dv[a]);
                         let size = contacts_dot(change, change).sqrt();
                         if alone && size > 0.0 {
