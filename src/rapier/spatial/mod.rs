@@ -12,6 +12,7 @@
 
 mod carrier;
 mod contacts;
+mod flights;
 mod records;
 mod settings;
 mod strikes;
@@ -82,6 +83,18 @@ impl BallState {
             self.x[k] = [p.x as f64, p.y as f64, p.z as f64];
             self.v[k] = [v.x as f64, v.y as f64, v.z as f64];
             self.w[k] = [w.x as f64, w.y as f64, w.z as f64];
+        }
+    }
+
+    /// Gives Rapier the angular velocities of the balls marked in `which`, keeping what it
+    /// will read back.
+    fn write_spins(&mut self, world: &mut SpatialWorld, which: &[bool]) {
+        for k in (0..world.balls.len()).filter(|&k| which[k]) {
+            let w = self.w[k];
+            let body = world.ball_mut(k);
+            body.set_angvel(Vector::new(w[0] as f32, w[1] as f32, w[2] as f32), true);
+            let r = body.angvel();
+            self.w[k] = [r.x as f64, r.y as f64, r.z as f64];
         }
     }
 
@@ -172,6 +185,9 @@ pub fn simulate_spatial_with(scene: &Scene, solver: SolverSettings, options: &Ru
     let mut kicked = vec![false; n];
     let mut cascade = contacts::Cascade::default();
     let mut strikes = strikes::Strikes::default();
+    let mut flights = flights::Flights::default();
+    let mut undone = vec![false; n];
+    let mut joined: Vec<bool> = Vec::new();
     let mut unsolved = vec![Vec::new(); dampers.len()];
     let mut fastest = vec![0.0f64; dampers.len()];
     // How far ahead each damper's broad-phase boxes reach, in Rapier's length unit: the first
@@ -384,6 +400,8 @@ pub fn simulate_spatial_with(scene: &Scene, solver: SolverSettings, options: &Ru
                 held[j] += touches;
             }
         }
+        joined.clear();
+        joined.resize(found.len(), false);
         for (k, c) in found.iter().enumerate() {
             report.deepest_overlap = report.deepest_overlap.max(-c.gap);
             if strikes.holds(c) {
@@ -443,11 +461,40 @@ pub fn simulate_spatial_with(scene: &Scene, solver: SolverSettings, options: &Ru
             let resting = resting_speed(c, &in_pile, &walls_a);
             let approach = closing_speed(gap0, w0, g_n, h);
             let stopped = w_end - (w0 - g_n * h) > resting;
+            // Rapier's solve joins the balls of a pair only where it acted on it: they touch,
+            // or their approach changed by more than a resting contact's.
+            joined[k] = c.gap <= touching || (w_end - (w0 - g_n * h)).abs() > resting;
             if approach > resting && stopped && c.gap <= touching + 2.0 * (-w0).max(0.0) * h {
                 new.push(Closing { approach, k, gap0, w0, g_n, solved });
             }
         }
         new.sort_by(|a, b| b.approach.total_cmp(&a.approach));
+        // Groups of balls in flight that strike each other: Rapier's whole step of them is
+        // undone (`flights`), and each of their impacts acts along the line its balls touch
+        // along in free flight, at the speed they approach with when its turn comes.
+        // (A strike on a touching group has its own rule, and its target was pressed.)
+        let struck_pairs = new.iter().map(|closing| &found[closing.k]).filter(|c| !strikes.holds(c)).filter_map(|c| match c.other {
+            Other::Ball(j) => Some((c.ball, j)),
+            Other::Wall(_) => None,
+        });
+        flights.mark(&found, &joined, |i| !strikes.pressed(i), struck_pairs, &mut undone);
+        for i in (0..n).filter(|&i| undone[i]) {
+            let free: [f64; 3] = std::array::from_fn(|a| before.v[i][a] + g[a] * h);
+            let b = body_of[i];
+            frame.vs[b] += mass[i] * (now.v[i][0] - free[0]) / body_mass[b];
+            now.v[i] = free;
+            now.w[i] = before.w[i];
+        }
+        for closing in new.iter_mut() {
+            let c = found[closing.k];
+            let Other::Ball(j) = c.other else { continue };
+            if undone[c.ball] && undone[j] && !strikes.holds(&c) {
+                let d: [f64; 3] = std::array::from_fn(|a| before.x[j][a] - before.x[c.ball][a]);
+                let dv: [f64; 3] = std::array::from_fn(|a| before.v[j][a] - before.v[c.ball][a]);
+                let normal = contacts::touching_normal(d, dv, radius[c.ball] + radius[j], 2.0 * h).unwrap_or(c.normal);
+                closing.solved = Some(Solved { along: normal, change: 0.0, normal });
+            }
+        }
         kicked.iter_mut().for_each(|k| *k = false);
         let mut step_impact_loss = 0.0;
         {
@@ -464,9 +511,11 @@ pub fn simulate_spatial_with(scene: &Scene, solver: SolverSettings, options: &Ru
                             // Rapier's plastic solve of the pair is undone, and the impact acts
                             // along the line the balls touch along: mixing the two lines lost
                             // energy at e = 1.
-                            let along = Contact { normal: solved.along, ..c };
-                            let (_, inv_a, inv_b) = contacts::relative(&along, &balls, &frame);
-                            contacts::push_apart(&along, -solved.change / (inv_a + inv_b), &mut balls, &mut frame);
+                            if solved.change != 0.0 {
+                                let along = Contact { normal: solved.along, ..c };
+                                let (_, inv_a, inv_b) = contacts::relative(&along, &balls, &frame);
+                                contacts::push_apart(&along, -solved.change / (inv_a + inv_b), &mut balls, &mut frame);
+                            }
                             c.normal = solved.normal;
                             // It strikes at the speed it approaches with now, after the
                             // step's impacts before it.
@@ -474,6 +523,15 @@ pub fn simulate_spatial_with(scene: &Scene, solver: SolverSettings, options: &Ru
                             if approach <= 0.0 {
                                 continue;
                             }
+                        }
+                        (approach, contacts::strike(&c, approach, e, &mut balls, &mut frame))
+                    }
+                    Other::Wall(_) if undone[c.ball] => {
+                        // A ball of a group in flight strikes the wall at the speed it
+                        // approaches with when its turn comes.
+                        let approach = -contacts::relative(&c, &balls, &frame).0;
+                        if approach <= 0.0 {
+                            continue;
                         }
                         (approach, contacts::strike(&c, approach, e, &mut balls, &mut frame))
                     }
@@ -516,7 +574,11 @@ pub fn simulate_spatial_with(scene: &Scene, solver: SolverSettings, options: &Ru
                 });
             }
         }
+        for i in 0..n {
+            kicked[i] |= undone[i];
+        }
         now.write_velocities(&mut world, &kicked);
+        now.write_spins(&mut world, &undone);
         impact_loss += step_impact_loss;
         // What Rapier's step took beyond the impact law's losses (see
         // `SpatialReport::contact_loss`): the balls' and the frame's energy change, less

@@ -27,6 +27,7 @@ pub struct Strikes {
     touches_ball: Vec<bool>,
     touches_any: Vec<bool>,
     touches_end_wall: Vec<bool>,
+    pressed: Vec<bool>,
     closings: Vec<u32>,
     /// Each ball's partner in a strike of the step, if it is in one.
     partner: Vec<Option<usize>>,
@@ -57,7 +58,7 @@ impl Strikes {
     ) {
         let n = v.len();
         self.list.clear();
-        for flags in [&mut self.touches_ball, &mut self.touches_any, &mut self.touches_end_wall] {
+        for flags in [&mut self.touches_ball, &mut self.touches_any, &mut self.touches_end_wall, &mut self.pressed] {
             flags.clear();
             flags.resize(n, false);
         }
@@ -74,9 +75,11 @@ impl Strikes {
         for c in found {
             match c.other {
                 Other::Ball(j) if c.gap <= touching => {
+                    let parting = dot(v[j], c.normal) - dot(v[c.ball], c.normal) > resting(c);
                     for k in [c.ball, j] {
                         self.touches_ball[k] = true;
                         self.touches_any[k] = true;
+                        self.pressed[k] |= !parting;
                     }
                 }
                 Other::Ball(j) if closes(c, j) => {
@@ -84,6 +87,8 @@ impl Strikes {
                     self.closings[j] += 1;
                 }
                 Other::Wall(_) if c.gap <= touching => {
+                    let parting = walls_v(c.ball) * c.normal[0] - dot(v[c.ball], c.normal) > resting(c);
+                    self.pressed[c.ball] |= !parting;
                     self.touches_any[c.ball] = true;
                     self.touches_end_wall[c.ball] |= c.normal[0] != 0.0;
                 }
@@ -119,6 +124,12 @@ impl Strikes {
             self.partner[target] = Some(striker);
             self.list.push(Strike { striker, target });
         }
+    }
+
+    /// Whether ball `i` was pressed at the step's start: it touched a ball or a wall and did
+    /// not part from it faster than a resting contact.
+    pub fn pressed(&self, i: usize) -> bool {
+        self.pressed[i]
     }
 
     /// Whether contact `c` is between the balls of one of the step's strikes.

@@ -2,6 +2,7 @@
 //! went wrong; its module doc names the issue, the cause and the fix.
 
 mod at2_without_npts;
+mod ball_meets_two_in_one_step;
 mod ball_struck_on_the_floor;
 mod balls_sliding_together;
 mod bed_energy_below_zero;

@@ -1,0 +1,96 @@
+//! Groups of balls in flight (docs/MODEL.md §9, "Groups in flight"). Rapier solves all the
+//! contacts of a step at once: a ball that meets two others in one step is stopped short of
+//! both by one plastic solve, which passes momentum between pairs that never touch. The impact
+//! law applied afterwards to each pair then starts from velocities the other pairs' contacts
+//! have changed, and a gas loses or gains energy at `e = 1`. A group of balls that touched
+//! nothing at the step's start, and that only each other's contacts join, felt nothing in the
+//! step but Rapier's solve of those contacts and gravity: its whole step is undone, and its
+//! impacts act one after the other on the velocities free flight gives.
+
+use super::contacts::{Contact, Other};
+
+/// The step's groups of balls joined by contacts, kept between steps.
+#[derive(Default)]
+pub struct Flights {
+    root: Vec<u32>,
+    in_flight: Vec<bool>,
+    struck: Vec<bool>,
+}
+
+impl Flights {
+    fn find(&mut self, mut i: usize) -> usize {
+        while self.root[i] as usize != i {
+            let up = self.root[self.root[i] as usize];
+            self.root[i] = up;
+            i = up as usize;
+        }
+        i
+    }
+
+    /// Marks in `undone` the balls of every group, joined by the ball pairs of `found` (every
+    /// pair a step may have closed, at its end) marked in `joined` (those Rapier's solve acted
+    /// on), whose balls all touched nothing at the step's start (`free`) and of which two
+    /// strike each other (a pair of `struck`).
+    pub fn mark(
+        &mut self,
+        found: &[Contact],
+        joined: &[bool],
+        free: impl Fn(usize) -> bool,
+        struck: impl Iterator<Item = (usize, usize)>,
+        undone: &mut [bool],
+    ) {
+        let n = undone.len();
+        self.root.clear();
+        self.root.extend(0..n as u32);
+        for (c, _) in found.iter().zip(joined).filter(|(_, &joins)| joins) {
+            if let Other::Ball(j) = c.other {
+                let (a, b) = (self.find(c.ball), self.find(j));
+                if a != b {
+                    self.root[a.max(b)] = a.min(b) as u32;
+                }
+            }
+        }
+        self.in_flight.clear();
+        self.in_flight.resize(n, true);
+        self.struck.clear();
+        self.struck.resize(n, false);
+        for i in 0..n {
+            let r = self.find(i);
+            self.in_flight[r] &= free(i);
+        }
+        for (a, _) in struck {
+            let r = self.find(a);
+            self.struck[r] = true;
+        }
+        for (i, flag) in undone.iter_mut().enumerate() {
+            let r = self.find(i);
+            *flag = self.in_flight[r] && self.struck[r];
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn pair(a: usize, b: usize) -> Contact {
+        Contact { ball: a, other: Other::Ball(b), gap: 0.0, normal: [1.0, 0.0, 0.0] }
+    }
+
+    /// A group is undone only when every ball in it was free and two of them strike; a wall
+    /// contact joins nothing.
+    #[test]
+    fn undoes_only_free_groups_that_strike() {
+        let found = [
+            pair(0, 1),
+            pair(1, 2),
+            pair(3, 4),
+            pair(5, 6),
+            Contact { ball: 7, other: Other::Wall(crate::scene::Wall::Left), gap: 0.0, normal: [-1.0, 0.0, 0.0] },
+        ];
+        let mut undone = vec![false; 8];
+        // Ball 4 touched something at the step's start; 5 and 6 do not strike.
+        Flights::default().mark(&found, &[true; 5], |i| i != 4, [(1, 2), (3, 4)].into_iter(), &mut undone);
+        assert_eq!(undone, [true, true, true, false, false, false, false, false]);
+    }
+}
