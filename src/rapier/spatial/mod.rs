@@ -33,7 +33,7 @@ use crate::run::{EnergyAccount, Impacts, Recorder, Run, MAX_KEPT_IMPACTS};
 use crate::scene::Scene;
 use carrier::Carrier;
 use contacts::{Balls, Contact, Containers, FrameBody, Other};
-use records::{impact_record, sunk_too_deep};
+use records::{impact_record, sample, sunk_too_deep};
 use settings::chambers;
 
 /// Steps between two looks at the budgets and the progress: every step, since a step of a deep
@@ -639,22 +639,6 @@ pub fn simulate_spatial_with(scene: &Scene, solver: SolverSettings, options: &Ru
     run.horizon = scene.horizon;
     run.wall_time_s = meter.elapsed();
     Ok((run, report))
-}
-
-/// Takes the sample at `ts`: the frame at `frame` (displacement and velocity), or a
-/// structure's floors from `carrier`, and each ball's centre and velocity from `ball(i)`.
-fn sample(
-    recorder: &mut Recorder,
-    scene: &Scene,
-    carrier: &Carrier,
-    ts: f64,
-    frame: (f64, f64),
-    ball: impl Fn(usize) -> ([f64; 3], [f64; 3]),
-) {
-    match carrier.floors(ts) {
-        None => recorder.sample_in_space(scene, ts, frame.0, frame.1, ball),
-        Some((z, ground)) => recorder.sample_floors_in_space(scene, ts, z.split_at(z.len() / 2), ground, ball),
-    }
 }
 
 /// A contact Rapier stopped in the step: its closing speed and what it was computed from.

@@ -1,10 +1,11 @@
-//! What the spatial path writes down beyond its samples: each impact's record, and the stop of
-//! a run whose ball Rapier's solve left sunk into a wall.
+//! What the spatial path writes down: its samples, each impact's record, and the stop of a run
+//! whose ball Rapier's solve left sunk into a wall.
 
+use super::carrier::Carrier;
 use super::contacts::{Contact, Other};
 use super::{contacts_dot, RESTING_SINK_FRACTION};
 use crate::model::{Model, ModelError};
-use crate::run::Impact;
+use crate::run::{Impact, Recorder};
 use crate::scene::{Body, Scene, Wall};
 
 /// The stop of a run in which Rapier's solve left a ball sunk into a wall (`sunk`: the ball,
@@ -46,4 +47,20 @@ pub(super) fn impact_record(t: f64, c: &Contact, approach: f64, lost: f64) -> Im
         Other::Wall(wall) => (Body::Ball(c.ball), wall.body()),
     };
     Impact { t, a, b, approach_speed: approach, energy_lost: lost, impulses: 1, peak_force: None, contact_duration: None }
+}
+
+/// Takes the sample at `ts`: the frame at `frame` (displacement and velocity), or a
+/// structure's floors from `carrier`, and each ball's centre and velocity from `ball(i)`.
+pub(super) fn sample(
+    recorder: &mut Recorder,
+    scene: &Scene,
+    carrier: &Carrier,
+    ts: f64,
+    frame: (f64, f64),
+    ball: impl Fn(usize) -> ([f64; 3], [f64; 3]),
+) {
+    match carrier.floors(ts) {
+        None => recorder.sample_in_space(scene, ts, frame.0, frame.1, ball),
+        Some((z, ground)) => recorder.sample_floors_in_space(scene, ts, z.split_at(z.len() / 2), ground, ball),
+    }
 }
