@@ -2,10 +2,10 @@
 //! contacts of a step at once: a ball that meets two others in one step is stopped short of
 //! both by one plastic solve, which passes momentum between pairs that never touch. The impact
 //! law applied afterwards to each pair then starts from velocities the other pairs' contacts
-//! have changed, and a gas loses or gains energy at `e = 1`. A group of balls that touched
-//! nothing at the step's start, and that only each other's contacts join, felt nothing in the
-//! step but Rapier's solve of those contacts and gravity: its whole step is undone, and its
-//! impacts act one after the other on the velocities free flight gives.
+//! have changed, and a gas loses or gains energy at `e = 1`. A group of balls joined only by
+//! each other's contacts, none of which was pressed against anything at the step's start, felt
+//! nothing in the step but Rapier's solve of those contacts and gravity: its whole step is
+//! undone, and its impacts act one after the other on the velocities free flight gives.
 
 use super::contacts::{Contact, Other};
 
@@ -29,8 +29,8 @@ impl Flights {
 
     /// Marks in `undone` the balls of every group, joined by the ball pairs of `found` (every
     /// pair a step may have closed, at its end) marked in `joined` (those Rapier's solve acted
-    /// on), whose balls all touched nothing at the step's start (`free`) and of which two
-    /// strike each other (a pair of `struck`).
+    /// on), whose balls were all free at the step's start (`free`: not pressed against a ball
+    /// or a wall) and of which two strike each other (a pair of `struck`).
     pub fn mark(
         &mut self,
         found: &[Contact],
