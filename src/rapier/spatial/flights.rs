@@ -30,7 +30,8 @@ impl Flights {
     /// Marks in `undone` the balls of every group, joined by the ball pairs of `found` (every
     /// pair a step may have closed, at its end) marked in `joined` (those Rapier's solve acted
     /// on), whose balls were all free at the step's start (`free`: not pressed against a ball
-    /// or a wall) and of which two strike each other (a pair of `struck`).
+    /// or a wall) and of which two strike each other (a pair of `struck`). Returns whether it
+    /// marked any; a step without strikes between balls costs nothing more.
     pub fn mark(
         &mut self,
         found: &[Contact],
@@ -38,7 +39,12 @@ impl Flights {
         free: impl Fn(usize) -> bool,
         struck: impl Iterator<Item = (usize, usize)>,
         undone: &mut [bool],
-    ) {
+    ) -> bool {
+        let mut struck = struck.peekable();
+        if struck.peek().is_none() {
+            undone.iter_mut().for_each(|flag| *flag = false);
+            return false;
+        }
         let n = undone.len();
         self.root.clear();
         self.root.extend(0..n as u32);
@@ -62,10 +68,13 @@ impl Flights {
             let r = self.find(a);
             self.struck[r] = true;
         }
+        let mut any = false;
         for (i, flag) in undone.iter_mut().enumerate() {
             let r = self.find(i);
             *flag = self.in_flight[r] && self.struck[r];
+            any |= *flag;
         }
+        any
     }
 }
 
@@ -90,7 +99,8 @@ mod tests {
         ];
         let mut undone = vec![false; 8];
         // Ball 4 touched something at the step's start; 5 and 6 do not strike.
-        Flights::default().mark(&found, &[true; 5], |i| i != 4, [(1, 2), (3, 4)].into_iter(), &mut undone);
+        let any = Flights::default().mark(&found, &[true; 5], |i| i != 4, [(1, 2), (3, 4)].into_iter(), &mut undone);
         assert_eq!(undone, [true, true, true, false, false, false, false, false]);
+        assert!(any);
     }
 }

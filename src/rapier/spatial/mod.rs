@@ -477,22 +477,24 @@ pub fn simulate_spatial_with(scene: &Scene, solver: SolverSettings, options: &Ru
             Other::Ball(j) => Some((c.ball, j)),
             Other::Wall(_) => None,
         });
-        flights.mark(&found, &joined, |i| !strikes.pressed(i), struck_pairs, &mut undone);
-        for i in (0..n).filter(|&i| undone[i]) {
-            let free: [f64; 3] = std::array::from_fn(|a| before.v[i][a] + g[a] * h);
-            let b = body_of[i];
-            frame.vs[b] += mass[i] * (now.v[i][0] - free[0]) / body_mass[b];
-            now.v[i] = free;
-            now.w[i] = before.w[i];
-        }
-        for closing in new.iter_mut() {
-            let c = found[closing.k];
-            let Other::Ball(j) = c.other else { continue };
-            if undone[c.ball] && undone[j] && !strikes.holds(&c) {
-                let d: [f64; 3] = std::array::from_fn(|a| before.x[j][a] - before.x[c.ball][a]);
-                let dv: [f64; 3] = std::array::from_fn(|a| before.v[j][a] - before.v[c.ball][a]);
-                let normal = contacts::touching_normal(d, dv, radius[c.ball] + radius[j], 2.0 * h).unwrap_or(c.normal);
-                closing.solved = Some(Solved { along: normal, change: 0.0, normal });
+        let any_undone = flights.mark(&found, &joined, |i| !strikes.pressed(i), struck_pairs, &mut undone);
+        if any_undone {
+            for i in (0..n).filter(|&i| undone[i]) {
+                let free: [f64; 3] = std::array::from_fn(|a| before.v[i][a] + g[a] * h);
+                let b = body_of[i];
+                frame.vs[b] += mass[i] * (now.v[i][0] - free[0]) / body_mass[b];
+                now.v[i] = free;
+                now.w[i] = before.w[i];
+            }
+            for closing in new.iter_mut() {
+                let c = found[closing.k];
+                let Other::Ball(j) = c.other else { continue };
+                if undone[c.ball] && undone[j] && !strikes.holds(&c) {
+                    let d: [f64; 3] = std::array::from_fn(|a| before.x[j][a] - before.x[c.ball][a]);
+                    let dv: [f64; 3] = std::array::from_fn(|a| before.v[j][a] - before.v[c.ball][a]);
+                    let normal = contacts::touching_normal(d, dv, radius[c.ball] + radius[j], 2.0 * h).unwrap_or(c.normal);
+                    closing.solved = Some(Solved { along: normal, change: 0.0, normal });
+                }
             }
         }
         kicked.iter_mut().for_each(|k| *k = false);
@@ -574,11 +576,11 @@ pub fn simulate_spatial_with(scene: &Scene, solver: SolverSettings, options: &Ru
                 });
             }
         }
-        for i in 0..n {
-            kicked[i] |= undone[i];
+        if any_undone {
+            kicked.iter_mut().zip(&undone).for_each(|(k, u)| *k |= u);
+            now.write_spins(&mut world, &undone);
         }
         now.write_velocities(&mut world, &kicked);
-        now.write_spins(&mut world, &undone);
         impact_loss += step_impact_loss;
         // What Rapier's step took beyond the impact law's losses (see
         // `SpatialReport::contact_loss`): the balls' and the frame's energy change, less
