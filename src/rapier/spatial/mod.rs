@@ -432,12 +432,13 @@ pub fn simulate_spatial_with(scene: &Scene, solver: SolverSettings, options: &Ru
                     let solved = touched.map(|normal| {
                         let change: [f64; 3] = std::array::from_fn(|a| dv_end[a] - dv[a]);
                         let size = contacts_dot(change, change).sqrt();
-                        if alone && size > 0.0 {
-                            Solved { along: change.map(|x| x / size), change: size, normal }
+                        let undo = if alone && size > 0.0 {
+                            (change.map(|x| x / size), size)
                         } else {
                             let along = d.map(|c| c / distance);
-                            Solved { along, change: contacts_dot(dv_end, along) - contacts_dot(dv, along), normal }
-                        }
+                            (along, contacts_dot(dv_end, along) - contacts_dot(dv, along))
+                        };
+                        Solved { undo: Some(undo), normal }
                     });
                     let normal = solved.map_or(c.normal, |s| s.normal);
                     (distance - sum, contacts_dot(dv, normal), contacts_dot(dv_end, normal), 0.0, solved)
@@ -493,7 +494,8 @@ pub fn simulate_spatial_with(scene: &Scene, solver: SolverSettings, options: &Ru
                     let d: [f64; 3] = std::array::from_fn(|a| before.x[j][a] - before.x[c.ball][a]);
                     let dv: [f64; 3] = std::array::from_fn(|a| before.v[j][a] - before.v[c.ball][a]);
                     let normal = contacts::touching_normal(d, dv, radius[c.ball] + radius[j], 2.0 * h).unwrap_or(c.normal);
-                    closing.solved = Some(Solved { along: normal, change: 0.0, normal });
+                    // The group's whole step is undone already.
+                    closing.solved = Some(Solved { undo: None, normal });
                 }
             }
         }
@@ -513,10 +515,10 @@ pub fn simulate_spatial_with(scene: &Scene, solver: SolverSettings, options: &Ru
                             // Rapier's plastic solve of the pair is undone, and the impact acts
                             // along the line the balls touch along: mixing the two lines lost
                             // energy at e = 1.
-                            if solved.change != 0.0 {
-                                let along = Contact { normal: solved.along, ..c };
+                            if let Some((along, change)) = solved.undo {
+                                let along = Contact { normal: along, ..c };
                                 let (_, inv_a, inv_b) = contacts::relative(&along, &balls, &frame);
-                                contacts::push_apart(&along, -solved.change / (inv_a + inv_b), &mut balls, &mut frame);
+                                contacts::push_apart(&along, -change / (inv_a + inv_b), &mut balls, &mut frame);
                             }
                             c.normal = solved.normal;
                             // It strikes at the speed it approaches with now, after the
@@ -662,10 +664,9 @@ struct Closing {
 /// How Rapier's plastic solve changed a pair of balls that met in flight in a step.
 #[derive(Clone, Copy)]
 struct Solved {
-    /// The line along which the step's change of the pair's relative velocity is undone.
-    along: [f64; 3],
-    /// That change along it, m/s.
-    change: f64,
+    /// The line along which the step's change of the pair's relative velocity is undone, and
+    /// that change along it, m/s (none when the pair's group had its whole step undone).
+    undo: Option<([f64; 3], f64)>,
     /// The line of the centres where free flight brings them to touch: the impact's normal.
     normal: [f64; 3],
 }
