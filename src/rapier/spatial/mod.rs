@@ -415,9 +415,7 @@ pub fn simulate_spatial_with(scene: &Scene, solver: SolverSettings, options: &Ru
             }
             let (gap0, w0, w_end, g_n, solved) = match c.other {
                 Other::Ball(j) => {
-                    let d: [f64; 3] = std::array::from_fn(|a| before.x[j][a] - before.x[c.ball][a]);
-                    let dv: [f64; 3] = std::array::from_fn(|a| before.v[j][a] - before.v[c.ball][a]);
-                    let dv_end: [f64; 3] = std::array::from_fn(|a| now.v[j][a] - now.v[c.ball][a]);
+                    let (d, dv, dv_end) = (between(&before.x, c.ball, j), between(&before.v, c.ball, j), between(&now.v, c.ball, j));
                     let distance = contacts_dot(d, d).sqrt();
                     // Two balls that meet in flight touch along the line of their centres at
                     // that instant, and their impact acts along it; Rapier solved the pair
@@ -491,8 +489,7 @@ pub fn simulate_spatial_with(scene: &Scene, solver: SolverSettings, options: &Ru
                 let c = found[closing.k];
                 let Other::Ball(j) = c.other else { continue };
                 if undone[c.ball] && undone[j] && !strikes.holds(&c) {
-                    let d: [f64; 3] = std::array::from_fn(|a| before.x[j][a] - before.x[c.ball][a]);
-                    let dv: [f64; 3] = std::array::from_fn(|a| before.v[j][a] - before.v[c.ball][a]);
+                    let (d, dv) = (between(&before.x, c.ball, j), between(&before.v, c.ball, j));
                     let normal = contacts::touching_normal(d, dv, radius[c.ball] + radius[j], 2.0 * h).unwrap_or(c.normal);
                     // The group's whole step is undone already.
                     closing.solved = Some(Solved { undo: None, normal });
@@ -669,6 +666,11 @@ struct Solved {
     undo: Option<([f64; 3], f64)>,
     /// The line of the centres where free flight brings them to touch: the impact's normal.
     normal: [f64; 3],
+}
+
+/// Ball `b`'s vector less ball `a`'s, of `v` (positions or velocities).
+fn between(v: &[[f64; 3]], a: usize, b: usize) -> [f64; 3] {
+    std::array::from_fn(|k| v[b][k] - v[a][k])
 }
 
 fn contacts_dot(a: [f64; 3], b: [f64; 3]) -> f64 {
