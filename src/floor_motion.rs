@@ -94,9 +94,10 @@ pub(crate) struct Sine {
 pub struct FloorMotion {
     pub(crate) structure: Arc<Structure>,
     pub(crate) modes: Arc<Modes>,
-    /// Modes already decomposed, by the mass the carrying floor holds, with the sine's
-    /// steady response for them.
-    cache: Vec<(f64, Arc<Modes>, Option<Sine>)>,
+    /// Modes already decomposed, by the mass each floor holds, with the sine's steady response
+    /// for them: the bare floors' first, then at most [`MODES_KEPT`] others, the oldest dropped
+    /// first.
+    cache: Vec<(Vec<f64>, Arc<Modes>, Option<Sine>)>,
     pub(crate) t0: f64,
     pub(crate) z0: Vec<f64>,
     pub(crate) pieces: RefCell<Vec<Piece>>,
@@ -108,7 +109,13 @@ pub struct FloorMotion {
     pub(crate) stiffness: DMatrix<f64>,
     /// The floors whose terms each piece carries, the carrying floor first.
     watched: Vec<usize>,
+    /// The mass of balls each floor holds in this segment, kg.
+    held: Vec<f64>,
 }
+
+/// How many decompositions of the floors' modes with balls held a motion keeps besides the bare
+/// floors': a box of balls the floors carry in part holds many masses in turn.
+pub const MODES_KEPT: usize = 128;
 
 impl FloorMotion {
     /// The floors of `structure` from their initial state at `t = 0`, under the scene's sine
@@ -129,9 +136,11 @@ impl FloorMotion {
             forcing,
             stiffness: structure_stiffness,
             watched,
+            held: Vec::new(),
         };
+        m.held = vec![0.0; m.n()];
         m.sine = m.steady_response()?;
-        m.cache.push((0.0, modes, m.sine.clone()));
+        m.cache.push((m.held.clone(), modes, m.sine.clone()));
         m.reset();
         Ok(m)
     }
@@ -333,32 +342,59 @@ impl FloorMotion {
     /// `held` kg of balls. When the floors cannot be decomposed with that mass, the segment
     /// still starts (with the modes it had) and the reason is returned.
     pub fn restart(&mut self, t: f64, v: f64, held: f64) -> Result<(), String> {
-        let (mut z, (_, vg)) = self.floors(t);
         let d = self.structure.floor;
-        z[self.n() + d] = v - vg;
+        let mut each = vec![0.0; self.n()];
+        each[d] = held;
+        self.restart_holding(t, &[(d, v)], &each)
+    }
+
+    /// Starts a new segment at `t`, each floor `j` of `velocities` moving at its `v` (absolute),
+    /// each floor `j` holding `held[j]` kg of balls. When the floors cannot be decomposed with
+    /// those masses, the segment still starts (with the modes it had) and the reason is
+    /// returned.
+    pub fn restart_holding(&mut self, t: f64, velocities: &[(usize, f64)], held: &[f64]) -> Result<(), String> {
+        let (mut z, (_, vg)) = self.floors(t);
+        let n = self.n();
+        for &(j, v) in velocities {
+            z[n + j] = v - vg;
+        }
         let mut failure = Ok(());
-        if let Some((_, m, sine)) = self.cache.iter().find(|(mass, ..)| *mass == held) {
+        if let Some((_, m, sine)) = self.cache.iter().find(|(masses, ..)| masses.as_slice() == held) {
             self.modes = m.clone();
             self.sine = sine.clone();
         } else {
-            match self.structure.building.modes(d, held, self.structure.load()) {
+            let on = || {
+                let floors: Vec<String> =
+                    (0..n).filter(|&j| held[j] != 0.0).map(|j| format!("{} kg of balls held on floor {}", held[j], j + 1)).collect();
+                floors.join(" and ")
+            };
+            match self.structure.building.modes_holding(held, self.structure.load()) {
                 Ok(m) => {
                     self.modes = Arc::new(m);
                     match self.steady_response() {
                         Ok(sine) => {
                             self.sine = sine;
-                            self.cache.push((held, self.modes.clone(), self.sine.clone()));
+                            if self.cache.len() > MODES_KEPT {
+                                self.cache.remove(1);
+                            }
+                            self.cache.push((held.to_vec(), self.modes.clone(), self.sine.clone()));
                         }
-                        Err(why) => failure = Err(format!("with {held} kg of balls held on floor {}, {why}", d + 1)),
+                        Err(why) => failure = Err(format!("with {}, {why}", on())),
                     }
                 }
-                Err(why) => failure = Err(format!("with {held} kg of balls held on floor {}, {why}", d + 1)),
+                Err(why) => failure = Err(format!("with {}, {why}", on())),
             }
         }
         self.t0 = t;
         self.z0 = z;
+        self.held = held.to_vec();
         self.reset();
         failure
+    }
+
+    /// The mass of balls each floor holds in this segment, kg.
+    pub fn held(&self) -> &[f64] {
+        &self.held
     }
 
     /// Starts a new segment at `t`, each floor `j` of `velocities` moving at its `v` (absolute),
@@ -375,6 +411,7 @@ impl FloorMotion {
         self.sine = sine.clone();
         self.t0 = t;
         self.z0 = z;
+        self.held = vec![0.0; n];
         self.reset();
     }
 

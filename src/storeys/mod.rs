@@ -160,7 +160,14 @@ impl Building {
     /// The state matrix's modes with `added` kg on floor `floor` (balls the floor carries), and
     /// the static responses to `load`.
     pub fn modes(&self, floor: usize, added: f64, load: Load) -> Result<Modes, String> {
-        Modes::new(self, floor, added, load)
+        let mut each = vec![0.0; self.floors()];
+        each[floor] = added;
+        Modes::new(self, &each, load)
+    }
+
+    /// [`Building::modes`] with `added[j]` kg on each floor `j`.
+    pub fn modes_holding(&self, added: &[f64], load: Load) -> Result<Modes, String> {
+        Modes::new(self, added, load)
     }
 }
 
@@ -193,10 +200,12 @@ pub struct Modes {
 }
 
 impl Modes {
-    fn new(b: &Building, floor: usize, added: f64, load: Load) -> Result<Modes, String> {
+    fn new(b: &Building, added: &[f64], load: Load) -> Result<Modes, String> {
         let n = b.floors();
         let mut masses = b.masses.clone();
-        masses[floor] += added;
+        for (m, a) in masses.iter_mut().zip(added) {
+            *m += a;
+        }
         let k = b.stiffness();
         // The state scaled as `[s u; u']`, with `s` the largest `sqrt(K_ii / m_i)`: its matrix
         // then has the size of the fastest mode's rate rather than of its square, and the
