@@ -1,6 +1,7 @@
 //! Runs one stress scene (by seed, or a TOML file through the reference) and prints its time:
 //! `cargo run --release -p lpc-tools --bin stress_one -- SEED [MAX_HORIZON] [MODEL]` (`--toml` prints
-//! the scene file instead) or `... -- scene.toml`.
+//! the scene file instead, `--bed` draws its balls as a bed as `lpc stress --beds` does) or
+//! `... -- scene.toml`.
 use lpc_damper::model::{Model, RunOptions};
 
 fn main() {
@@ -18,8 +19,11 @@ fn main() {
     }
     let seed: u64 = args[1].parse().unwrap();
     let max_h: f64 = args.get(2).map_or(100.0, |s| s.parse().unwrap());
-    let model: lpc_damper::Model = args.get(3).map_or("reference", |s| s).parse().unwrap();
-    let file = lpc_damper::studies::stress::random_scene_file(seed, max_h, false);
+    let model: lpc_damper::Model = args.get(3).filter(|s| !s.starts_with("--")).map_or("reference", |s| s).parse().unwrap();
+    let mut file = lpc_damper::studies::stress::random_scene_file(seed, max_h, false);
+    if args.iter().any(|a| a == "--bed") {
+        file = lpc_damper::studies::stress::with_bed(file, seed);
+    }
     if args.iter().any(|a| a == "--toml") {
         println!("{}", toml::to_string(&file).unwrap());
         return;
