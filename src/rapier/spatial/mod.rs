@@ -10,6 +10,7 @@
 //! write the same few arrays, and the Bevy schedule would add its ECS synchronisation (a copy
 //! of every body per step) and nothing the headless run needs. The one-line path is untouched.
 
+mod balls;
 mod carrier;
 mod contacts;
 mod flights;
@@ -31,6 +32,7 @@ pub use world::{SolverSettings, SpatialWorld};
 use crate::model::{Budget, Meter, Model, ModelError, OverBudget, RunOptions};
 use crate::run::{EnergyAccount, Impacts, Recorder, Run, MAX_KEPT_IMPACTS};
 use crate::scene::Scene;
+use balls::BallState;
 use carrier::Carrier;
 use contacts::{Balls, Contact, Containers, FrameBody, Other};
 use records::{impact_record, sample, sunk_too_deep};
@@ -66,51 +68,6 @@ pub struct SpatialReport {
 /// Runs the spatial path on `scene` with its default settings.
 pub fn simulate_spatial(scene: &Scene, options: &RunOptions) -> Result<Run, ModelError> {
     simulate_spatial_with(scene, solver_settings(scene), options).map(|(run, _)| run)
-}
-
-/// The balls' state as `f64` arrays, read from Rapier.
-struct BallState {
-    x: Vec<[f64; 3]>,
-    v: Vec<[f64; 3]>,
-    w: Vec<[f64; 3]>,
-}
-
-impl BallState {
-    fn read(&mut self, world: &SpatialWorld) {
-        for k in 0..world.balls.len() {
-            let b = world.ball(k);
-            let (p, v, w) = (b.translation(), b.linvel(), b.angvel());
-            self.x[k] = [p.x as f64, p.y as f64, p.z as f64];
-            self.v[k] = [v.x as f64, v.y as f64, v.z as f64];
-            self.w[k] = [w.x as f64, w.y as f64, w.z as f64];
-        }
-    }
-
-    /// Gives Rapier the angular velocities of the balls marked in `which`, keeping what it
-    /// will read back.
-    fn write_spins(&mut self, world: &mut SpatialWorld, which: &[bool]) {
-        for k in (0..world.balls.len()).filter(|&k| which[k]) {
-            let w = self.w[k];
-            let body = world.ball_mut(k);
-            body.set_angvel(Vector::new(w[0] as f32, w[1] as f32, w[2] as f32), true);
-            let r = body.angvel();
-            self.w[k] = [r.x as f64, r.y as f64, r.z as f64];
-        }
-    }
-
-    /// Gives Rapier the velocities of the balls marked in `which`, keeping what it will read
-    /// back (the `f32` velocity).
-    fn write_velocities(&mut self, world: &mut SpatialWorld, which: &[bool]) {
-        for k in 0..world.balls.len() {
-            if which[k] {
-                let v = self.v[k];
-                let body = world.ball_mut(k);
-                body.set_linvel(Vector::new(v[0] as f32, v[1] as f32, v[2] as f32), true);
-                let r = body.linvel();
-                self.v[k] = [r.x as f64, r.y as f64, r.z as f64];
-            }
-        }
-    }
 }
 
 /// The spatial path with given solver settings: the run and what it measured.
