@@ -10,8 +10,9 @@ use crate::scene::Scene;
 /// The carrying body's motion since the last step's end (a frame) or since the last impulse
 /// on it (a floor), in closed form.
 pub(super) enum Carrier<'a> {
-    /// A frame: the closed-form oscillator from its state `(x0, v0)` at `t0`.
-    Frame { scene: &'a Scene, motion: Driven, x0: f64, v0: f64, t0: f64 },
+    /// A frame: the closed-form oscillator from its state `(x0, v0)` at `t0`, carrying
+    /// `carrying` kg of balls.
+    Frame { scene: &'a Scene, motion: Driven, carrying: f64, x0: f64, v0: f64, t0: f64 },
     /// A structure's floors, and those that carry dampers (the carrying one for one damper).
     Floors(Box<FloorMotion>, Vec<usize>),
 }
@@ -24,7 +25,7 @@ impl<'a> Carrier<'a> {
         }
         let f = scene.frame.ok_or("the scene has no frame")?;
         let motion = Driven::new(Oscillator::new(f.mass, f.damping, f.stiffness), scene.harmonic_load());
-        Ok(Carrier::Frame { scene, motion, x0: scene.initial_displacement, v0: 0.0, t0: 0.0 })
+        Ok(Carrier::Frame { scene, motion, carrying: 0.0, x0: scene.initial_displacement, v0: 0.0, t0: 0.0 })
     }
 
     /// The carrying body's absolute displacement and velocity at `t` (not before the last
@@ -53,7 +54,7 @@ impl<'a> Carrier<'a> {
     /// from `from` (since the last restart), J.
     pub(super) fn energy_flows(&self, from: f64, h: f64) -> (f64, f64) {
         match self {
-            Carrier::Frame { scene, motion, x0, v0, t0 } => {
+            Carrier::Frame { scene, motion, x0, v0, t0, .. } => {
                 let (xa, va) = if from == *t0 { (*x0, *v0) } else { motion.state(*x0, *v0, *t0, from) };
                 if motion.xp.is_none() {
                     (motion.osc.dissipated(xa, va, h), 0.0)
@@ -78,32 +79,55 @@ impl<'a> Carrier<'a> {
         }
     }
 
-    /// The carrying body, at `state` (displacement and velocity) at `t`, goes on from there at
-    /// velocity `v`: a frame restarts at every step's end, the floors only when an impulse
-    /// changed the carrying floor's velocity.
-    pub(super) fn restart(&mut self, t: f64, state: (f64, f64), v: f64) -> Result<(), String> {
+    /// The mass of balls each carrying body's closed form carries since the last restart, kg.
+    pub(super) fn carried(&self) -> Vec<f64> {
         match self {
-            Carrier::Frame { x0, v0, t0, .. } => {
-                (*x0, *v0, *t0) = (state.0, v, t);
-                Ok(())
-            }
-            Carrier::Floors(m, _) if v != state.1 => m.restart(t, v, 0.0),
-            Carrier::Floors(..) => Ok(()),
+            Carrier::Frame { carrying, .. } => vec![*carrying],
+            Carrier::Floors(m, floors) => floors.iter().map(|&j| m.held()[j]).collect(),
         }
     }
 
-    /// [`Carrier::restart`] for every carrying body: at `states` at `t`, going on at `v`.
-    pub(super) fn restart_bodies(&mut self, t: f64, states: &[(f64, f64)], v: &[f64]) -> Result<(), String> {
+    /// The carrying body, at `state` (displacement and velocity) at `t`, goes on from there at
+    /// velocity `v` carrying `carried` kg of balls: a frame restarts at every step's end, the
+    /// floors when an impulse changed the carrying floor's velocity or what it carries changed.
+    pub(super) fn restart(&mut self, t: f64, state: (f64, f64), v: f64, carried: f64) -> Result<(), String> {
+        match self {
+            Carrier::Frame { scene, motion, carrying, x0, v0, t0 } => {
+                if let (Some(f), true) = (scene.frame, *carrying != carried) {
+                    *motion = Driven::new(Oscillator::new(f.mass + carried, f.damping, f.stiffness), scene.harmonic_load());
+                    *carrying = carried;
+                }
+                (*x0, *v0, *t0) = (state.0, v, t);
+                Ok(())
+            }
+            Carrier::Floors(m, _) => {
+                let d = m.structure.floor;
+                if v != state.1 || m.held()[d] != carried {
+                    m.restart(t, v, carried)
+                } else {
+                    Ok(())
+                }
+            }
+        }
+    }
+
+    /// [`Carrier::restart`] for every carrying body: at `states` at `t`, going on at `v` and
+    /// carrying `carried` kg of balls.
+    pub(super) fn restart_bodies(&mut self, t: f64, states: &[(f64, f64)], v: &[f64], carried: &[f64]) -> Result<(), String> {
         match self {
             Carrier::Floors(m, floors) if floors.len() > 1 => {
                 let struck: Vec<(usize, f64)> =
                     floors.iter().zip(states.iter().zip(v)).filter(|(_, (s, v))| **v != s.1).map(|(&j, (_, &v))| (j, v)).collect();
-                if !struck.is_empty() {
-                    m.restart_floors(t, &struck);
+                let mut held = vec![0.0; m.n()];
+                for (&j, &c) in floors.iter().zip(carried) {
+                    held[j] = c;
+                }
+                if !struck.is_empty() || m.held() != held.as_slice() {
+                    m.restart_holding(t, &struck, &held)?;
                 }
                 Ok(())
             }
-            _ => self.restart(t, states[0], v[0]),
+            _ => self.restart(t, states[0], v[0], carried[0]),
         }
     }
 

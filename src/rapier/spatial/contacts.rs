@@ -105,6 +105,21 @@ impl Finder {
     }
 }
 
+/// Counts into `near` how many of `found` each ball is in, and into `held` how many of them
+/// touch (closer than `touching`).
+pub fn count(found: &[Contact], touching: f64, near: &mut [u32], held: &mut [u32]) {
+    near.iter_mut().chain(held.iter_mut()).for_each(|count| *count = 0);
+    for c in found {
+        let touches = u32::from(c.gap <= touching);
+        near[c.ball] += 1;
+        held[c.ball] += touches;
+        if let Other::Ball(j) = c.other {
+            near[j] += 1;
+            held[j] += touches;
+        }
+    }
+}
+
 /// A contact between balls whose normal has at least this component along gravity leans across
 /// it: one ball rests partly on the other (a row lying on the floor has none, to round-off).
 pub const PILE_LEANING: f64 = 1e-3;
@@ -192,6 +207,11 @@ pub fn strike(c: &Contact, approach: f64, e: f64, balls: &mut Balls, frame: &mut
 /// pair short of contact; at the step's end when the flight never closes it; at its start
 /// when it was closed already).
 pub fn closing_speed(gap0: f64, w0: f64, g_n: f64, h: f64) -> f64 {
+    closing(gap0, w0, g_n, h).1
+}
+
+/// [`closing_speed`] and the time into the step at which the contact closes, s.
+pub fn closing(gap0: f64, w0: f64, g_n: f64, h: f64) -> (f64, f64) {
     // gap(t) = gap0 + w0 t - g_n t^2 / 2.
     let tau = if gap0 <= 0.0 {
         0.0
@@ -215,7 +235,7 @@ pub fn closing_speed(gap0: f64, w0: f64, g_n: f64, h: f64) -> f64 {
             }
         }
     };
-    -(w0 - g_n * tau)
+    (tau, -(w0 - g_n * tau))
 }
 
 /// The unit direction from one ball's centre to the other's at the instant free flight brings

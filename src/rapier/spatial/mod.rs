@@ -11,6 +11,7 @@
 //! of every body per step) and nothing the headless run needs. The one-line path is untouched.
 
 mod balls;
+mod carried;
 mod carrier;
 mod contacts;
 mod flights;
@@ -24,7 +25,7 @@ use bevy_rapier3d::rapier::prelude::{ActiveHooks, Vector};
 pub use contacts::closing_speed;
 pub use settings::{
     checks, energy_gain_allowance, needs_spatial, rapier_world, refusal, solver_settings, wall_sink_limit, CONTACT_DAMPING_RATIO,
-    CONTACT_FREQUENCY_PER_STEP_RATE, DEFAULT_SPATIAL_DT, DEFAULT_SPATIAL_ITERATIONS, LEAST_PREDICTION, RESTING_SINK_FRACTION,
+    CONTACT_FREQUENCY_PER_SUBSTEP_RATE, DEFAULT_SPATIAL_DT, DEFAULT_SPATIAL_ITERATIONS, LEAST_PREDICTION, RESTING_SINK_FRACTION,
     SPATIAL_ENERGY_GAIN, STEP_TRAVEL, TOUCHING_FRACTION,
 };
 pub use world::{SolverSettings, SpatialWorld};
@@ -150,6 +151,10 @@ pub fn simulate_spatial_with(scene: &Scene, solver: SolverSettings, options: &Ru
     // How far ahead each damper's broad-phase boxes reach, in Rapier's length unit: the first
     // step makes them.
     let mut boxed_for = vec![f32::INFINITY; dampers.len()];
+    // The mass of balls each body's walls drag along (`carried`), which its closed form
+    // carries, and the x momentum Rapier's step gave each ball.
+    let mut carried = carried::CarriedMass::new((0..bodies).map(|b| (0..n).filter(|&i| body_of[i] == b).map(|i| mass[i]).sum()).collect());
+    let mut pushed = vec![0.0; n];
     let height_at_start = scene.height_energy_at_start();
     let energy_of = |carrier: &Carrier, state: &BallState, t: f64, xs: &[f64], vs: &[f64]| -> f64 {
         let mut e = carrier.energy(t, xs[0], vs[0]) + height_at_start;
@@ -170,6 +175,7 @@ pub fn simulate_spatial_with(scene: &Scene, solver: SolverSettings, options: &Ru
         let walls = Containers { chambers: &geometry, damper: &damper_of, xs: &xs_of_damper(&xs) };
         finder.find(walls, &now.x, &radius, touching + reach * solver.dt, &mut found);
         contacts::mark_piles(&found, touching, down, &mut in_pile);
+        contacts::count(&found, touching, &mut near, &mut held);
         kicked.iter_mut().for_each(|k| *k = true);
         let mut struck = vec![false; n];
         let mut balls = Balls { v: &mut now.v, mass: &mass };
@@ -188,7 +194,7 @@ pub fn simulate_spatial_with(scene: &Scene, solver: SolverSettings, options: &Ru
             }
         });
         let starts: Vec<(f64, f64)> = xs.iter().copied().zip(vs.iter().copied()).collect();
-        carrier.restart_bodies(0.0, &starts, &frame.vs).map_err(ModelError::Refused)?;
+        carrier.restart_bodies(0.0, &starts, &frame.vs, &carried.mass).map_err(ModelError::Refused)?;
         vs = frame.vs;
         now.write_velocities(&mut world, &struck);
     }
@@ -310,24 +316,33 @@ pub fn simulate_spatial_with(scene: &Scene, solver: SolverSettings, options: &Ru
             unsolved[striker.damper].push((striker.collider, target.collider));
             world.collider_mut(s.striker).set_active_hooks(ActiveHooks::MODIFY_SOLVER_CONTACTS);
         }
+        let walls_v = carried::WallsVelocity { start: &vs, mean: &mean_vs, end: &v1 };
+        // The balls that touch something step in their walls' reference (`carried`); those in
+        // flight, in the ground's.
+        let resting: Vec<bool> = held.iter().map(|&count| count > 0).collect();
+        carried::enter_walls_reference(&mut world, &now.v, (&body_of, &resting), walls_v, &mass, h);
         std::mem::swap(&mut before, &mut now);
         for (damper, pairs) in world.dampers.iter_mut().zip(&unsolved) {
             damper.physics.step_with_events(&strikes::Unsolved { pairs }, &());
         }
         now.read(&world);
+        carried::leave_walls_reference(&mut world, &mut now.v, (&body_of, &resting), walls_v);
         for s in &strikes.list {
             world.collider_mut(s.striker).set_active_hooks(ActiveHooks::empty());
-            if strikes::bring_back(*s, &mut now.x, &now.v, mean_vs[body_of[s.striker]], &radius, h) {
+            if strikes::bring_back(*s, &mut now.x, &now.v, v1[body_of[s.striker]], &radius, h) {
                 let p = now.x[s.striker].map(|c| c as f32);
                 world.ball_mut(s.striker).set_translation(Vector::new(p[0], p[1], p[2]), true);
                 now.x[s.striker] = p.map(f64::from);
             }
         }
         // Rapier's walls are infinitely heavy: the frame takes the opposite of the x momentum
-        // they gave the balls (ball-ball impulses cancel in the sum; gravity's is not theirs).
-        let mut dpx = vec![-0.0; bodies];
+        // they gave the balls (ball-ball impulses cancel in the sum; gravity's is not theirs),
+        // less what its closed form gave the mass it carried through the step.
+        let carrying = carrier.carried();
+        let mut dpx: Vec<f64> = (0..bodies).map(|b| -carrying[b] * (v1[b] - vs[b])).collect();
         for i in 0..n {
-            dpx[body_of[i]] += mass[i] * (now.v[i][0] - before.v[i][0] - g[0] * h);
+            pushed[i] = mass[i] * (now.v[i][0] - before.v[i][0] - g[0] * h);
+            dpx[body_of[i]] += pushed[i];
         }
         let mut frame = FrameBody { vs: (0..bodies).map(|b| v1[b] - dpx[b] / body_mass[b]).collect(), mass: &body_mass, of_ball: &body_of };
         // Pairs Rapier may have stopped: its speculative contacts slow a pair a little before
@@ -345,18 +360,7 @@ pub fn simulate_spatial_with(scene: &Scene, solver: SolverSettings, options: &Ru
             let b = body_of[c.ball];
             return Err(sunk_too_deep(scene, t1, (c.ball, -c.gap, wall), sink_limit, (v1[b] - vs[b]) / h));
         }
-        // How many of the step's contacts each ball is in (`near`), and how many of them touch
-        // (`held`).
-        near.iter_mut().chain(held.iter_mut()).for_each(|count| *count = 0);
-        for c in &found {
-            let touches = u32::from(c.gap <= touching);
-            near[c.ball] += 1;
-            held[c.ball] += touches;
-            if let Other::Ball(j) = c.other {
-                near[j] += 1;
-                held[j] += touches;
-            }
-        }
+        contacts::count(&found, touching, &mut near, &mut held);
         joined.clear();
         joined.resize(found.len(), false);
         for (k, c) in found.iter().enumerate() {
@@ -402,12 +406,14 @@ pub fn simulate_spatial_with(scene: &Scene, solver: SolverSettings, options: &Ru
                     let p = before.x[c.ball];
                     let b = body_of[c.ball];
                     let (gap0, _) = geometry[damper_of[c.ball] as usize].gap(wall, [p[0] - xs[b], p[1], p[2]], radius[c.ball]);
-                    let wall_n = c.normal[0] * mean_vs[b];
+                    // The walls accelerate from their velocity at the step's start to that at
+                    // its end (Rapier steps the balls in their reference).
+                    let n_x = c.normal[0];
                     (
                         gap0,
-                        wall_n - contacts_dot(before.v[c.ball], c.normal),
-                        wall_n - contacts_dot(now.v[c.ball], c.normal),
-                        contacts_dot(g, c.normal),
+                        n_x * vs[b] - contacts_dot(before.v[c.ball], c.normal),
+                        n_x * v1[b] - contacts_dot(now.v[c.ball], c.normal),
+                        contacts_dot(g, c.normal) - n_x * (v1[b] - vs[b]) / h,
                         None,
                     )
                 }
@@ -457,9 +463,9 @@ pub fn simulate_spatial_with(scene: &Scene, solver: SolverSettings, options: &Ru
         let mut step_impact_loss = 0.0;
         {
             let mut balls = Balls { v: &mut now.v, mass: &mass };
-            // The frame's velocity as the impacts leave it one after the other (§3): each
-            // wall impact meets the frame as the impacts before it left it.
-            let mut frame_in_turn = mean_vs.clone();
+            // How the step's wall impacts so far changed each body's velocity (§3): each wall
+            // impact meets the frame as the impacts before it left it.
+            let mut frame_change = vec![0.0; bodies];
             for closing in &new {
                 let c = found[closing.k];
                 let (approach, lost) = match c.other {
@@ -496,20 +502,21 @@ pub fn simulate_spatial_with(scene: &Scene, solver: SolverSettings, options: &Ru
                     Other::Wall(_) => {
                         let n = c.normal;
                         let b = body_of[c.ball];
-                        let w0 = closing.w0 + n[0] * (frame_in_turn[b] - mean_vs[b]);
-                        let approach = closing_speed(closing.gap0, w0, closing.g_n, h);
+                        let w0 = closing.w0 + n[0] * frame_change[b];
+                        let (tau, approach) = contacts::closing(closing.gap0, w0, closing.g_n, h);
                         if approach <= 0.0 {
                             continue;
                         }
-                        // Eq. 9-10 with the frame as it is at this impact's turn: the ball
-                        // leaves at the frame's normal velocity then, less `e` times the
+                        // Eq. 9-10 with the frame as it is at this impact's turn and instant:
+                        // the ball leaves at the walls' normal velocity then, less `e` times the
                         // approach, less the frame's share of the recoil.
                         let (m, inv_frame) = (mass[c.ball], n[0] * n[0] / body_mass[b]);
                         let mu = 1.0 / (1.0 / m + inv_frame);
-                        let ball_after = n[0] * frame_in_turn[b] + approach - (1.0 + e) * approach * mu / m;
+                        let walls_then = vs[b] + (v1[b] - vs[b]) * tau / h + frame_change[b];
+                        let ball_after = n[0] * walls_then + approach - (1.0 + e) * approach * mu / m;
                         let ball_now = contacts_dot(balls.v[c.ball], n);
                         contacts::push_apart(&c, m * (ball_now - ball_after), &mut balls, &mut frame);
-                        frame_in_turn[b] += (1.0 + e) * approach * mu * n[0] / body_mass[b];
+                        frame_change[b] += (1.0 + e) * approach * mu * n[0] / body_mass[b];
                         (approach, 0.5 * (1.0 - e * e) * mu * approach * approach)
                     }
                 };
@@ -546,7 +553,10 @@ pub fn simulate_spatial_with(scene: &Scene, solver: SolverSettings, options: &Ru
         };
         let gravity_work: f64 = (0..n).map(|i| mass[i] * contacts_dot(g, std::array::from_fn(|a| now.x[i][a] - before.x[i][a]))).sum();
         let frame_jump: f64 = (0..bodies).map(|b| 0.5 * body_mass[b] * (frame.vs[b] * frame.vs[b] - v1[b] * v1[b])).sum();
-        let step_loss = -(kinetic(&now) - kinetic(&before) - gravity_work + frame_jump) - step_impact_loss;
+        // The carrier's closed form did work on the mass it carried: its own energy changed by
+        // the excitation's work, less its dampers' loss, less that work.
+        let carried_work: f64 = (0..bodies).map(|b| 0.5 * carrying[b] * (v1[b] * v1[b] - vs[b] * vs[b])).sum();
+        let step_loss = -(kinetic(&now) - kinetic(&before) - gravity_work + frame_jump - carried_work) - step_impact_loss;
         contact_loss += step_loss;
         report.worst_step_gain = report.worst_step_gain.max(-step_loss);
         // Samples in the step: the carrier in closed form (impulses land at the step's end),
@@ -565,8 +575,15 @@ pub fn simulate_spatial_with(scene: &Scene, solver: SolverSettings, options: &Ru
             });
             next_sample += 1;
         }
+        // What the walls dragged along in the step, from the balls no impact struck.
+        let mut response = vec![0.0; bodies];
+        for i in (0..n).filter(|&i| !kicked[i]) {
+            response[body_of[i]] += pushed[i];
+        }
+        let change: Vec<f64> = (0..bodies).map(|b| v1[b] - vs[b]).collect();
+        carried.update(&response, &change);
         let ends: Vec<(f64, f64)> = x1.iter().copied().zip(v1.iter().copied()).collect();
-        carrier.restart_bodies(t1, &ends, &frame.vs).map_err(ModelError::Refused)?;
+        carrier.restart_bodies(t1, &ends, &frame.vs, &carried.mass).map_err(ModelError::Refused)?;
         while next_sample < sample_count && scene.sample_at_step_end(next_sample as f64 * scene.sample_dt, t1, h) {
             let a = &now;
             sample(&mut recorder, scene, &carrier, next_sample as f64 * scene.sample_dt, (x1[0], frame.vs[0]), |i| (a.x[i], a.v[i]));

@@ -12,11 +12,13 @@ use crate::scene::{Chamber, Scene};
 pub const DEFAULT_SPATIAL_DT: f64 = 1e-3;
 /// Default solver iterations of the spatial path (Rapier's default).
 pub const DEFAULT_SPATIAL_ITERATIONS: usize = 4;
-/// Natural frequency of Rapier's contact springs, as a fraction of the step rate: with
-/// Rapier's default (30 Hz) the bed of scenes/particle-box.toml sinks by half a radius (2.4 mm
-/// deepest overlap over 0.5 s at a millisecond), at 60 Hz by a fifth; a quarter of the step
-/// rate (250 Hz at a millisecond) stays stable and keeps it to 2.4 % (0.12 mm).
-pub const CONTACT_FREQUENCY_PER_STEP_RATE: f64 = 0.25;
+/// Natural frequency of Rapier's contact springs, as a fraction of its substep rate (Rapier
+/// takes as many substeps in a step as it has solver iterations): a quarter, the stiffest its
+/// soft contacts stay stable at (docs/MODEL.md §9, "Stiff contacts"). Softer, a contact passes
+/// only a share of a load in each substep, and a pile shaken below friction's hold loses energy
+/// as a viscous body: at a quarter of the step rate (250 Hz at 1 ms) a settled bed on a rigidly
+/// shaken floor lost seven times what it loses at a quarter of the substep rate (1000 Hz).
+pub const CONTACT_FREQUENCY_PER_SUBSTEP_RATE: f64 = 0.25;
 /// Damping ratio of Rapier's contact springs (Rapier's default: overdamped, no rebound).
 pub const CONTACT_DAMPING_RATIO: f64 = 10.0;
 /// The least distance ahead at which Rapier predicts contacts, in its length unit (the largest
@@ -95,11 +97,12 @@ pub fn solver_settings(scene: &Scene) -> SolverSettings {
     // wall swung at hundreds of metres per second otherwise passes through balls).
     let smallest = scene.balls.iter().map(|b| b.radius).fold(f64::INFINITY, f64::min);
     let dt = if smallest.is_finite() { dt.min(STEP_TRAVEL * smallest / scene.speed_scale()) } else { dt };
+    let iterations = scene.rapier.solver_iterations.map_or(DEFAULT_SPATIAL_ITERATIONS, |i| i as usize);
     SolverSettings {
         dt,
         length_unit: (2.0 * largest).max(1e-6),
-        solver_iterations: scene.rapier.solver_iterations.map_or(DEFAULT_SPATIAL_ITERATIONS, |i| i as usize),
-        contact_frequency: CONTACT_FREQUENCY_PER_STEP_RATE / dt,
+        solver_iterations: iterations,
+        contact_frequency: CONTACT_FREQUENCY_PER_SUBSTEP_RATE * iterations as f64 / dt,
         contact_damping: CONTACT_DAMPING_RATIO,
     }
 }

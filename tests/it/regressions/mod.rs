@@ -7,6 +7,7 @@ mod ball_struck_on_the_floor;
 mod balls_sliding_together;
 mod bed_energy_below_zero;
 mod box_loses_floor_velocity;
+mod carried_ball_felt_late;
 mod check_bad_scene_exit_status;
 mod closed_pipe;
 mod compare_flag_that_cannot_help;
