@@ -353,11 +353,8 @@ impl FloorMotion {
     /// those masses, the segment still starts (with the modes it had) and the reason is
     /// returned.
     pub fn restart_holding(&mut self, t: f64, velocities: &[(usize, f64)], held: &[f64]) -> Result<(), String> {
-        let (mut z, (_, vg)) = self.floors(t);
+        let z = self.state_moving(t, velocities);
         let n = self.n();
-        for &(j, v) in velocities {
-            z[n + j] = v - vg;
-        }
         let mut failure = Ok(());
         if let Some((_, m, sine)) = self.cache.iter().find(|(masses, ..)| masses.as_slice() == held) {
             self.modes = m.clone();
@@ -392,6 +389,17 @@ impl FloorMotion {
         failure
     }
 
+    /// The floors' state at `t` relative to the ground, with each floor `j` of `velocities`
+    /// moving at its `v` (absolute) instead.
+    fn state_moving(&self, t: f64, velocities: &[(usize, f64)]) -> Vec<f64> {
+        let (mut z, (_, vg)) = self.floors(t);
+        let n = self.n();
+        for &(j, v) in velocities {
+            z[n + j] = v - vg;
+        }
+        z
+    }
+
     /// The mass of balls each floor holds in this segment, kg.
     pub fn held(&self) -> &[f64] {
         &self.held
@@ -400,11 +408,8 @@ impl FloorMotion {
     /// Starts a new segment at `t`, each floor `j` of `velocities` moving at its `v` (absolute),
     /// no balls held: several floors struck at one instant.
     pub fn restart_floors(&mut self, t: f64, velocities: &[(usize, f64)]) {
-        let (mut z, (_, vg)) = self.floors(t);
+        let z = self.state_moving(t, velocities);
         let n = self.n();
-        for &(j, v) in velocities {
-            z[n + j] = v - vg;
-        }
         // The bare floors' modes are the first decomposed.
         let (_, m, sine) = &self.cache[0];
         self.modes = m.clone();
