@@ -2,7 +2,9 @@
 
 use bevy_rapier3d::rapier::prelude::Vector;
 
+use super::contacts::{Contact, Other};
 use super::world::SpatialWorld;
+use crate::scene::Wall;
 
 /// The balls' state as `f64` arrays, read from Rapier.
 pub(super) struct BallState {
@@ -50,5 +52,38 @@ impl BallState {
                 self.v[k] = [r.x as f64, r.y as f64, r.z as f64];
             }
         }
+    }
+
+    /// Puts every ball that `found` (the contacts at the step's end) shows sunk into a wall by
+    /// more than `limit` back out along the wall's normal to `resting` (positions only: no
+    /// velocity or energy changes), in Rapier too; the velocities are left to the impact law,
+    /// which strikes a put-back ball that approaches its wall as any impact. Returns whether any
+    /// ball moved, or a ball whose centre has crossed a wall (sunk by its radius or more: the
+    /// ball, how deep, m, and the wall), which has left its container and cannot be put back.
+    pub(super) fn put_back_sunk(
+        &mut self,
+        world: &mut SpatialWorld,
+        found: &[Contact],
+        radius: &[f64],
+        (limit, resting): (f64, f64),
+    ) -> Result<bool, (usize, f64, Wall)> {
+        let mut moved = false;
+        for c in found.iter().filter(|c| -c.gap > limit) {
+            let Other::Wall(wall) = c.other else { continue };
+            if -c.gap >= radius[c.ball] {
+                return Err((c.ball, -c.gap, wall));
+            }
+            let back = -c.gap - resting;
+            let x = &mut self.x[c.ball];
+            for (xa, na) in x.iter_mut().zip(c.normal) {
+                *xa -= na * back;
+            }
+            let body = world.ball_mut(c.ball);
+            body.set_translation(Vector::new(x[0] as f32, x[1] as f32, x[2] as f32), true);
+            let p = body.translation();
+            *x = [p.x as f64, p.y as f64, p.z as f64];
+            moved = true;
+        }
+        Ok(moved)
     }
 }

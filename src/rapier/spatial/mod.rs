@@ -59,6 +59,10 @@ pub struct SpatialReport {
     pub deepest_overlap: f64,
     /// Steps taken.
     pub steps: u64,
+    /// The deepest a ball sank into a wall at a step's end, before it was put back, m.
+    pub deepest_wall_sink: f64,
+    /// Steps at whose end a ball sunk into a wall past the resting sink was put back.
+    pub sinks_put_back: u64,
     /// Impacts found as new contacts.
     pub new_contact_impacts: u64,
     /// Impacts of touching pairs the new ones set approaching, and of those that touch and
@@ -131,10 +135,11 @@ pub fn simulate_spatial_with(scene: &Scene, solver: SolverSettings, options: &Ru
         2.0 * (pressing + c.normal[0].abs() * walls_a[body_of[c.ball]]) * solver.dt + speed_floor
     };
     let lu = solver.length_unit as f32;
-    // A ball sunk deeper into a wall stops the run rather than leave the container. (Balls
-    // may sink deeper into each other: Rapier's solve holds a pile by the overlaps of its
-    // balls, which nothing outside the run sees.)
+    // How deep a ball may sink into a wall, and the resting sink a deeper one is put back to.
+    // (Balls may sink deeper into each other: Rapier's solve holds a pile by the overlaps of
+    // its balls, which nothing outside the run sees.)
     let sink_limit = wall_sink_limit(scene);
+    let resting_sink = RESTING_SINK_FRACTION * scene.balls.iter().map(|b| b.radius).fold(0.0, f64::max);
     let mut finder = contacts::Finder::default();
     // How fast pairs may close, m/s: twice the fastest expected speed.
     let reach = 2.0 * speed;
@@ -350,21 +355,33 @@ pub fn simulate_spatial_with(scene: &Scene, solver: SolverSettings, options: &Ru
         let walls = Containers { chambers: &geometry, damper: &damper_of, xs: &xs_of_damper(&x1) };
         finder.find(walls, &now.x, &radius, touching + reach * h, &mut found);
         contacts::mark_piles(&found, touching, down, &mut in_pile);
+        // A ball Rapier's soft contacts let sink into a wall past the resting sink (struck hard
+        // in a crowd, or pressed by walls at thousands of g) is put back to that sink; one
+        // whose centre has crossed the wall stops the run.
+        for c in &found {
+            report.deepest_overlap = report.deepest_overlap.max(-c.gap);
+            if let Other::Wall(_) = c.other {
+                report.deepest_wall_sink = report.deepest_wall_sink.max(-c.gap);
+            }
+        }
+        match now.put_back_sunk(&mut world, &found, &radius, (sink_limit, resting_sink)) {
+            Ok(true) => {
+                report.sinks_put_back += 1;
+                finder.find(walls, &now.x, &radius, touching + reach * h, &mut found);
+                contacts::mark_piles(&found, touching, down, &mut in_pile);
+            }
+            Ok(false) => {}
+            Err(sunk) => {
+                let b = body_of[sunk.0];
+                return Err(sunk_too_deep(scene, t1, sunk, radius[sunk.0], (v1[b] - vs[b]) / h));
+            }
+        }
         // Contacts whose approach Rapier stopped, the fastest first.
         let mut new: Vec<Closing> = Vec::new();
-        let sunk = found.iter().filter_map(|c| match c.other {
-            Other::Wall(wall) if -c.gap > sink_limit => Some((c, wall)),
-            _ => None,
-        });
-        if let Some((c, wall)) = sunk.min_by(|a, b| a.0.gap.total_cmp(&b.0.gap)) {
-            let b = body_of[c.ball];
-            return Err(sunk_too_deep(scene, t1, (c.ball, -c.gap, wall), sink_limit, (v1[b] - vs[b]) / h));
-        }
         contacts::count(&found, touching, &mut near, &mut held);
         joined.clear();
         joined.resize(found.len(), false);
         for (k, c) in found.iter().enumerate() {
-            report.deepest_overlap = report.deepest_overlap.max(-c.gap);
             if strikes.holds(c) {
                 // Rapier did not solve the pair: it strikes at the speed it touches with.
                 let balls = Balls { v: &mut now.v, mass: &mass };

@@ -1,17 +1,17 @@
 //! What the spatial path writes down: its samples, each impact's record, and the stop of a run
-//! whose ball Rapier's solve left sunk into a wall.
+//! whose ball Rapier's solve left sunk through a wall.
 
 use super::carrier::Carrier;
 use super::contacts::{Contact, Other};
-use super::{contacts_dot, RESTING_SINK_FRACTION};
+use super::contacts_dot;
 use crate::model::{Model, ModelError};
 use crate::run::{Impact, Recorder};
 use crate::scene::{Body, Scene, Wall};
 
 /// The stop of a run in which Rapier's solve left a ball sunk into a wall (`sunk`: the ball,
-/// by how much, m, and the wall) deeper than `sink_limit` at `t`, the frame accelerating at
-/// `frame_acceleration` over the step.
-pub(super) fn sunk_too_deep(scene: &Scene, t: f64, sunk: (usize, f64, Wall), sink_limit: f64, frame_acceleration: f64) -> ModelError {
+/// by how much, m, and the wall) by its radius `radius` or more at `t`, its centre past the
+/// wall, the frame accelerating at `frame_acceleration` over the step.
+pub(super) fn sunk_too_deep(scene: &Scene, t: f64, sunk: (usize, f64, Wall), radius: f64, frame_acceleration: f64) -> ModelError {
     let (ball, depth, wall) = sunk;
     let into = match wall {
         Wall::Left => "the left wall".into(),
@@ -27,11 +27,10 @@ pub(super) fn sunk_too_deep(scene: &Scene, t: f64, sunk: (usize, f64, Wall), sin
         model: Model::Rapier,
         t,
         reason: format!(
-            "at t = {t:.6e} s ball{} has sunk {:.3e} m into {into}, more than the {:.3e} m Rapier's soft contacts may sink ({} % of the largest radius): its solve cannot hold the load on the ball (the walls accelerate at {:.3e} m/s^2, gravity is {:.3e} m/s^2); the compliant model and, without friction, the reference run such scenes",
+            "at t = {t:.6e} s ball{} has sunk {:.3e} m into {into}, its radius of {:.3e} m or more: its centre is past the wall and it has left the container, which Rapier's soft contacts did not hold against the load on the ball (the walls accelerate at {:.3e} m/s^2, gravity is {:.3e} m/s^2); the compliant model and, without friction, the reference run such scenes",
             ball + 1,
             depth,
-            sink_limit,
-            RESTING_SINK_FRACTION * 100.0,
+            radius,
             frame_acceleration.abs(),
             contacts_dot(scene.space.gravity, scene.space.gravity).sqrt(),
         ),

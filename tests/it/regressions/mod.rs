@@ -43,6 +43,7 @@ mod step_depends_on_horizon;
 mod stiff_frame_rapier_step;
 mod stopped_run_prints_nothing;
 mod striker_pressed_by_end_wall;
+mod struck_crowd_sunk_into_wall;
 mod summary_without_bare_floors;
 mod touching_balls_refused;
 mod valid_input_panics;
