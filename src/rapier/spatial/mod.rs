@@ -24,9 +24,9 @@ use bevy_rapier3d::rapier::prelude::{ActiveHooks, Vector};
 
 pub use contacts::closing_speed;
 pub use settings::{
-    checks, energy_gain_allowance, needs_spatial, rapier_world, refusal, solver_settings, wall_sink_limit, CONTACT_DAMPING_RATIO,
-    CONTACT_FREQUENCY_PER_SUBSTEP_RATE, DEFAULT_SPATIAL_DT, DEFAULT_SPATIAL_ITERATIONS, LEAST_PREDICTION, RESTING_SINK_FRACTION,
-    SPATIAL_ENERGY_GAIN, STEP_TRAVEL, TOUCHING_FRACTION,
+    checks, energy_gain_allowance, needs_spatial, rapier_world, refusal, resting_wall_sink, solver_settings, wall_sink_limit,
+    CONTACT_DAMPING_RATIO, CONTACT_FREQUENCY_PER_SUBSTEP_RATE, DEFAULT_SPATIAL_DT, DEFAULT_SPATIAL_ITERATIONS, LEAST_PREDICTION,
+    RESTING_SINK_FRACTION, SPATIAL_ENERGY_GAIN, STEP_TRAVEL, TOUCHING_FRACTION,
 };
 pub use world::{SolverSettings, SpatialWorld};
 
@@ -139,7 +139,7 @@ pub fn simulate_spatial_with(scene: &Scene, solver: SolverSettings, options: &Ru
     // (Balls may sink deeper into each other: Rapier's solve holds a pile by the overlaps of
     // its balls, which nothing outside the run sees.)
     let sink_limit = wall_sink_limit(scene);
-    let resting_sink = RESTING_SINK_FRACTION * scene.balls.iter().map(|b| b.radius).fold(0.0, f64::max);
+    let resting_sink = resting_wall_sink(scene);
     let mut finder = contacts::Finder::default();
     // How fast pairs may close, m/s: twice the fastest expected speed.
     let reach = 2.0 * speed;

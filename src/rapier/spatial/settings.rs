@@ -116,12 +116,18 @@ pub fn energy_gain_allowance(scene: &Scene, energy_in: f64) -> f64 {
     SPATIAL_ENERGY_GAIN * energy_in.abs() + lift
 }
 
-/// The deepest a ball of `scene` may sink into a wall on the spatial path, m: Rapier's resting
-/// sink, [`RESTING_SINK_FRACTION`] of the largest radius, and a micrometre beyond it. Deeper,
-/// Rapier's soft contacts are not holding the load on the ball, and the run stops.
-pub fn wall_sink_limit(scene: &Scene) -> f64 {
+/// Rapier's resting sink on the spatial path, m: [`RESTING_SINK_FRACTION`] of the largest
+/// radius of `scene`, to which a ball sunk deeper into a wall is put back.
+pub fn resting_wall_sink(scene: &Scene) -> f64 {
     let largest = scene.balls.iter().map(|b| b.radius).fold(0.0, f64::max);
-    RESTING_SINK_FRACTION * largest + 1e-6
+    RESTING_SINK_FRACTION * largest
+}
+
+/// The deepest a ball of `scene` may sink into a wall on the spatial path, m: Rapier's resting
+/// sink ([`resting_wall_sink`]) and a micrometre beyond it. Deeper, Rapier's soft contacts have
+/// given too far, and the ball is put back to the resting sink.
+pub fn wall_sink_limit(scene: &Scene) -> f64 {
+    resting_wall_sink(scene) + 1e-6
 }
 
 /// The tolerances a spatial run is checked with: its energy allowance, Rapier's resting sink
