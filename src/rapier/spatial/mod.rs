@@ -15,6 +15,7 @@ mod carried;
 mod carrier;
 mod contacts;
 mod flights;
+mod hooks;
 mod records;
 mod settings;
 mod strikes;
@@ -129,9 +130,9 @@ pub fn simulate_spatial_with(scene: &Scene, solver: SolverSettings, options: &Ru
     let g_norm = contacts_dot(g, g).sqrt();
     let down = if g_norm > 0.0 { g.map(|c| c / g_norm) } else { [0.0; 3] };
     let mut in_pile = vec![false; n];
+    let piled = |c: &Contact, in_pile: &[bool]| in_pile[c.ball] || matches!(c.other, Other::Ball(j) if in_pile[j]);
     let resting_speed = |c: &Contact, in_pile: &[bool], walls_a: &[f64]| {
-        let piled = in_pile[c.ball] || matches!(c.other, Other::Ball(j) if in_pile[j]);
-        let pressing = if piled { g_norm } else { contacts_dot(g, c.normal).abs() };
+        let pressing = if piled(c, in_pile) { g_norm } else { contacts_dot(g, c.normal).abs() };
         2.0 * (pressing + c.normal[0].abs() * walls_a[body_of[c.ball]]) * solver.dt + speed_floor
     };
     let lu = solver.length_unit as f32;
@@ -152,6 +153,8 @@ pub fn simulate_spatial_with(scene: &Scene, solver: SolverSettings, options: &Ru
     let mut undone = vec![false; n];
     let mut joined: Vec<bool> = Vec::new();
     let mut unsolved = vec![Vec::new(); dampers.len()];
+    // The pairs the impact law struck in a step, whose impulses Rapier forgets at the next.
+    let mut struck_last_step = hooks::Struck::default();
     let mut fastest = vec![0.0f64; dampers.len()];
     // How far ahead each damper's broad-phase boxes reach, in Rapier's length unit: the first
     // step makes them.
@@ -321,6 +324,7 @@ pub fn simulate_spatial_with(scene: &Scene, solver: SolverSettings, options: &Ru
             unsolved[striker.damper].push((striker.collider, target.collider));
             world.collider_mut(s.striker).set_active_hooks(ActiveHooks::MODIFY_SOLVER_CONTACTS);
         }
+        struck_last_step.forget(&mut world);
         let walls_v = carried::WallsVelocity { start: &vs, mean: &mean_vs, end: &v1 };
         // The balls that touch something step in their walls' reference (`carried`); those in
         // flight, in the ground's.
@@ -539,6 +543,9 @@ pub fn simulate_spatial_with(scene: &Scene, solver: SolverSettings, options: &Ru
                 };
                 step_impact_loss += lost;
                 impacts.push(impact_record(t1, &c, approach, lost));
+                if !piled(&c, &in_pile) {
+                    struck_last_step.push(c.ball, c.other);
+                }
                 report.new_contact_impacts += 1;
                 kicked[c.ball] = true;
                 if let Other::Ball(j) = c.other {
@@ -552,6 +559,9 @@ pub fn simulate_spatial_with(scene: &Scene, solver: SolverSettings, options: &Ru
                     let lost = contacts::strike(c, approach, e, balls, frame);
                     step_impact_loss += lost;
                     impacts.push(impact_record(t1, c, approach, lost));
+                    if !piled(c, &in_pile) {
+                        struck_last_step.push(c.ball, c.other);
+                    }
                     report.knock_on_impacts += 1;
                 });
             }

@@ -23,6 +23,8 @@ pub struct DamperWorld {
     pub physics: PhysicsWorld,
     /// The kinematic body that carries the container (the frame's, or its floor's).
     pub frame: RigidBodyHandle,
+    /// The container's walls and their colliders.
+    pub walls: Vec<(Wall, ColliderHandle)>,
 }
 
 /// Where a ball lives.
@@ -101,29 +103,31 @@ pub fn build(scene: &Scene, chambers: &[Chamber], solver: SolverSettings) -> Spa
             .restitution(0.0)
             .restitution_combine_rule(CoefficientCombineRule::Min)
     };
-    let mut dampers: Vec<DamperWorld> =
-        scene
-            .damper_list()
-            .iter()
-            .zip(chambers)
-            .map(|(damper, geometry)| {
-                let mut physics = PhysicsWorld::new();
-                physics.gravity = Vector::new(gx as f32, gy as f32, gz as f32);
-                physics.integration_parameters = parameters;
-                let start = scene.damper_start(damper);
-                let frame = physics.insert_body(
-                    RigidBodyBuilder::kinematic_position_based().translation(Vector::new(start as f32, 0.0, 0.0)).can_sleep(false),
-                );
-                let thick = WALL_THICKNESS_RADII * geometry.largest_radius;
-                for wall in geometry.walls() {
+    let mut dampers: Vec<DamperWorld> = scene
+        .damper_list()
+        .iter()
+        .zip(chambers)
+        .map(|(damper, geometry)| {
+            let mut physics = PhysicsWorld::new();
+            physics.gravity = Vector::new(gx as f32, gy as f32, gz as f32);
+            physics.integration_parameters = parameters;
+            let start = scene.damper_start(damper);
+            let frame = physics.insert_body(
+                RigidBodyBuilder::kinematic_position_based().translation(Vector::new(start as f32, 0.0, 0.0)).can_sleep(false),
+            );
+            let thick = WALL_THICKNESS_RADII * geometry.largest_radius;
+            let walls = geometry
+                .walls()
+                .map(|wall| {
                     let (centre, half) = wall_box(geometry, wall, thick);
                     let collider = plastic(ColliderBuilder::cuboid(half[0] as f32, half[1] as f32, half[2] as f32))
                         .translation(Vector::new(centre[0] as f32, centre[1] as f32, centre[2] as f32));
-                    physics.insert_collider(collider, Some(frame));
-                }
-                DamperWorld { physics, frame }
-            })
-            .collect();
+                    (wall, physics.insert_collider(collider, Some(frame)))
+                })
+                .collect();
+            DamperWorld { physics, frame, walls }
+        })
+        .collect();
     let mut balls = Vec::with_capacity(scene.balls.len());
     for (i, ball) in scene.balls.iter().enumerate() {
         let [y, z] = scene.space.lateral_of(i);

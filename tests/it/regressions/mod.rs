@@ -46,6 +46,7 @@ mod striker_pressed_by_end_wall;
 mod struck_crowd_sunk_into_wall;
 mod summary_without_bare_floors;
 mod touching_balls_refused;
+mod touching_row_pushed_twice;
 mod valid_input_panics;
 mod wall_budget_after_slow_steps;
 mod walls_across_unnamed;

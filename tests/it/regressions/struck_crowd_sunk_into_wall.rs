@@ -5,6 +5,11 @@
 //! the strike's speed over the contacts' rate, and the ball sank past the resting sink, where the
 //! run stopped with a reason fit for a steady load. A ball sunk past that sink is now put back to
 //! it (positions only), and only one whose centre has crossed a wall stops the run.
+//!
+//! The bed was seed 8's. Since Rapier forgets the stored impulses of pairs the impact law
+//! struck (docs/MODEL.md §9), seed 8's deepest ball stays 0.14 mm into a wall, within the
+//! resting sink, so the test takes seed 6's bed, where a ball still sinks 0.32 mm and is put
+//! back. The assertions are unchanged.
 
 use crate::common::scene_from_toml;
 use lpc_damper::model::RunOptions;
@@ -19,8 +24,8 @@ fn a_ball_struck_in_a_crowd_into_a_wall_is_put_back() {
     let text = text
         .replace("amplitude = 0.00955", "amplitude = 0.004")
         .replace("horizon = 2.0", "horizon = 0.015")
-        .replace("seed = 1 ", "seed = 8 ");
-    assert!(text.contains("seed = 8 ") && text.contains("amplitude = 0.004"), "the scene names its seed and amplitude");
+        .replace("seed = 1 ", "seed = 6 ");
+    assert!(text.contains("seed = 6 ") && text.contains("amplitude = 0.004"), "the scene names its seed and amplitude");
     let scene = scene_from_toml(&text);
     let (run, report) = simulate_spatial_with(&scene, solver_settings(&scene), &RunOptions::default()).unwrap();
     assert!(report.sinks_put_back > 0 && report.deepest_wall_sink > wall_sink_limit(&scene), "{report:?}");
