@@ -3,15 +3,17 @@
 # rows of 1, 2, 3 and 5 touching steel-sized balls (r 6.75 mm, 10 g) fly at 1 m/s into the
 # left end wall of a 1 m box on a frame too heavy to move, at e = 1, floating (no gravity,
 # friction 0.1, on the spatial path) or resting on the floor (gravity, no friction), at steps
-# of 1 and 0.1 ms, for 30 ms. A row prints the energy left, or the reason the run stopped.
-#   bash benches/touching_rows.sh [LPC]   (default: target/release/lpc)
+# of DTS (default 1 and 0.1 ms), for 30 ms. A row prints the energy left, or the reason the run
+# stopped.
+#   bash benches/touching_rows.sh [LPC] [DTS]   (default: target/release/lpc, "0.001 0.0001")
 set -euo pipefail
 lpc=${1:-target/release/lpc}
+dts=${2:-0.001 0.0001}
 dir=$(mktemp -d)
 r=0.00675
 for place in float floor; do
   for n in 1 2 3 5; do
-    for dt in 0.001 0.0001; do
+    for dt in $dts; do
       f="$dir/row${n}_${place}_${dt}.toml"
       if [ "$place" = float ]; then
         world="restitution = 1.0\nfriction = 0.1"; z=0.0
