@@ -95,7 +95,14 @@ impl Finder {
                     return;
                 }
                 let d = [x[j][0] - x[i][0], x[j][1] - x[i][1], x[j][2] - x[i][2]];
-                let dist = (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt();
+                let squared = d[0] * d[0] + d[1] * d[1] + d[2] * d[2];
+                // Most balls of the cells around are farther than touching: they are passed
+                // over without a square root, with a margin far above its rounding.
+                let far = radius[i] + radius[j] + touching;
+                if squared > far * far * (1.0 + 1e-9) {
+                    return;
+                }
+                let dist = squared.sqrt();
                 let gap = dist - radius[i] - radius[j];
                 if gap <= touching && dist > 0.0 {
                     out.push(Contact { ball: i, other: Other::Ball(j), gap, normal: d.map(|c| c / dist) });
