@@ -400,6 +400,29 @@ impl FloorMotion {
         z
     }
 
+    /// Moves each floor `j` of `shifts` by its `dx` at the start of the segment just started
+    /// (impulses that landed within the step before it had moved it so far beyond its closed
+    /// form).
+    pub fn displace(&mut self, shifts: &[(usize, f64)]) {
+        for &(j, dx) in shifts {
+            self.z0[j] += dx;
+        }
+        self.reset();
+    }
+
+    /// The change of the storeys' spring energy at `t` were each floor `j` of `shifts` moved by
+    /// its `dx`, J.
+    pub fn displaced_energy(&self, t: f64, shifts: &[(usize, f64)]) -> f64 {
+        let (z, _) = self.floors(t);
+        let u = &z[..self.n()];
+        let mut moved = u.to_vec();
+        for &(j, dx) in shifts {
+            moved[j] += dx;
+        }
+        let building = &self.structure.building;
+        building.spring_energy(&moved) - building.spring_energy(u)
+    }
+
     /// The mass of balls each floor holds in this segment, kg.
     pub fn held(&self) -> &[f64] {
         &self.held

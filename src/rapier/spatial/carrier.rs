@@ -112,12 +112,21 @@ impl<'a> Carrier<'a> {
     }
 
     /// [`Carrier::restart`] for every carrying body: at `states` at `t`, going on at `v` and
-    /// carrying `carried` kg of balls.
-    pub(super) fn restart_bodies(&mut self, t: f64, states: &[(f64, f64)], v: &[f64], carried: &[f64]) -> Result<(), String> {
+    /// carrying `carried` kg of balls, each moved `travel` m beyond its closed form by the
+    /// impulses that landed within the step before `t` (docs/MODEL.md §9).
+    pub(super) fn restart_bodies(
+        &mut self,
+        t: f64,
+        states: &[(f64, f64)],
+        v: &[f64],
+        carried: &[f64],
+        travel: &[f64],
+    ) -> Result<(), String> {
+        let moved = travel.iter().any(|&d| d != 0.0);
         match self {
             Carrier::Floors(m, floors) if floors.len() > 1 => {
                 let struck: Vec<(usize, f64)> =
-                    floors.iter().zip(states.iter().zip(v)).filter(|(_, (s, v))| **v != s.1).map(|(&j, (_, &v))| (j, v)).collect();
+                    (0..floors.len()).filter(|&k| travel[k] != 0.0 || v[k] != states[k].1).map(|k| (floors[k], v[k])).collect();
                 let mut held = vec![0.0; m.n()];
                 for (&j, &c) in floors.iter().zip(carried) {
                     held[j] = c;
@@ -125,9 +134,31 @@ impl<'a> Carrier<'a> {
                 if !struck.is_empty() || m.held() != held.as_slice() {
                     m.restart_holding(t, &struck, &held)?;
                 }
+                if moved {
+                    let shifts: Vec<(usize, f64)> = floors.iter().copied().zip(travel.iter().copied()).filter(|&(_, d)| d != 0.0).collect();
+                    m.displace(&shifts);
+                }
                 Ok(())
             }
-            _ => self.restart(t, states[0], v[0], carried[0]),
+            Carrier::Floors(m, _) if moved => {
+                let d = m.structure.floor;
+                m.restart(t, v[0], carried[0])?;
+                m.displace(&[(d, travel[0])]);
+                Ok(())
+            }
+            _ => self.restart(t, (states[0].0 + travel[0], states[0].1), v[0], carried[0]),
+        }
+    }
+
+    /// The change of the carrier's spring energy at `t` were each carrying body moved by
+    /// `travel` m, J.
+    pub(super) fn travel_energy(&self, t: f64, travel: &[f64]) -> f64 {
+        match self {
+            Carrier::Frame { scene, .. } => {
+                let (x, v) = self.state(t);
+                scene.frame_energy(t, x + travel[0], v) - scene.frame_energy(t, x, v)
+            }
+            Carrier::Floors(m, floors) => m.displaced_energy(t, &floors.iter().copied().zip(travel.iter().copied()).collect::<Vec<_>>()),
         }
     }
 

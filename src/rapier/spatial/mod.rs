@@ -13,6 +13,7 @@
 mod balls;
 mod carried;
 mod carrier;
+mod closings;
 mod contacts;
 mod flights;
 mod hooks;
@@ -36,6 +37,7 @@ use crate::run::{EnergyAccount, Impacts, Recorder, Run, MAX_KEPT_IMPACTS};
 use crate::scene::Scene;
 use balls::BallState;
 use carrier::Carrier;
+use closings::{Closing, Solved, WallKicks};
 use contacts::{Balls, Contact, Containers, FrameBody, Other};
 use records::{impact_record, sample, sunk_too_deep};
 use settings::chambers;
@@ -202,7 +204,7 @@ pub fn simulate_spatial_with(scene: &Scene, solver: SolverSettings, options: &Ru
             }
         });
         let starts: Vec<(f64, f64)> = xs.iter().copied().zip(vs.iter().copied()).collect();
-        carrier.restart_bodies(0.0, &starts, &frame.vs, &carried.mass).map_err(ModelError::Refused)?;
+        carrier.restart_bodies(0.0, &starts, &frame.vs, &carried.mass, &vec![0.0; bodies]).map_err(ModelError::Refused)?;
         vs = frame.vs;
         now.write_velocities(&mut world, &struck);
     }
@@ -380,7 +382,7 @@ pub fn simulate_spatial_with(scene: &Scene, solver: SolverSettings, options: &Ru
                 return Err(sunk_too_deep(scene, t1, sunk, radius[sunk.0], (v1[b] - vs[b]) / h));
             }
         }
-        // Contacts whose approach Rapier stopped, the fastest first.
+        // Contacts whose approach Rapier stopped, and strikes kept out of its solve.
         let mut new: Vec<Closing> = Vec::new();
         contacts::count(&found, touching, &mut near, &mut held);
         joined.clear();
@@ -391,7 +393,9 @@ pub fn simulate_spatial_with(scene: &Scene, solver: SolverSettings, options: &Ru
                 let balls = Balls { v: &mut now.v, mass: &mass };
                 let approach = -contacts::relative(c, &balls, &frame).0;
                 if c.gap <= touching && approach > 0.0 {
-                    new.push(Closing { approach, k, gap0: 0.0, w0: -approach, g_n: 0.0, solved: None });
+                    // It strikes at the speed it approaches with when its turn comes.
+                    let solved = Some(Solved { undo: None, normal: c.normal });
+                    new.push(Closing { approach, tau: 0.0, k, gap0: 0.0, w0: -approach, g_n: 0.0, solved });
                 }
                 continue;
             }
@@ -442,16 +446,20 @@ pub fn simulate_spatial_with(scene: &Scene, solver: SolverSettings, options: &Ru
             // An impact is a contact Rapier's plastic solve stopped in this step: it was
             // approaching faster than a resting contact, and the step took its approach.
             let resting = resting_speed(c, &in_pile, &walls_a);
-            let approach = closing_speed(gap0, w0, g_n, h);
+            let (tau, approach) = contacts::closing(gap0, w0, g_n, h);
             let stopped = w_end - (w0 - g_n * h) > resting;
             // Rapier's solve joins the balls of a pair only where it acted on it: they touch,
             // or their approach changed by more than a resting contact's.
             joined[k] = c.gap <= touching || (w_end - (w0 - g_n * h)).abs() > resting;
             if approach > resting && stopped && c.gap <= touching + 2.0 * (-w0).max(0.0) * h {
-                new.push(Closing { approach, k, gap0, w0, g_n, solved });
+                new.push(Closing { approach, tau, k, gap0, w0, g_n, solved });
             }
         }
-        new.sort_by(|a, b| b.approach.total_cmp(&a.approach));
+        // The impacts act the fastest first, and strikes kept out of Rapier's solve after every
+        // impact Rapier stopped: their targets lie in piles whose stops the impact law has to
+        // turn into bounces before a strike meets them.
+        let held_back = |c: &Closing| strikes.holds(&found[c.k]);
+        new.sort_by(|a, b| held_back(a).cmp(&held_back(b)).then(b.approach.total_cmp(&a.approach)));
         // Groups of balls in flight that strike each other: Rapier's whole step of them is
         // undone (`flights`), and each of their impacts acts along the line its balls touch
         // along in free flight, at the speed they approach with when its turn comes.
@@ -482,11 +490,15 @@ pub fn simulate_spatial_with(scene: &Scene, solver: SolverSettings, options: &Ru
         }
         kicked.iter_mut().for_each(|k| *k = false);
         let mut step_impact_loss = 0.0;
+        let mut kicks = WallKicks::new(bodies);
         {
             let mut balls = Balls { v: &mut now.v, mass: &mass };
-            // How the step's wall impacts so far changed each body's velocity (§3): each wall
-            // impact meets the frame as the impacts before it left it.
-            let mut frame_change = vec![0.0; bodies];
+            // The balls' velocities before the step's impacts: what the impacts ahead of a wall
+            // impact changed in its ball shifts that impact's approach.
+            let unstruck = if new.is_empty() { Vec::new() } else { balls.v.to_vec() };
+            let change = |v: &[[f64; 3]], i: usize, normal: [f64; 3]| -> f64 {
+                contacts_dot(std::array::from_fn(|a| v[i][a] - unstruck[i][a]), normal)
+            };
             for closing in &new {
                 let c = found[closing.k];
                 let (approach, lost) = match c.other {
@@ -512,18 +524,25 @@ pub fn simulate_spatial_with(scene: &Scene, solver: SolverSettings, options: &Ru
                         (approach, contacts::strike(&c, approach, e, &mut balls, &mut frame))
                     }
                     Other::Wall(_) if undone[c.ball] => {
-                        // A ball of a group in flight strikes the wall at the speed it
-                        // approaches with when its turn comes.
-                        let approach = -contacts::relative(&c, &balls, &frame).0;
+                        // A ball of a group in flight strikes the walls at the speed it
+                        // approaches them with when its turn comes, as they move then: the
+                        // frame's closed form and the step's wall impacts before this one.
+                        let (n, b) = (c.normal, body_of[c.ball]);
+                        let walls_then = kicks.walls_then(b, (vs[b], v1[b]), closing.tau, h);
+                        let approach = contacts_dot(balls.v[c.ball], n) - n[0] * walls_then;
                         if approach <= 0.0 {
                             continue;
                         }
-                        (approach, contacts::strike(&c, approach, e, &mut balls, &mut frame))
+                        let (impulse, lost) = kicks.strike(b, (mass[c.ball], body_mass[b]), n[0], approach, e, (closing.tau, h));
+                        contacts::push_apart(&c, impulse, &mut balls, &mut frame);
+                        (approach, lost)
                     }
                     Other::Wall(_) => {
                         let n = c.normal;
                         let b = body_of[c.ball];
-                        let w0 = closing.w0 + n[0] * frame_change[b];
+                        // Rapier stopped the ball at its own approach: what the impacts before
+                        // this one did to it and to the walls shifts that approach.
+                        let w0 = closing.w0 + n[0] * kicks.change[b] - change(balls.v, c.ball, n);
                         let (tau, approach) = contacts::closing(closing.gap0, w0, closing.g_n, h);
                         if approach <= 0.0 {
                             continue;
@@ -531,14 +550,13 @@ pub fn simulate_spatial_with(scene: &Scene, solver: SolverSettings, options: &Ru
                         // Eq. 9-10 with the frame as it is at this impact's turn and instant:
                         // the ball leaves at the walls' normal velocity then, less `e` times the
                         // approach, less the frame's share of the recoil.
-                        let (m, inv_frame) = (mass[c.ball], n[0] * n[0] / body_mass[b]);
-                        let mu = 1.0 / (1.0 / m + inv_frame);
-                        let walls_then = vs[b] + (v1[b] - vs[b]) * tau / h + frame_change[b];
-                        let ball_after = n[0] * walls_then + approach - (1.0 + e) * approach * mu / m;
+                        let m = mass[c.ball];
+                        let walls_then = kicks.walls_then(b, (vs[b], v1[b]), tau, h);
+                        let (impulse, lost) = kicks.strike(b, (m, body_mass[b]), n[0], approach, e, (tau, h));
+                        let ball_after = n[0] * walls_then + approach - impulse / m;
                         let ball_now = contacts_dot(balls.v[c.ball], n);
                         contacts::push_apart(&c, m * (ball_now - ball_after), &mut balls, &mut frame);
-                        frame_change[b] += (1.0 + e) * approach * mu * n[0] / body_mass[b];
-                        (approach, 0.5 * (1.0 - e * e) * mu * approach * approach)
+                        (approach, lost)
                     }
                 };
                 step_impact_loss += lost;
@@ -579,7 +597,9 @@ pub fn simulate_spatial_with(scene: &Scene, solver: SolverSettings, options: &Ru
             (0..n).map(|i| 0.5 * mass[i] * contacts_dot(s.v[i], s.v[i]) + 0.5 * inertia[i] * contacts_dot(s.w[i], s.w[i])).sum()
         };
         let gravity_work: f64 = (0..n).map(|i| mass[i] * contacts_dot(g, std::array::from_fn(|a| now.x[i][a] - before.x[i][a]))).sum();
-        let frame_jump: f64 = (0..bodies).map(|b| 0.5 * body_mass[b] * (frame.vs[b] * frame.vs[b] - v1[b] * v1[b])).sum();
+        let moved = kicks.travel.iter().any(|&d| d != 0.0);
+        let frame_jump: f64 = (0..bodies).map(|b| 0.5 * body_mass[b] * (frame.vs[b] * frame.vs[b] - v1[b] * v1[b])).sum::<f64>()
+            + if moved { carrier.travel_energy(t1, &kicks.travel) } else { 0.0 };
         // The carrier's closed form did work on the mass it carried: its own energy changed by
         // the excitation's work, less its dampers' loss, less that work.
         let carried_work: f64 = (0..bodies).map(|b| 0.5 * carrying[b] * (v1[b] * v1[b] - vs[b] * vs[b])).sum();
@@ -610,7 +630,15 @@ pub fn simulate_spatial_with(scene: &Scene, solver: SolverSettings, options: &Ru
         let change: Vec<f64> = (0..bodies).map(|b| v1[b] - vs[b]).collect();
         carried.update(&response, &change);
         let ends: Vec<(f64, f64)> = x1.iter().copied().zip(v1.iter().copied()).collect();
-        carrier.restart_bodies(t1, &ends, &frame.vs, &carried.mass).map_err(ModelError::Refused)?;
+        carrier.restart_bodies(t1, &ends, &frame.vs, &carried.mass, &kicks.travel).map_err(ModelError::Refused)?;
+        // Rapier's walls go where the impulses took them.
+        let x1: Vec<f64> = if moved { x1.iter().zip(&kicks.travel).map(|(x, d)| x + d).collect() } else { x1 };
+        if moved {
+            for (d, damper) in world.dampers.iter_mut().enumerate() {
+                let x = x1[body_of_damper[d]];
+                damper.physics.bodies[damper.frame].set_translation(Vector::new(x as f32, 0.0, 0.0), false);
+            }
+        }
         while next_sample < sample_count && scene.sample_at_step_end(next_sample as f64 * scene.sample_dt, t1, h) {
             let a = &now;
             sample(&mut recorder, scene, &carrier, next_sample as f64 * scene.sample_dt, (x1[0], frame.vs[0]), |i| (a.x[i], a.v[i]));
@@ -641,32 +669,6 @@ pub fn simulate_spatial_with(scene: &Scene, solver: SolverSettings, options: &Ru
     run.horizon = scene.horizon;
     run.wall_time_s = meter.elapsed();
     Ok((run, report))
-}
-
-/// A contact Rapier stopped in the step: its closing speed and what it was computed from.
-struct Closing {
-    /// Approach speed at closing, m/s.
-    approach: f64,
-    /// Index of the contact.
-    k: usize,
-    /// Gap at the step's start, m.
-    gap0: f64,
-    /// Relative normal velocity at the step's start, m/s.
-    w0: f64,
-    /// Gravity along the normal (towards a wall), m/s^2.
-    g_n: f64,
-    /// For two balls that met in flight, how Rapier solved them and where they touched.
-    solved: Option<Solved>,
-}
-
-/// How Rapier's plastic solve changed a pair of balls that met in flight in a step.
-#[derive(Clone, Copy)]
-struct Solved {
-    /// The line along which the step's change of the pair's relative velocity is undone, and
-    /// that change along it, m/s (none when the pair's group had its whole step undone).
-    undo: Option<([f64; 3], f64)>,
-    /// The line of the centres where free flight brings them to touch: the impact's normal.
-    normal: [f64; 3],
 }
 
 /// Ball `b`'s vector less ball `a`'s, of `v` (positions or velocities).
