@@ -5,7 +5,8 @@
 pub(super) struct Closing {
     /// Approach speed at closing, m/s.
     pub approach: f64,
-    /// When in the step free flight closes it, s after the step's start.
+    /// When in the step free flight closes it, s after the step's start (0 for a strike kept
+    /// out of Rapier's solve, a pair of balls, whose turn no instant sets).
     pub tau: f64,
     /// Index of the contact.
     pub k: usize,
