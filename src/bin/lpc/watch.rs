@@ -36,54 +36,70 @@ pub fn watched_model(model: Model, scene: &Scene, options: RunOptions) -> std::r
     let options = RunOptions { progress: Some(&progress), ..options };
     let unit = model.step_unit();
     let done = AtomicBool::new(false);
-    let result = std::thread::scope(|s| {
-        let watcher = s.spawn(|| {
-            let bar = if on_terminal() { ProgressBar::new(1000) } else { ProgressBar::hidden() };
-            let shown = std::cell::Cell::new(false);
-            let say = |said: cost::Said| {
-                // Said on a terminal or in a log: what the whole run will cost.
-                let e = said.estimate;
-                let line = format!(
-                    "{model}: `{}` {}: about {} {unit} and {:.1} s of computing in all, at its recent rate (t = {:.3e} of {} s \
+    let watch = || {
+        let bar = if on_terminal() { ProgressBar::new(1000) } else { ProgressBar::hidden() };
+        let shown = std::cell::Cell::new(false);
+        let say = |said: cost::Said| {
+            // Said on a terminal or in a log: what the whole run will cost.
+            let e = said.estimate;
+            let line = format!(
+                "{model}: `{}` {}: about {} {unit} and {:.1} s of computing in all, at its recent rate (t = {:.3e} of {} s \
                      after {:.2} s and {} {unit}; lately {} {unit} per simulated second, {:.2e} s each; a run's cost can change \
                      tenfold as it goes, so this is revised when it moves twofold; --max-steps and --max-wall-time bound it)",
-                    scene.name,
-                    if said.revision { "revised" } else { "is a long run" },
-                    human(e.steps.round()),
-                    e.seconds,
-                    said.t,
-                    human(scene.horizon),
-                    said.elapsed_s,
-                    said.steps,
-                    human(e.steps_per_simulated_second.round()),
-                    e.seconds_per_step,
-                );
-                if bar.is_hidden() || !shown.get() {
-                    eprintln!("{line}");
-                } else {
-                    bar.println(line);
-                }
-            };
-            let tick = |elapsed_s: f64, t: f64, steps: u64| {
-                if elapsed_s < QUIET_FOR_S {
-                    return;
-                }
-                if !shown.replace(true) {
-                    let template = format!("{model} [{{bar:30}}] {{msg}} ({{elapsed}}, about {{eta}} to go)");
-                    bar.set_style(ProgressStyle::with_template(&template).expect("valid template"));
-                }
-                bar.set_position((1000.0 * t / scene.horizon).clamp(0.0, 1000.0) as u64);
-                bar.set_message(format!("t = {t:.3e} of {:.3e} s, {steps} {unit}", scene.horizon));
-            };
-            cost::watch(&progress, scene.horizon, &done, say, tick);
-            bar.finish_and_clear();
-        });
-        let result = model.simulate(scene, &options);
-        done.store(true, Ordering::Relaxed);
-        watcher.thread().unpark();
-        result
-    });
-    result
+                scene.name,
+                if said.revision { "revised" } else { "is a long run" },
+                human(e.steps.round()),
+                e.seconds,
+                said.t,
+                human(scene.horizon),
+                said.elapsed_s,
+                said.steps,
+                human(e.steps_per_simulated_second.round()),
+                e.seconds_per_step,
+            );
+            if bar.is_hidden() || !shown.get() {
+                eprintln!("{line}");
+            } else {
+                bar.println(line);
+            }
+        };
+        let tick = |elapsed_s: f64, t: f64, steps: u64| {
+            if elapsed_s < QUIET_FOR_S {
+                return;
+            }
+            if !shown.replace(true) {
+                let template = format!("{model} [{{bar:30}}] {{msg}} ({{elapsed}}, about {{eta}} to go)");
+                bar.set_style(ProgressStyle::with_template(&template).expect("valid template"));
+            }
+            bar.set_position((1000.0 * t / scene.horizon).clamp(0.0, 1000.0) as u64);
+            bar.set_message(format!("t = {t:.3e} of {:.3e} s, {steps} {unit}", scene.horizon));
+        };
+        cost::watch(&progress, scene.horizon, &done, say, tick);
+        bar.finish_and_clear();
+    };
+    beside_watcher(&done, watch, || model.simulate(scene, &options))
+}
+
+/// Runs `run` beside `watch` (on its own thread, which watches until `done`) and ends the watch
+/// when `run` returns or panics: the scope waits for the watcher before a panic goes on, so a
+/// watch left running would hang the command.
+fn beside_watcher<R>(done: &AtomicBool, watch: impl FnOnce() + Send, run: impl FnOnce() -> R) -> R {
+    /// Ends the watch when dropped, as the run ends either way.
+    struct RunEnded<'a> {
+        done: &'a AtomicBool,
+        watcher: std::thread::Thread,
+    }
+    impl Drop for RunEnded<'_> {
+        fn drop(&mut self) {
+            self.done.store(true, Ordering::Relaxed);
+            self.watcher.unpark();
+        }
+    }
+    std::thread::scope(|s| {
+        let watcher = s.spawn(watch);
+        let _ended = RunEnded { done, watcher: watcher.thread().clone() };
+        run()
+    })
 }
 
 /// [`watched_model`], its error as the command's.
@@ -201,5 +217,29 @@ impl Work {
 impl Drop for Work {
     fn drop(&mut self) {
         self.stop();
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A run that panics ends its watch, and the panic goes on instead of the command hanging.
+    #[test]
+    fn a_run_that_panics_ends_its_watch() {
+        let (sender, receiver) = std::sync::mpsc::channel();
+        std::thread::spawn(move || {
+            let done = AtomicBool::new(false);
+            let watch = || {
+                while !done.load(Ordering::Relaxed) {
+                    std::thread::park_timeout(Duration::from_millis(10));
+                }
+            };
+            let run = || -> () { panic!("a model's bug") };
+            let outcome = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| beside_watcher(&done, watch, run)));
+            sender.send(outcome.is_err()).ok();
+        });
+        // A watch left running never lets the scope end: no answer comes at all.
+        assert_eq!(receiver.recv_timeout(Duration::from_secs(60)), Ok(true));
     }
 }
