@@ -70,18 +70,56 @@ impl Cells {
 
     /// Calls `visit(j)` for every ball `j > i` in ball `i`'s cell and the cells around it.
     pub(crate) fn neighbours(&self, i: usize, mut visit: impl FnMut(usize)) {
+        self.runs_within(i, [0.0; 3], f64::INFINITY, |run| {
+            for &j in &self.items[run] {
+                if j as usize > i {
+                    visit(j as usize);
+                }
+            }
+        });
+    }
+
+    /// The balls in cell order: each cell's, by index, cell after cell.
+    pub(crate) fn items(&self) -> &[u32] {
+        &self.items
+    }
+
+    /// Calls `visit(run)` for where ball `i`'s cell and the cells around it lie in
+    /// [`Cells::items`], less the cells farther than `reach` from `p` (ball `i`'s position in the
+    /// container's frame; the cells on the grid's faces reach on without end, as they hold the
+    /// balls beyond it). A run of neighbouring cells along z is one range, so there are nine
+    /// ranges at most, in the cells' order.
+    pub(crate) fn runs_within(&self, i: usize, p: [f64; 3], reach: f64, mut visit: impl FnMut(std::ops::Range<usize>)) {
         let c = self.cell_of[i] as usize;
         let at = [c / (self.dims[1] * self.dims[2]), (c / self.dims[2]) % self.dims[1], c % self.dims[2]];
-        let range = |k: usize| at[k].saturating_sub(1)..=(at[k] + 1).min(self.dims[k] - 1);
-        for a in range(0) {
-            for b in range(1) {
-                for d in range(2) {
-                    let cell = self.index([a, b, d]);
-                    for &j in &self.items[self.start[cell] as usize..self.start[cell + 1] as usize] {
-                        if j as usize > i {
-                            visit(j as usize);
-                        }
+        let low = |k: usize| at[k].saturating_sub(1);
+        let high = |k: usize| (at[k] + 1).min(self.dims[k] - 1);
+        // The square of how far `p` lies from the cells `a` along axis `k`.
+        let off = |k: usize, a: usize| {
+            let below = if a == 0 { f64::NEG_INFINITY } else { self.low[k] + a as f64 * self.size[k] };
+            let above = if a + 1 == self.dims[k] { f64::INFINITY } else { self.low[k] + (a + 1) as f64 * self.size[k] };
+            let d = (below - p[k]).max(p[k] - above).max(0.0);
+            d * d
+        };
+        // A margin far above the rounding of the cells' bounds and of the balls' offsets.
+        let limit = reach * reach * (1.0 + 1e-6);
+        let (z_low, z_high) = (low(2), high(2));
+        let along_z: [f64; 3] = std::array::from_fn(|d| if z_low + d <= z_high { off(2, z_low + d) } else { 0.0 });
+        for a in low(0)..=high(0) {
+            let along_x = off(0, a);
+            for b in low(1)..=high(1) {
+                let across = along_x + off(1, b);
+                // The cells of a column within reach are a run: `off` grows away from `p`.
+                let (mut first, mut last) = (usize::MAX, 0);
+                for (d, z) in along_z.iter().enumerate().take(z_high - z_low + 1) {
+                    if across + z <= limit {
+                        first = first.min(d);
+                        last = d;
                     }
+                }
+                if first <= last {
+                    let (first, last) = (self.index([a, b, z_low + first]), self.index([a, b, z_low + last]));
+                    visit(self.start[first] as usize..self.start[last + 1] as usize);
                 }
             }
         }
@@ -130,6 +168,40 @@ mod tests {
             found.sort();
             assert_eq!(found, all);
             assert!(!all.is_empty());
+        }
+    }
+
+    /// The runs within a reach of a ball hold every ball within that reach of it, and only balls
+    /// of the cells around it, on grids one or two cells deep along an axis and with balls
+    /// beyond the grid's faces.
+    #[test]
+    fn runs_within_reach_hold_every_ball_within_it() {
+        let width = 0.1;
+        let point = |k: usize, extent: [f64; 3]| -> [f64; 3] {
+            let u = [(k as f64 * 0.618_033_988_75).fract(), (k as f64 * 0.414_213_562_37).fract(), (k as f64 * 0.732_050_807_57).fract()];
+            // Some balls lie a little beyond the grid, as a ball sunk into a wall does.
+            std::array::from_fn(|a| (1.1 * u[a] - 0.05) * extent[a] - if a == 0 { 0.0 } else { 0.5 * extent[a] })
+        };
+        for extent in [[1.0, 0.5, 0.3], [0.15, 0.1, 0.25], [0.35, 0.05, 1.0]] {
+            let p: Vec<[f64; 3]> = (0..300).map(|k| point(k, extent)).collect();
+            let mut cells = Cells::new(extent, width, p.len());
+            cells.rebuild(|i| p[i]);
+            for reach in [0.03, 0.07, width] {
+                for i in 0..p.len() {
+                    let mut visited = Vec::new();
+                    cells.runs_within(i, p[i], reach, |run| visited.extend(cells.items()[run].iter().map(|&j| j as usize)));
+                    let mut around = Vec::new();
+                    cells.neighbours(i, |j| around.push(j));
+                    for j in (i + 1)..p.len() {
+                        let d: f64 = (0..3).map(|a| (p[i][a] - p[j][a]).powi(2)).sum::<f64>().sqrt();
+                        if d <= reach {
+                            assert!(visited.contains(&j), "{extent:?} {reach}: ball {j} at {d} from {i}");
+                        }
+                    }
+                    assert!(visited.iter().filter(|&&j| j > i).all(|j| around.contains(j)));
+                    assert_eq!(visited.len(), visited.iter().collect::<std::collections::HashSet<_>>().len());
+                }
+            }
         }
     }
 }

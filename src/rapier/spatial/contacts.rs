@@ -60,6 +60,17 @@ pub struct Containers<'a> {
 #[derive(Default)]
 pub struct Finder {
     cells: Option<(Cells, f64)>,
+    /// The balls in the cells' order, so that the search around a ball reads them in sequence.
+    in_cells: Vec<Nearby>,
+}
+
+/// A ball as the search around another reads it.
+#[derive(Clone, Copy)]
+struct Nearby {
+    index: u32,
+    damper: u32,
+    x: [f64; 3],
+    radius: f64,
 }
 
 impl Finder {
@@ -81,6 +92,11 @@ impl Finder {
         let Some((cells, _)) = self.cells.as_mut() else { return };
         let local = |i: usize| [x[i][0] - xs[damper[i] as usize], x[i][1], x[i][2]];
         cells.rebuild(local);
+        self.in_cells.clear();
+        self.in_cells.extend(cells.items().iter().map(|&j| {
+            let k = j as usize;
+            Nearby { index: j, damper: damper[k], x: x[k], radius: radius[k] }
+        }));
         for i in 0..n {
             let p = local(i);
             let geometry = &chambers[damper[i] as usize];
@@ -90,22 +106,28 @@ impl Finder {
                     out.push(Contact { ball: i, other: Other::Wall(wall), gap, normal });
                 }
             }
-            cells.neighbours(i, |j| {
-                if damper[j] != damper[i] {
-                    return;
-                }
-                let d = [x[j][0] - x[i][0], x[j][1] - x[i][1], x[j][2] - x[i][2]];
-                let squared = d[0] * d[0] + d[1] * d[1] + d[2] * d[2];
-                // Most balls of the cells around are farther than touching: they are passed
-                // over without a square root, with a margin far above its rounding.
-                let far = radius[i] + radius[j] + touching;
-                if squared > far * far * (1.0 + 1e-9) {
-                    return;
-                }
-                let dist = squared.sqrt();
-                let gap = dist - radius[i] - radius[j];
-                if gap <= touching && dist > 0.0 {
-                    out.push(Contact { ball: i, other: Other::Ball(j), gap, normal: d.map(|c| c / dist) });
+            // Balls farther than the largest radius and `touching` from this ball's surface
+            // cannot touch it: the cells beyond are passed over.
+            let in_cells = &self.in_cells;
+            cells.runs_within(i, p, radius[i] + largest + touching, |run| {
+                for other in &in_cells[run] {
+                    let j = other.index as usize;
+                    if j <= i || other.damper != damper[i] {
+                        continue;
+                    }
+                    let d = [other.x[0] - x[i][0], other.x[1] - x[i][1], other.x[2] - x[i][2]];
+                    let squared = d[0] * d[0] + d[1] * d[1] + d[2] * d[2];
+                    // Most balls of the cells around are farther than touching: they are passed
+                    // over without a square root, with a margin far above its rounding.
+                    let far = radius[i] + other.radius + touching;
+                    if squared > far * far * (1.0 + 1e-9) {
+                        continue;
+                    }
+                    let dist = squared.sqrt();
+                    let gap = dist - radius[i] - other.radius;
+                    if gap <= touching && dist > 0.0 {
+                        out.push(Contact { ball: i, other: Other::Ball(j), gap, normal: d.map(|c| c / dist) });
+                    }
                 }
             });
         }
