@@ -14,7 +14,10 @@ use super::contacts::{Contact, Other};
 pub struct Flights {
     root: Vec<u32>,
     in_flight: Vec<bool>,
-    struck: Vec<bool>,
+    off_walls: Vec<bool>,
+    /// Each group's balls, and what it strikes ([`BALLS`], [`WALL`]).
+    size: Vec<u32>,
+    struck: Vec<u32>,
 }
 
 impl Flights {
@@ -29,19 +32,23 @@ impl Flights {
 
     /// Marks in `undone` the balls of every group, joined by the ball pairs of `found` (every
     /// pair a step may have closed, at its end) marked in `joined` (those Rapier's solve acted
-    /// on), whose balls were all free at the step's start (`free`: not pressed against a ball
-    /// or a wall) and of which two strike each other (a pair of `struck`). Returns whether it
-    /// marked any; a step without strikes between balls costs nothing more.
+    /// on), that is in flight: its balls were all free at the step's start (`free`: not pressed
+    /// against a ball or a wall) and two of them strike each other (a pair of `struck`), or it
+    /// is a group of two or more balls that rested on no wall at the step's start (`off_walls`)
+    /// of which one strikes a wall (a ball of `wall_struck`). Returns whether it marked any; a
+    /// step without such strikes costs nothing more.
     pub fn mark(
         &mut self,
         found: &[Contact],
         joined: &[bool],
-        free: impl Fn(usize) -> bool,
+        (free, off_walls): (impl Fn(usize) -> bool, impl Fn(usize) -> bool),
         struck: impl Iterator<Item = (usize, usize)>,
+        wall_struck: impl Iterator<Item = usize>,
         undone: &mut [bool],
     ) -> bool {
         let mut struck = struck.peekable();
-        if struck.peek().is_none() {
+        let mut wall_struck = wall_struck.peekable();
+        if struck.peek().is_none() && wall_struck.peek().is_none() {
             undone.iter_mut().for_each(|flag| *flag = false);
             return false;
         }
@@ -56,27 +63,44 @@ impl Flights {
                 }
             }
         }
-        self.in_flight.clear();
-        self.in_flight.resize(n, true);
-        self.struck.clear();
-        self.struck.resize(n, false);
+        for flags in [&mut self.in_flight, &mut self.off_walls] {
+            flags.clear();
+            flags.resize(n, true);
+        }
+        for counts in [&mut self.size, &mut self.struck] {
+            counts.clear();
+            counts.resize(n, 0);
+        }
         for i in 0..n {
             let r = self.find(i);
             self.in_flight[r] &= free(i);
+            self.off_walls[r] &= off_walls(i);
+            self.size[r] += 1;
         }
+        // A group in flight whose balls strike each other, or a group off the walls that
+        // strikes one.
         for (a, _) in struck {
             let r = self.find(a);
-            self.struck[r] = true;
+            self.struck[r] |= BALLS;
+        }
+        for a in wall_struck {
+            let r = self.find(a);
+            self.struck[r] |= WALL;
         }
         let mut any = false;
         for (i, flag) in undone.iter_mut().enumerate() {
             let r = self.find(i);
-            *flag = self.in_flight[r] && self.struck[r];
+            let (kinds, size) = (self.struck[r], self.size[r]);
+            *flag = (self.in_flight[r] && kinds & BALLS != 0) || (self.off_walls[r] && size >= 2 && kinds & WALL != 0);
             any |= *flag;
         }
         any
     }
 }
+
+/// What a group strikes in a step: each other, a wall.
+const BALLS: u32 = 1;
+const WALL: u32 = 2;
 
 #[cfg(test)]
 mod tests {
@@ -99,7 +123,14 @@ mod tests {
         ];
         let mut undone = vec![false; 8];
         // Ball 4 touched something at the step's start; 5 and 6 do not strike.
-        let any = Flights::default().mark(&found, &[true; 5], |i| i != 4, [(1, 2), (3, 4)].into_iter(), &mut undone);
+        let any = Flights::default().mark(
+            &found,
+            &[true; 5],
+            (|i| i != 4, |_| false),
+            [(1, 2), (3, 4)].into_iter(),
+            std::iter::empty(),
+            &mut undone,
+        );
         assert_eq!(undone, [true, true, true, false, false, false, false, false]);
         assert!(any);
     }

@@ -28,6 +28,7 @@ pub struct Strikes {
     touches_any: Vec<bool>,
     touches_end_wall: Vec<bool>,
     pressed: Vec<bool>,
+    held_by_wall: Vec<bool>,
     closings: Vec<u32>,
     /// Each ball's partner in a strike of the step, if it is in one.
     partner: Vec<Option<usize>>,
@@ -58,7 +59,8 @@ impl Strikes {
     ) {
         let n = v.len();
         self.list.clear();
-        for flags in [&mut self.touches_ball, &mut self.touches_any, &mut self.touches_end_wall, &mut self.pressed] {
+        for flags in [&mut self.touches_ball, &mut self.touches_any, &mut self.touches_end_wall, &mut self.pressed, &mut self.held_by_wall]
+        {
             flags.clear();
             flags.resize(n, false);
         }
@@ -87,8 +89,11 @@ impl Strikes {
                     self.closings[j] += 1;
                 }
                 Other::Wall(_) if c.gap <= touching => {
-                    let parting = walls_v(c.ball) * c.normal[0] - dot(v[c.ball], c.normal) > resting(c);
+                    let w = walls_v(c.ball) * c.normal[0] - dot(v[c.ball], c.normal);
+                    let parting = w > resting(c);
                     self.pressed[c.ball] |= !parting;
+                    // A ball that closes on the wall faster than a resting contact strikes it.
+                    self.held_by_wall[c.ball] |= !parting && w >= -resting(c);
                     self.touches_any[c.ball] = true;
                     self.touches_end_wall[c.ball] |= c.normal[0] != 0.0;
                 }
@@ -130,6 +135,12 @@ impl Strikes {
     /// not part from it faster than a resting contact.
     pub fn pressed(&self, i: usize) -> bool {
         self.pressed[i]
+    }
+
+    /// Whether ball `i` rested on a wall at the step's start: it touched the wall and neither
+    /// parted from it nor closed on it faster than a resting contact.
+    pub fn held_by_wall(&self, i: usize) -> bool {
+        self.held_by_wall[i]
     }
 
     /// Whether contact `c` is between the balls of one of the step's strikes.

@@ -35,6 +35,7 @@ mod record_beyond_double_range;
 mod record_point_inside_step;
 mod resting_ball_without_energy;
 mod row_pressed_into_wall;
+mod row_struck_into_wall;
 mod series_beyond_memory;
 mod spatial_counts_impacts;
 mod spatial_series_read_back;

@@ -11,8 +11,10 @@
 //! resting sink, so the test took seed 6's bed, where a ball still sank 0.32 mm. Since the
 //! impacts meet what the step's earlier impacts moved (docs/MODEL.md §9), no ball of the 4 mm
 //! drive's beds sinks past the resting sink (seed 6's deepest 0.12 mm), so the test takes seed
-//! 6's bed at a 3 mm drive, where a ball sinks 0.27 mm and is put back. The assertions are
-//! unchanged.
+//! 6's bed at a 3 mm drive, where a ball sinks 0.27 mm and is put back. Since touching groups
+//! that strike a wall have their step undone (docs/MODEL.md §9), seed 6's deepest ball stays
+//! 0.12 mm into a wall at 3 mm, so the test takes seed 7's bed at the study's own drive, where a
+//! ball sinks 0.33 mm and is put back. The assertions are unchanged.
 
 use crate::common::scene_from_toml;
 use lpc_damper::model::RunOptions;
@@ -24,11 +26,8 @@ use lpc_damper::Model;
 fn a_ball_struck_in_a_crowd_into_a_wall_is_put_back() {
     let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR"));
     let text = std::fs::read_to_string(root.join("benches/driven-box.toml")).unwrap();
-    let text = text
-        .replace("amplitude = 0.00955", "amplitude = 0.003")
-        .replace("horizon = 2.0", "horizon = 0.015")
-        .replace("seed = 1 ", "seed = 6 ");
-    assert!(text.contains("seed = 6 ") && text.contains("amplitude = 0.003"), "the scene names its seed and amplitude");
+    let text = text.replace("horizon = 2.0", "horizon = 0.015").replace("seed = 1 ", "seed = 7 ");
+    assert!(text.contains("seed = 7 ") && text.contains("amplitude = 0.00955"), "the scene names its seed and amplitude");
     let scene = scene_from_toml(&text);
     let (run, report) = simulate_spatial_with(&scene, solver_settings(&scene), &RunOptions::default()).unwrap();
     assert!(report.sinks_put_back > 0 && report.deepest_wall_sink > wall_sink_limit(&scene), "{report:?}");
