@@ -5,7 +5,9 @@
 //! have changed, and a gas loses or gains energy at `e = 1`. A group of balls joined only by
 //! each other's contacts, none of which was pressed against anything at the step's start, felt
 //! nothing in the step but Rapier's solve of those contacts and gravity: its whole step is
-//! undone, and its impacts act one after the other on the velocities free flight gives.
+//! undone, and its impacts act one after the other on the velocities free flight gives. So is
+//! the step of a touching group off the walls of which a ball strikes a wall ("Touching rows
+//! struck into a wall"): Rapier's solve stops such a row as one block.
 
 use super::contacts::{Contact, Other};
 
@@ -132,6 +134,19 @@ mod tests {
             &mut undone,
         );
         assert_eq!(undone, [true, true, true, false, false, false, false, false]);
+        assert!(any);
+    }
+
+    /// A group off the walls is undone when one of its balls strikes a wall and it has two
+    /// balls or more; a group with a ball resting on a wall, or a lone ball, is not.
+    #[test]
+    fn undoes_groups_off_the_walls_that_strike_one() {
+        let found = [pair(0, 1), pair(2, 3), pair(3, 4)];
+        let mut undone = vec![false; 6];
+        // Ball 4 rested on a wall; ball 5 is alone; none was free of the others.
+        let any =
+            Flights::default().mark(&found, &[true; 3], (|_| false, |i| i != 4), std::iter::empty(), [1, 2, 5].into_iter(), &mut undone);
+        assert_eq!(undone, [true, true, false, false, false, false]);
         assert!(any);
     }
 }
