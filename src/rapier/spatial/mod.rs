@@ -471,8 +471,8 @@ pub fn simulate_spatial_with(scene: &Scene, solver: SolverSettings, options: &Ru
         // So are touching groups that rested on no wall of which a ball strikes a wall: Rapier's
         // solve stops the whole group at once, where the impact law passes the strike along it.
         let struck_walls = new.iter().map(|closing| &found[closing.k]).filter(|c| matches!(c.other, Other::Wall(_))).map(|c| c.ball);
-        let free = (|i| !strikes.pressed(i), |i| !strikes.held_by_wall(i));
-        let any_undone = flights.mark(&found, &joined, free, struck_pairs, struck_walls, &mut undone);
+        let free_or_off_walls = (|i| !strikes.pressed(i), |i| !strikes.held_by_wall(i));
+        let any_undone = flights.mark(&found, &joined, free_or_off_walls, struck_pairs, struck_walls, &mut undone);
         if any_undone {
             for i in (0..n).filter(|&i| undone[i]) {
                 let free: [f64; 3] = std::array::from_fn(|a| before.v[i][a] + g[a] * h);

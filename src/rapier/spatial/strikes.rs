@@ -89,11 +89,11 @@ impl Strikes {
                     self.closings[j] += 1;
                 }
                 Other::Wall(_) if c.gap <= touching => {
-                    let w = walls_v(c.ball) * c.normal[0] - dot(v[c.ball], c.normal);
-                    let parting = w > resting(c);
+                    let (w, rest) = (walls_v(c.ball) * c.normal[0] - dot(v[c.ball], c.normal), resting(c));
+                    let parting = w > rest;
                     self.pressed[c.ball] |= !parting;
                     // A ball that closes on the wall faster than a resting contact strikes it.
-                    self.held_by_wall[c.ball] |= !parting && w >= -resting(c);
+                    self.held_by_wall[c.ball] |= !parting && w >= -rest;
                     self.touches_any[c.ball] = true;
                     self.touches_end_wall[c.ball] |= c.normal[0] != 0.0;
                 }
