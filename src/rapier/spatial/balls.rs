@@ -54,6 +54,18 @@ impl BallState {
         }
     }
 
+    /// Gives Rapier the positions of the balls marked in `which`, keeping what it will read
+    /// back (the `f32` position).
+    pub(super) fn write_positions(&mut self, world: &mut SpatialWorld, which: &[bool]) {
+        for k in (0..world.balls.len()).filter(|&k| which[k]) {
+            let x = self.x[k];
+            let body = world.ball_mut(k);
+            body.set_translation(Vector::new(x[0] as f32, x[1] as f32, x[2] as f32), true);
+            let p = body.translation();
+            self.x[k] = [p.x as f64, p.y as f64, p.z as f64];
+        }
+    }
+
     /// Puts every ball that `found` (the contacts at the step's end) shows sunk into a wall by
     /// more than `limit` back out along the wall's normal to `resting` (positions only: no
     /// velocity or energy changes), in Rapier too; the velocities are left to the impact law,

@@ -20,6 +20,7 @@ pub struct Flights {
     /// Each group's balls, and what it strikes ([`BALLS`], [`WALL`]).
     size: Vec<u32>,
     struck: Vec<u32>,
+    into_wall: Vec<bool>,
 }
 
 impl Flights {
@@ -52,6 +53,7 @@ impl Flights {
         let mut wall_struck = wall_struck.peekable();
         if struck.peek().is_none() && wall_struck.peek().is_none() {
             undone.iter_mut().for_each(|flag| *flag = false);
+            self.into_wall.iter_mut().for_each(|flag| *flag = false);
             return false;
         }
         let n = undone.len();
@@ -90,19 +92,86 @@ impl Flights {
             self.struck[r] |= WALL;
         }
         let mut any = false;
+        self.into_wall.clear();
+        self.into_wall.resize(n, false);
         for (i, flag) in undone.iter_mut().enumerate() {
             let r = self.find(i);
             let (kinds, size) = (self.struck[r], self.size[r]);
-            *flag = (self.in_flight[r] && kinds & BALLS != 0) || (self.off_walls[r] && size >= 2 && kinds & WALL != 0);
+            self.into_wall[i] = self.off_walls[r] && size >= 2 && kinds & WALL != 0;
+            *flag = (self.in_flight[r] && kinds & BALLS != 0) || self.into_wall[i];
             any |= *flag;
         }
         any
+    }
+
+    /// The balls of the groups the last [`Flights::mark`] undid because they strike a wall.
+    pub fn struck_into_wall(&self) -> &[bool] {
+        &self.into_wall
     }
 }
 
 /// What a group strikes in a step: each other, a wall.
 const BALLS: u32 = 1;
 const WALL: u32 = 2;
+
+/// The most sweeps over an undone group's pairs that part its pressed balls, and the overlap,
+/// relative to the pair's distance, below which a pair counts as parted (an `f32` position's
+/// rounding).
+const PARTING_SWEEPS: usize = 2000;
+const PARTED: f64 = 1e-7;
+
+/// Takes out of the undone groups (`undone`) the overlaps Rapier's plastic stop pressed into
+/// them ("Touching rows struck into a wall"): the step's velocities are the impact law's, but
+/// the positions are Rapier's, and a row it stopped as one block is left pressed into itself,
+/// which Rapier's next step would push apart with speeds the impacts never gave. Every pair of
+/// `found` (at the step's end) of two undone balls is parted along its centres' line until it
+/// overlaps no deeper than at the step's start (`start`), the lighter ball moving more; a ball
+/// that touches a wall at the step's end (a gap within `touching`) does not move. Marks the
+/// balls it moved in `moved` and returns whether it moved any.
+pub fn part_pressed(
+    found: &[Contact],
+    (undone, touching): (&[bool], f64),
+    (start, end): (&[[f64; 3]], &mut [[f64; 3]]),
+    (radius, mass): (&[f64], &[f64]),
+    moved: &mut [bool],
+) -> bool {
+    let distance = |x: &[[f64; 3]], i: usize, j: usize| -> f64 { (0..3).map(|a| (x[j][a] - x[i][a]).powi(2)).sum::<f64>().sqrt() };
+    let mut pairs: Vec<(usize, usize, f64)> = Vec::new();
+    let mut on_wall = vec![false; undone.len()];
+    for c in found.iter().filter(|c| undone[c.ball]) {
+        match c.other {
+            Other::Ball(j) if undone[j] => pairs.push((c.ball, j, (radius[c.ball] + radius[j]).min(distance(start, c.ball, j)))),
+            Other::Ball(_) => {}
+            Other::Wall(_) => on_wall[c.ball] |= c.gap <= touching,
+        }
+    }
+    let mut any = false;
+    for sweep in 0..PARTING_SWEEPS {
+        let mut deepest = 0.0f64;
+        // Sweeps alternate in direction, so a correction runs along a row both ways.
+        for k in 0..pairs.len() {
+            let (i, j, least) = pairs[if sweep % 2 == 0 { k } else { pairs.len() - 1 - k }];
+            let apart = distance(end, i, j);
+            let (free_i, free_j) = (if on_wall[i] { 0.0 } else { 1.0 / mass[i] }, if on_wall[j] { 0.0 } else { 1.0 / mass[j] });
+            if apart >= least || apart == 0.0 || free_i + free_j == 0.0 {
+                continue;
+            }
+            let short = least - apart;
+            for a in 0..3 {
+                let along = (end[j][a] - end[i][a]) / apart;
+                end[i][a] -= along * short * free_i / (free_i + free_j);
+                end[j][a] += along * short * free_j / (free_i + free_j);
+            }
+            (moved[i], moved[j]) = (moved[i] || free_i > 0.0, moved[j] || free_j > 0.0);
+            any = true;
+            deepest = deepest.max(short / least);
+        }
+        if deepest <= PARTED {
+            break;
+        }
+    }
+    any
+}
 
 #[cfg(test)]
 mod tests {
@@ -148,5 +217,30 @@ mod tests {
             Flights::default().mark(&found, &[true; 3], (|_| false, |i| i != 4), std::iter::empty(), [1, 2, 5].into_iter(), &mut undone);
         assert_eq!(undone, [true, true, false, false, false, false]);
         assert!(any);
+    }
+
+    /// A row pressed into itself against a wall is parted to touching, the ball on the wall
+    /// staying; a pair that overlapped at the step's start is parted only to that overlap.
+    #[test]
+    fn parts_a_pressed_row_from_the_ball_on_its_wall() {
+        let r = 0.005;
+        let wall = Contact { ball: 0, other: Other::Wall(crate::scene::Wall::Left), gap: -1e-6, normal: [-1.0, 0.0, 0.0] };
+        let found = [wall, pair(0, 1), pair(1, 2), pair(2, 3)];
+        // At the start the row touches, but the last two balls overlap by 1 um; Rapier's stop
+        // pressed every pair by 30 um more.
+        let start = [[r, 0.0, 0.0], [3.0 * r, 0.0, 0.0], [5.0 * r, 0.0, 0.0], [7.0 * r - 1e-6, 0.0, 0.0]];
+        let mut end = start;
+        for (k, x) in end.iter_mut().enumerate() {
+            x[0] -= 3e-5 * k as f64;
+        }
+        let mut moved = [false; 4];
+        let parted = part_pressed(&found, (&[true; 4], 1e-7), (&start, &mut end), (&[r; 4], &[0.01; 4]), &mut moved);
+        assert!(parted);
+        assert_eq!(moved, [false, true, true, true]);
+        assert_eq!(end[0], [r, 0.0, 0.0]);
+        for (k, least) in [(0, 2.0 * r), (1, 2.0 * r), (2, 2.0 * r - 1e-6)] {
+            let apart = end[k + 1][0] - end[k][0];
+            assert!((apart - least).abs() <= PARTED * least, "pair {k}: {apart} m apart, not {least}");
+        }
     }
 }

@@ -153,6 +153,7 @@ pub fn simulate_spatial_with(scene: &Scene, solver: SolverSettings, options: &Ru
     let mut strikes = strikes::Strikes::default();
     let mut flights = flights::Flights::default();
     let mut undone = vec![false; n];
+    let mut parted = vec![false; n];
     let mut joined: Vec<bool> = Vec::new();
     let mut unsolved = vec![Vec::new(); dampers.len()];
     // The pairs the impact law struck in a step, whose impulses Rapier forgets at the next.
@@ -591,6 +592,11 @@ pub fn simulate_spatial_with(scene: &Scene, solver: SolverSettings, options: &Ru
         if any_undone {
             kicked.iter_mut().zip(&undone).for_each(|(k, u)| *k |= u);
             now.write_spins(&mut world, &undone);
+            parted.iter_mut().for_each(|p| *p = false);
+            if flights::part_pressed(&found, (flights.struck_into_wall(), touching), (&before.x, &mut now.x), (&radius, &mass), &mut parted)
+            {
+                now.write_positions(&mut world, &parted);
+            }
         }
         now.write_velocities(&mut world, &kicked);
         impact_loss += step_impact_loss;
