@@ -2,7 +2,7 @@
 
 use bevy_rapier3d::rapier::prelude::Vector;
 
-use super::contacts::{Contact, Other};
+use super::contacts::{dot, Contact, Other};
 use super::world::SpatialWorld;
 use crate::scene::Wall;
 
@@ -51,6 +51,31 @@ impl BallState {
                 let r = body.linvel();
                 self.v[k] = [r.x as f64, r.y as f64, r.z as f64];
             }
+        }
+    }
+
+    /// Gives the balls marked in `undone` back the free flight of a step of `h` under gravity
+    /// `g` (of unit direction `down`) from `before`, undoing Rapier's solve of the step; a ball
+    /// that `lies_on_floor` has only its motion along the floor undone, and keeps Rapier's
+    /// velocity across the floor and its spin. Tells `undone_vx` each ball's x velocity change
+    /// undone (Rapier's less free flight's).
+    pub(super) fn undo_step(
+        &mut self,
+        before: &BallState,
+        (undone, lies_on_floor): (&[bool], impl Fn(usize) -> bool),
+        (g, down, h): ([f64; 3], [f64; 3], f64),
+        mut undone_vx: impl FnMut(usize, f64),
+    ) {
+        for i in (0..self.v.len()).filter(|&i| undone[i]) {
+            let mut free: [f64; 3] = std::array::from_fn(|a| before.v[i][a] + g[a] * h);
+            if lies_on_floor(i) {
+                let across = dot(self.v[i], down) - dot(free, down);
+                free = std::array::from_fn(|a| free[a] + across * down[a]);
+            } else {
+                self.w[i] = before.w[i];
+            }
+            undone_vx(i, self.v[i][0] - free[0]);
+            self.v[i] = free;
         }
     }
 

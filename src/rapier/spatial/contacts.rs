@@ -153,6 +153,14 @@ pub fn count(found: &[Contact], touching: f64, near: &mut [u32], held: &mut [u32
 /// it: one ball rests partly on the other (a row lying on the floor has none, to round-off).
 pub const PILE_LEANING: f64 = 1e-3;
 
+/// Whether a wall whose normal (from the ball) is `normal` is a floor under gravity of unit
+/// direction `down`: gravity presses a ball straight onto it, its normal leaning across
+/// gravity by less than [`PILE_LEANING`].
+pub fn is_floor(normal: [f64; 3], down: [f64; 3]) -> bool {
+    let along = dot(normal, down);
+    along > 0.0 && 1.0 - along * along < PILE_LEANING * PILE_LEANING
+}
+
 /// Marks in `in_pile` (one flag a ball) the balls of `found` in a pile: those touching (closer
 /// than `touching`) a ball along a normal that leans across gravity, of unit direction `down`,
 /// by [`PILE_LEANING`] or more. The weight such a contact carries presses the balls' other
@@ -169,7 +177,8 @@ pub fn mark_piles(found: &[Contact], touching: f64, down: [f64; 3], in_pile: &mu
     }
 }
 
-fn dot(a: [f64; 3], b: [f64; 3]) -> f64 {
+/// The dot product of two vectors.
+pub(super) fn dot(a: [f64; 3], b: [f64; 3]) -> f64 {
     a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
 }
 

@@ -9,7 +9,7 @@
 //! the step of a touching group off the walls of which a ball strikes a wall ("Touching rows
 //! struck into a wall"): Rapier's solve stops such a row as one block.
 
-use super::contacts::{Contact, Other};
+use super::contacts::{dot, Contact, Other};
 
 /// The step's groups of balls joined by contacts, kept between steps.
 #[derive(Default)]
@@ -120,13 +120,17 @@ const WALL: u32 = 2;
 const PARTING_SWEEPS: usize = 2000;
 const PARTED: f64 = 1e-7;
 
+/// A ball parted from another moves into a wall it touches when its move has at least this
+/// component along the wall's normal: it stays put for that pair instead.
+const INTO_WALL: f64 = 1e-3;
+
 /// Takes out of the undone groups (`undone`) the overlaps Rapier's plastic stop pressed into
 /// them ("Touching rows struck into a wall"): the step's velocities are the impact law's, but
 /// the positions are Rapier's, and a row it stopped as one block is left pressed into itself,
 /// which Rapier's next step would push apart with speeds the impacts never gave. Every pair of
 /// `found` (at the step's end) of two undone balls is parted along its centres' line until it
 /// overlaps no deeper than at the step's start (`start`), the lighter ball moving more; a ball
-/// that touches a wall at the step's end (a gap within `touching`) does not move. Marks the
+/// does not move into a wall it touches at the step's end (a gap within `touching`). Marks the
 /// balls it moved in `moved` and returns whether it moved any.
 pub fn part_pressed(
     found: &[Contact],
@@ -135,14 +139,29 @@ pub fn part_pressed(
     (radius, mass): (&[f64], &[f64]),
     moved: &mut [bool],
 ) -> bool {
-    let distance = |x: &[[f64; 3]], i: usize, j: usize| -> f64 { (0..3).map(|a| (x[j][a] - x[i][a]).powi(2)).sum::<f64>().sqrt() };
-    let mut pairs: Vec<(usize, usize, f64)> = Vec::new();
-    let mut on_wall = vec![false; undone.len()];
+    let between = |x: &[[f64; 3]], i: usize, j: usize| -> [f64; 3] { std::array::from_fn(|a| x[j][a] - x[i][a]) };
+    let length = |d: [f64; 3]| dot(d, d).sqrt();
+    let walls: Vec<(usize, [f64; 3])> = found
+        .iter()
+        .filter(|c| undone[c.ball] && matches!(c.other, Other::Wall(_)) && c.gap <= touching)
+        .map(|c| (c.ball, c.normal))
+        .collect();
+    // Whether ball `k` may move along `d`: no wall it touches lies that way.
+    let may_move = |k: usize, d: [f64; 3]| walls.iter().filter(|(ball, _)| *ball == k).all(|(_, n)| dot(*n, d) < INTO_WALL * length(d));
+    // Each pair with the distance it is parted to and its balls' shares of a correction.
+    let mut pairs: Vec<(usize, usize, f64, f64, f64)> = Vec::new();
     for c in found.iter().filter(|c| undone[c.ball]) {
-        match c.other {
-            Other::Ball(j) if undone[j] => pairs.push((c.ball, j, (radius[c.ball] + radius[j]).min(distance(start, c.ball, j)))),
-            Other::Ball(_) => {}
-            Other::Wall(_) => on_wall[c.ball] |= c.gap <= touching,
+        let Other::Ball(j) = c.other else { continue };
+        if !undone[j] {
+            continue;
+        }
+        let i = c.ball;
+        let d = between(end, i, j);
+        let least = (radius[i] + radius[j]).min(length(between(start, i, j)));
+        let free_i = if may_move(i, d.map(|x| -x)) { 1.0 / mass[i] } else { 0.0 };
+        let free_j = if may_move(j, d) { 1.0 / mass[j] } else { 0.0 };
+        if free_i + free_j > 0.0 {
+            pairs.push((i, j, least, free_i / (free_i + free_j), free_j / (free_i + free_j)));
         }
     }
     let mut any = false;
@@ -150,19 +169,18 @@ pub fn part_pressed(
         let mut deepest = 0.0f64;
         // Sweeps alternate in direction, so a correction runs along a row both ways.
         for k in 0..pairs.len() {
-            let (i, j, least) = pairs[if sweep % 2 == 0 { k } else { pairs.len() - 1 - k }];
-            let apart = distance(end, i, j);
-            let (free_i, free_j) = (if on_wall[i] { 0.0 } else { 1.0 / mass[i] }, if on_wall[j] { 0.0 } else { 1.0 / mass[j] });
-            if apart >= least || apart == 0.0 || free_i + free_j == 0.0 {
+            let (i, j, least, share_i, share_j) = pairs[if sweep % 2 == 0 { k } else { pairs.len() - 1 - k }];
+            let d = between(end, i, j);
+            let apart = length(d);
+            if apart >= least || apart == 0.0 {
                 continue;
             }
             let short = least - apart;
             for a in 0..3 {
-                let along = (end[j][a] - end[i][a]) / apart;
-                end[i][a] -= along * short * free_i / (free_i + free_j);
-                end[j][a] += along * short * free_j / (free_i + free_j);
+                end[i][a] -= d[a] / apart * short * share_i;
+                end[j][a] += d[a] / apart * short * share_j;
             }
-            (moved[i], moved[j]) = (moved[i] || free_i > 0.0, moved[j] || free_j > 0.0);
+            (moved[i], moved[j]) = (moved[i] || share_i > 0.0, moved[j] || share_j > 0.0);
             any = true;
             deepest = deepest.max(short / least);
         }
@@ -176,6 +194,7 @@ pub fn part_pressed(
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::scene::Wall;
 
     fn pair(a: usize, b: usize) -> Contact {
         Contact { ball: a, other: Other::Ball(b), gap: 0.0, normal: [1.0, 0.0, 0.0] }
@@ -219,13 +238,15 @@ mod tests {
         assert!(any);
     }
 
-    /// A row pressed into itself against a wall is parted to touching, the ball on the wall
-    /// staying; a pair that overlapped at the step's start is parted only to that overlap.
+    /// A row lying on the floor, pressed into itself against an end wall, is parted to
+    /// touching along the floor, the ball on the end wall staying; a pair that overlapped at
+    /// the step's start is parted only to that overlap.
     #[test]
     fn parts_a_pressed_row_from_the_ball_on_its_wall() {
         let r = 0.005;
-        let wall = Contact { ball: 0, other: Other::Wall(crate::scene::Wall::Left), gap: -1e-6, normal: [-1.0, 0.0, 0.0] };
-        let found = [wall, pair(0, 1), pair(1, 2), pair(2, 3)];
+        let wall = |ball, wall, normal| Contact { ball, other: Other::Wall(wall), gap: -1e-6, normal };
+        let mut found = vec![wall(0, Wall::Left, [-1.0, 0.0, 0.0]), pair(0, 1), pair(1, 2), pair(2, 3)];
+        found.extend((0..4).map(|k| wall(k, Wall::Floor, [0.0, 0.0, -1.0])));
         // At the start the row touches, but the last two balls overlap by 1 um; Rapier's stop
         // pressed every pair by 30 um more.
         let start = [[r, 0.0, 0.0], [3.0 * r, 0.0, 0.0], [5.0 * r, 0.0, 0.0], [7.0 * r - 1e-6, 0.0, 0.0]];

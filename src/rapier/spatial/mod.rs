@@ -38,7 +38,7 @@ use crate::scene::Scene;
 use balls::BallState;
 use carrier::Carrier;
 use closings::{Closing, Solved, WallKicks};
-use contacts::{Balls, Contact, Containers, FrameBody, Other};
+use contacts::{dot as contacts_dot, Balls, Contact, Containers, FrameBody, Other};
 use records::{impact_record, sample, sunk_too_deep};
 use settings::chambers;
 
@@ -319,7 +319,7 @@ pub fn simulate_spatial_with(scene: &Scene, solver: SolverSettings, options: &Ru
         // Strikes on touching groups are kept out of Rapier's solve of their pair (`strikes`).
         // The walls' mean acceleration over the step, as its closed form moves them.
         let walls_a: Vec<f64> = (0..bodies).map(|b| ((v1[b] - vs[b]) / h).abs()).collect();
-        strikes.predict(&found, &now.v, |k| vs[body_of[k]], touching, h, |c| resting_speed(c, &in_pile, &walls_a));
+        strikes.predict(&found, &now.v, |k| vs[body_of[k]], (touching, down), h, |c| resting_speed(c, &in_pile, &walls_a));
         // Each damper's strikes, as pairs of its world's colliders.
         unsolved.iter_mut().for_each(Vec::clear);
         for s in &strikes.list {
@@ -472,16 +472,16 @@ pub fn simulate_spatial_with(scene: &Scene, solver: SolverSettings, options: &Ru
         // So are touching groups that rested on no wall of which a ball strikes a wall: Rapier's
         // solve stops the whole group at once, where the impact law passes the strike along it.
         let struck_walls = new.iter().map(|closing| &found[closing.k]).filter(|c| matches!(c.other, Other::Wall(_))).map(|c| c.ball);
-        let free_or_off_walls = (|i| !strikes.pressed(i), |i| !strikes.held_by_wall(i));
+        // A ball lying on the floor outside a pile is off the walls too: such a group has only
+        // its motion along the floor undone, and keeps Rapier's hold across it and its spin.
+        let lies_on_floor = |i: usize| strikes.on_floor(i) && !in_pile[i];
+        let free_or_off_walls = (|i| !strikes.pressed(i), |i| !strikes.held_by_wall(i) && (!strikes.on_floor(i) || lies_on_floor(i)));
         let any_undone = flights.mark(&found, &joined, free_or_off_walls, struck_pairs, struck_walls, &mut undone);
         if any_undone {
-            for i in (0..n).filter(|&i| undone[i]) {
-                let free: [f64; 3] = std::array::from_fn(|a| before.v[i][a] + g[a] * h);
-                let b = body_of[i];
-                frame.vs[b] += mass[i] * (now.v[i][0] - free[0]) / body_mass[b];
-                now.v[i] = free;
-                now.w[i] = before.w[i];
-            }
+            // The frame takes back the x momentum the undone solve gave the balls.
+            now.undo_step(&before, (&undone, lies_on_floor), (g, down, h), |i, undone_vx| {
+                frame.vs[body_of[i]] += mass[i] * undone_vx / body_mass[body_of[i]];
+            });
             for closing in new.iter_mut() {
                 let c = found[closing.k];
                 let Other::Ball(j) = c.other else { continue };
@@ -684,8 +684,4 @@ pub fn simulate_spatial_with(scene: &Scene, solver: SolverSettings, options: &Ru
 /// Ball `b`'s vector less ball `a`'s, of `v` (positions or velocities).
 fn between(v: &[[f64; 3]], a: usize, b: usize) -> [f64; 3] {
     std::array::from_fn(|k| v[b][k] - v[a][k])
-}
-
-fn contacts_dot(a: [f64; 3], b: [f64; 3]) -> f64 {
-    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
 }

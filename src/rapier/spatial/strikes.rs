@@ -10,7 +10,7 @@
 
 use bevy_rapier3d::rapier::prelude::{ColliderHandle, ContactModificationContext, PhysicsHooks};
 
-use super::contacts::{Contact, Other};
+use super::contacts::{dot, is_floor, Contact, Other};
 
 /// A striker kept out of Rapier's solve of its pair for one step, and the ball it strikes.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -29,15 +29,12 @@ pub struct Strikes {
     touches_end_wall: Vec<bool>,
     pressed: Vec<bool>,
     held_by_wall: Vec<bool>,
+    on_floor: Vec<bool>,
     closings: Vec<u32>,
     /// Each ball's partner in a strike of the step, if it is in one.
     partner: Vec<Option<usize>>,
     /// The step's strikes.
     pub list: Vec<Strike>,
-}
-
-fn dot(a: [f64; 3], b: [f64; 3]) -> f64 {
-    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
 }
 
 impl Strikes {
@@ -53,14 +50,21 @@ impl Strikes {
         found: &[Contact],
         v: &[[f64; 3]],
         walls_v: impl Fn(usize) -> f64,
-        touching: f64,
+        (touching, down): (f64, [f64; 3]),
         h: f64,
         resting: impl Fn(&Contact) -> f64,
     ) {
         let n = v.len();
         self.list.clear();
-        for flags in [&mut self.touches_ball, &mut self.touches_any, &mut self.touches_end_wall, &mut self.pressed, &mut self.held_by_wall]
-        {
+        let flags = [
+            &mut self.touches_ball,
+            &mut self.touches_any,
+            &mut self.touches_end_wall,
+            &mut self.pressed,
+            &mut self.held_by_wall,
+            &mut self.on_floor,
+        ];
+        for flags in flags {
             flags.clear();
             flags.resize(n, false);
         }
@@ -93,7 +97,12 @@ impl Strikes {
                     let parting = w > rest;
                     self.pressed[c.ball] |= !parting;
                     // A ball that closes on the wall faster than a resting contact strikes it.
-                    self.held_by_wall[c.ball] |= !parting && w >= -rest;
+                    let held = !parting && w >= -rest;
+                    if is_floor(c.normal, down) {
+                        self.on_floor[c.ball] |= held;
+                    } else {
+                        self.held_by_wall[c.ball] |= held;
+                    }
                     self.touches_any[c.ball] = true;
                     self.touches_end_wall[c.ball] |= c.normal[0] != 0.0;
                 }
@@ -137,10 +146,16 @@ impl Strikes {
         self.pressed[i]
     }
 
-    /// Whether ball `i` rested on a wall at the step's start: it touched the wall and neither
-    /// parted from it nor closed on it faster than a resting contact.
+    /// Whether ball `i` rested on a wall other than a floor at the step's start: it touched
+    /// the wall and neither parted from it nor closed on it faster than a resting contact.
     pub fn held_by_wall(&self, i: usize) -> bool {
         self.held_by_wall[i]
+    }
+
+    /// Whether ball `i` rested so on a floor (a wall gravity presses it straight onto) at the
+    /// step's start.
+    pub fn on_floor(&self, i: usize) -> bool {
+        self.on_floor[i]
     }
 
     /// Whether contact `c` is between the balls of one of the step's strikes.
