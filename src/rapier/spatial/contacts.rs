@@ -264,7 +264,10 @@ pub fn closing(gap0: f64, w0: f64, g_n: f64, h: f64) -> (f64, f64) {
         if disc < 0.0 {
             h
         } else {
-            let roots = [(w0 - disc.sqrt()) / g_n, (w0 + disc.sqrt()) / g_n];
+            // The roots of g_n t^2 / 2 - w0 t - gap0, in the form that keeps a small g_n's
+            // root from cancelling to zero: q t = -gap0 and (g_n / 2) t = q.
+            let q = 0.5 * (w0 + w0.signum() * disc.sqrt());
+            let roots = [q / (0.5 * g_n), if q != 0.0 { -gap0 / q } else { f64::INFINITY }];
             let first = roots.into_iter().filter(|t| *t >= 0.0).fold(f64::INFINITY, f64::min);
             if first.is_finite() {
                 first
@@ -453,6 +456,19 @@ mod tests {
     use super::*;
     use rand::{Rng, SeedableRng};
     use rand_pcg::Pcg64;
+
+    /// A contact under a tiny acceleration along its normal (a heavy frame's, 1e-12 m/s^2)
+    /// closes when its free flight does: the quadratic's root cancelled to zero, so a wall a
+    /// step away was struck at the step's start, as the walls moved then.
+    #[test]
+    fn a_contact_under_a_tiny_acceleration_closes_when_its_flight_does() {
+        for g_n in [1e-12, -1e-12, 1e-3] {
+            let (tau, approach) = closing(1.216e-3, -1.0, g_n, 1e-3);
+            let flight = 1.216e-3 * (1.0 - 0.5 * g_n * 1.216e-3);
+            assert!((tau - flight).abs() <= 1e-9 * flight, "g_n {g_n}: closes at {tau} s, not {flight} s");
+            assert!((approach - (1.0 + g_n * tau)).abs() <= 1e-12, "g_n {g_n}: approach {approach} m/s");
+        }
+    }
 
     /// A lattice of touching balls, `nx` by `ny` by `nz`, with its contacts: neighbours along
     /// each axis, the left and right end walls at the first and last columns, the floor under
