@@ -358,15 +358,15 @@ fn moves_with_frame(c: &Contact) -> bool {
 }
 
 impl Cascade {
-    /// Strikes, one at a time and the fastest first, the contacts of `found` closer than
-    /// `touching` that approach faster than `resting(contact)`, beginning with those of the
+    /// Strikes, one at a time and the fastest first, the contacts of `found` that `touches`
+    /// that approach faster than `resting(contact)`, beginning with those of the
     /// `kicked` balls and going on to those of each ball struck, until none approaches or after
     /// four strikes a contact on average (a collapse within the step). `strike` applies one
     /// strike, given the contact and its approach speed; struck balls are marked in `kicked`.
     pub fn run(
         &mut self,
         found: &[Contact],
-        touching: f64,
+        touches: impl Fn(&Contact) -> bool,
         kicked: &mut [bool],
         resting: impl Fn(&Contact) -> f64,
         bodies: (&mut Balls, &mut FrameBody),
@@ -377,7 +377,7 @@ impl Cascade {
         self.by_ball.resize_with(n, Vec::new);
         self.by_ball.iter_mut().for_each(|list| list.clear());
         for (k, c) in found.iter().enumerate() {
-            if c.gap <= touching {
+            if touches(c) {
                 self.by_ball[c.ball].push(k);
                 if let Other::Ball(j) = c.other {
                     self.by_ball[j].push(k);
@@ -586,7 +586,8 @@ mod tests {
             let mut balls = Balls { v: &mut v_cal, mass: &mass };
             let mut strikes = Vec::new();
             let mut cascade = Cascade::default();
-            cascade.run(&found, 0.0, &mut kicked_cal, resting, (&mut balls, &mut frame_cal), |c, approach, balls, frame| {
+            let touches = |c: &Contact| c.gap <= 0.0;
+            cascade.run(&found, touches, &mut kicked_cal, resting, (&mut balls, &mut frame_cal), |c, approach, balls, frame| {
                 let k = found.iter().position(|f| f == c).unwrap();
                 strikes.push((k, approach));
                 strike(c, approach, e, balls, frame);

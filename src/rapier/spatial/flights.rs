@@ -124,6 +124,18 @@ const PARTED: f64 = 1e-7;
 /// component along the wall's normal: it stays put for that pair instead.
 const INTO_WALL: f64 = 1e-3;
 
+/// Whether balls `a` and `b` of an undone group touched at the step's start (positions `x`,
+/// velocities `v`, within `touching` of each other) and their free flight keeps them that close
+/// through a step of `h`. Such a pair touches still as hard spheres move, and takes the step's
+/// knock-ons, though Rapier's solve, whose positions the group keeps, may have opened it.
+pub fn kept_touching((a, b): (usize, usize), (x, v): (&[[f64; 3]], &[[f64; 3]]), radius: &[f64], (touching, h): (f64, f64)) -> bool {
+    let d: [f64; 3] = std::array::from_fn(|k| x[b][k] - x[a][k]);
+    let dv: [f64; 3] = std::array::from_fn(|k| v[b][k] - v[a][k]);
+    let distance = dot(d, d).sqrt();
+    let parting = (dot(dv, d) / distance).max(0.0);
+    distance - radius[a] - radius[b] + parting * h <= touching
+}
+
 /// Takes out of the undone groups (`undone`) the overlaps Rapier's plastic stop pressed into
 /// them ("Touching rows struck into a wall"): the step's velocities are the impact law's, but
 /// the positions are Rapier's, and a row it stopped as one block is left pressed into itself,

@@ -194,7 +194,8 @@ pub fn simulate_spatial_with(scene: &Scene, solver: SolverSettings, options: &Ru
         // The walls' mean acceleration over the first step.
         let walls_a: Vec<f64> = carrier.states(solver.dt).iter().zip(&vs).map(|((_, v1), v0)| ((v1 - v0) / solver.dt).abs()).collect();
         let resting = |c: &Contact| resting_speed(c, &in_pile, &walls_a);
-        cascade.run(&found, touching, &mut kicked, resting, (&mut balls, &mut frame), |c, approach, balls, frame| {
+        let touches = |c: &Contact| c.gap <= touching;
+        cascade.run(&found, touches, &mut kicked, resting, (&mut balls, &mut frame), |c, approach, balls, frame| {
             let lost = contacts::strike(c, approach, e, balls, frame);
             impact_loss += lost;
             impacts.push(impact_record(0.0, c, approach, lost));
@@ -578,7 +579,12 @@ pub fn simulate_spatial_with(scene: &Scene, solver: SolverSettings, options: &Ru
             // Touching pairs the impacts set approaching strike in turn, the fastest first.
             if !new.is_empty() {
                 let resting = |c: &Contact| resting_speed(c, &in_pile, &walls_a);
-                cascade.run(&found, touching, &mut kicked, resting, (&mut balls, &mut frame), |c, approach, balls, frame| {
+                let touches = |c: &Contact| {
+                    c.gap <= touching
+                        || matches!(c.other, Other::Ball(j) if any_undone && undone[c.ball] && undone[j]
+                            && flights::kept_touching((c.ball, j), (&before.x, &before.v), &radius, (touching, h)))
+                };
+                cascade.run(&found, touches, &mut kicked, resting, (&mut balls, &mut frame), |c, approach, balls, frame| {
                     let lost = contacts::strike(c, approach, e, balls, frame);
                     step_impact_loss += lost;
                     impacts.push(impact_record(t1, c, approach, lost));
