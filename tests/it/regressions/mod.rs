@@ -37,6 +37,7 @@ mod resting_ball_without_energy;
 mod row_pressed_into_wall;
 mod row_struck_into_wall;
 mod series_beyond_memory;
+mod solver_graph_after_forgetting;
 mod spatial_counts_impacts;
 mod spatial_series_read_back;
 pub(crate) mod squeezed_ball_stops;
