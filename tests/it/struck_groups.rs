@@ -32,18 +32,27 @@ enum Lying {
 /// too heavy for the balls to move. The horizon ends 20 ms after the strike, long before any
 /// ball reaches a wall.
 fn struck_row(gap: f64, row: usize, e: f64, dt: f64, lying: Lying) -> Scene {
-    let horizon = gap / SPEED + 0.02;
+    let first = 0.3;
+    let mut balls = vec![(first - 2.0 * RADIUS - gap, SPEED)];
+    balls.extend((0..row).map(|k| (first + 2.0 * RADIUS * k as f64, 0.0)));
+    long_box(&balls, gap / SPEED + 0.02, (e, dt), lying)
+}
+
+/// Balls of 10 g at `(x, velocity along x)` in a long box on a frame too heavy for them to move,
+/// lying so, restitution `e`, at steps of `dt`, for `horizon` (s).
+fn long_box(balls: &[(f64, f64)], horizon: f64, (e, dt): (f64, f64), lying: Lying) -> Scene {
     let height = 0.05;
-    let (world, z) = world_for(lying, height);
+    let (world, z) = match lying {
+        Lying::OnFloor => ("gravity = [0.0, 0.0, -9.81]\nfriction = 0.0", -0.5 * height + RADIUS),
+        Lying::Floating => ("friction = 0.1", 0.0),
+        Lying::OnLine => ("friction = 0.0", 0.0),
+    };
     let mut text = format!(
         "[frame]\nmass = 1e6\nstiffness = 1e6\ndamping = 0.0\ninitial_displacement = 0.0\n\
          [container]\nlength = 1.0\nwidth = 0.05\nheight = {height}\n\
          [world]\nrestitution = {e}\n{world}\n[rapier]\ndt = {dt}\n\
          [run]\nhorizon = {horizon}\nsample_dt = {horizon}\n"
     );
-    let first = 0.3;
-    let mut balls = vec![(first - 2.0 * RADIUS - gap, SPEED)];
-    balls.extend((0..row).map(|k| (first + 2.0 * RADIUS * k as f64, 0.0)));
     for (x, v) in balls {
         text += &format!("[[ball]]\nposition = [{x}, 0.0, {z}]\nmass = 0.01\nradius = {RADIUS}\nvelocity = [{v}, 0.0, 0.0]\n");
     }
@@ -144,31 +153,8 @@ proptest::proptest! {
 /// at steps of `dt`. The horizon ends 20 ms after the row reaches the wall, long before any
 /// ball reaches the other one.
 fn row_into_wall(gap: f64, row: usize, e: f64, dt: f64, lying: Lying) -> Scene {
-    let horizon = gap / SPEED + 0.02;
-    let height = 0.05;
-    let (world, z) = world_for(lying, height);
-    let mut text = format!(
-        "[frame]\nmass = 1e6\nstiffness = 1e6\ndamping = 0.0\ninitial_displacement = 0.0\n\
-         [container]\nlength = 1.0\nwidth = 0.05\nheight = {height}\n\
-         [world]\nrestitution = {e}\n{world}\n[rapier]\ndt = {dt}\n\
-         [run]\nhorizon = {horizon}\nsample_dt = {horizon}\n"
-    );
-    for k in 0..row {
-        let x = RADIUS + gap + 2.0 * RADIUS * k as f64;
-        text += &format!("[[ball]]\nposition = [{x}, 0.0, {z}]\nmass = 0.01\nradius = {RADIUS}\nvelocity = [{}, 0.0, 0.0]\n", -SPEED);
-    }
-    let scene = scene_from_toml(&text);
-    assert_eq!(spatial::needs_spatial(&scene), lying != Lying::OnLine);
-    scene
-}
-
-/// The `[world]` lines and the balls' height for a row lying so in a box of `height`.
-fn world_for(lying: Lying, height: f64) -> (&'static str, f64) {
-    match lying {
-        Lying::OnFloor => ("gravity = [0.0, 0.0, -9.81]\nfriction = 0.0", -0.5 * height + RADIUS),
-        Lying::Floating => ("friction = 0.1", 0.0),
-        Lying::OnLine => ("friction = 0.0", 0.0),
-    }
+    let balls: Vec<(f64, f64)> = (0..row).map(|k| (RADIUS + gap + 2.0 * RADIUS * k as f64, -SPEED)).collect();
+    long_box(&balls, gap / SPEED + 0.02, (e, dt), lying)
 }
 
 /// A ball striking a touching pair obliquely in the plane, without gravity or friction, with
