@@ -359,7 +359,7 @@ fn moves_with_frame(c: &Contact) -> bool {
 
 impl Cascade {
     /// Strikes, one at a time and the fastest first, the contacts of `found` that `touches`
-    /// that approach faster than `resting(contact)`, beginning with those of the
+    /// accepts and that approach faster than `resting(contact)`, beginning with those of the
     /// `kicked` balls and going on to those of each ball struck, until none approaches or after
     /// four strikes a contact on average (a collapse within the step). `strike` applies one
     /// strike, given the contact and its approach speed; struck balls are marked in `kicked`.
