@@ -118,11 +118,9 @@ fn drop_pairs(physics: &mut PhysicsWorld, pairs: &[Pair]) {
     // wrote) off Rapier's list of modified bodies without booking them in its islands, so the
     // step kept its graph of solver contacts and missed the changes the update made to it (in
     // debug builds an assertion of Rapier's, in release an index out of bounds). Marked
-    // modified again, every body is booked by the step, which then rebuilds that graph.
-    let handles: Vec<_> = physics.bodies.iter().map(|(handle, _)| handle).collect();
-    for handle in handles {
-        physics.bodies.get_mut(handle);
-    }
+    // modified again (Rapier's mutable iteration marks each body it yields), every body is
+    // booked by the step, which then rebuilds that graph.
+    physics.bodies.iter_mut().for_each(drop);
     // The update took the changes made to the world since the last step, which the step's
     // broad phase no longer sees: every collider is boxed for it anew.
     for (handle, collider) in physics.colliders.iter() {
