@@ -27,6 +27,21 @@ enum Lying {
     OnLine,
 }
 
+/// Checks every ball's final velocity in `run` against `expected` (§3's sequence) and, where
+/// given, the reference's `exact`. The strikes keep their f32 round-off; balls left touching
+/// are solved by Rapier at every one of the run's `steps`, each adding an f32 rounding of the
+/// speed.
+fn leaves_at(run: &[f64], expected: &[f64], exact: Option<&[f64]>, steps: f64) -> Result<(), proptest::test_runner::TestCaseError> {
+    let tolerance = (4.0 * F32_SOLVE + steps * f32::EPSILON as f64) * SPEED;
+    for (i, (v, w)) in run.iter().zip(expected).enumerate() {
+        proptest::prop_assert!((v - w).abs() <= tolerance, "ball {i}: {v} m/s against {w} ({run:?} against {expected:?})");
+        if let Some(exact) = exact {
+            proptest::prop_assert!((v - exact[i]).abs() <= tolerance, "ball {i}: {v} m/s against the reference's {}", exact[i]);
+        }
+    }
+    Ok(())
+}
+
 /// A ball of 10 g striking, from `gap` (m) at 1 m/s along the box's axis, a row of `row`
 /// balls of 10 g that touch at rest, restitution `e`, at steps of `dt`, in a long box on a frame
 /// too heavy for the balls to move. The horizon ends 20 ms after the strike, long before any
@@ -106,17 +121,8 @@ proptest::proptest! {
         // The contact model leaves to Rapier's plastic solve what approaches slower than a
         // resting contact, at least a billionth of the scene's speed.
         let expected = sequence_of_section_3(start, e, 1e-9 * SPEED, false);
-        // The strikes keep their f32 round-off; balls left touching (the stopped row) are
-        // solved by Rapier at every step, each adding an f32 rounding of the speed.
-        let steps = scene.horizon / dt;
-        let tolerance = (4.0 * F32_SOLVE + steps * f32::EPSILON as f64) * SPEED;
         let exact = if e == 1.0 { Some(reference(&struck_row(gap, row, e, dt, Lying::OnLine)).unwrap().final_velocities) } else { None };
-        for (i, (v, w)) in run.final_velocities.iter().zip(&expected).enumerate() {
-            proptest::prop_assert!((v - w).abs() <= tolerance, "ball {i}: {v} m/s against {w} ({:?} against {expected:?})", run.final_velocities);
-            if let Some(exact) = &exact {
-                proptest::prop_assert!((v - exact[i]).abs() <= tolerance, "ball {i}: {v} m/s against the reference's {}", exact[i]);
-            }
-        }
+        leaves_at(&run.final_velocities, &expected, exact.as_deref(), scene.horizon / dt)?;
     }
 
     /// A row of touching balls flying into a wall at `e = 1`, floating or lying on the floor,
@@ -136,15 +142,8 @@ proptest::proptest! {
         let scene = row_into_wall(gap, row, e, dt, lying);
         let run = simulate_spatial(&scene, &RunOptions::default()).unwrap();
         let expected = sequence_of_section_3(vec![-SPEED; row], e, 1e-9 * SPEED, true);
-        let steps = scene.horizon / dt;
-        let tolerance = (4.0 * F32_SOLVE + steps * f32::EPSILON as f64) * SPEED;
         let exact = if e == 1.0 { Some(reference(&row_into_wall(gap, row, e, dt, Lying::OnLine)).unwrap().final_velocities) } else { None };
-        for (i, (v, w)) in run.final_velocities.iter().zip(&expected).enumerate() {
-            proptest::prop_assert!((v - w).abs() <= tolerance, "ball {i}: {v} m/s against {w} ({:?} against {expected:?})", run.final_velocities);
-            if let Some(exact) = &exact {
-                proptest::prop_assert!((v - exact[i]).abs() <= tolerance, "ball {i}: {v} m/s against the reference's {}", exact[i]);
-            }
-        }
+        leaves_at(&run.final_velocities, &expected, exact.as_deref(), scene.horizon / dt)?;
     }
 }
 
